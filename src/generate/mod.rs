@@ -1,0 +1,4 @@
+//! Canonical model generators behind `weft-weave`. Each returns a validated [`Model`]
+//! with named node sets, ready to simulate.
+
+pub mod rod;

@@ -1,0 +1,16 @@
+//! weft: finite-element models of woven fabrics under impact, at two resolutions,
+//! coupled; an explicit solver, model generators, and stages that pass Parquet tables.
+//!
+//! Layout: [`model`] (the model and its folder of tables), [`solver`] (explicit central
+//! difference, element kernels, output sinks), [`simulate`] (the stage behind
+//! `weft-simulate`), [`generate`] (canonical models behind `weft-weave`), [`table`]
+//! (validated Parquet I/O with provenance), [`error`] (typed errors).
+
+pub mod error;
+pub mod generate;
+pub mod model;
+pub mod simulate;
+pub mod solver;
+pub mod table;
+
+pub use error::{Result, WeftError};

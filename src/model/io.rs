@@ -1,0 +1,593 @@
+//! Reading and writing a model folder of Parquet tables. Layout: `docs/tables.md`.
+
+use std::collections::{BTreeMap, HashMap};
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use super::*;
+use crate::table::{batch, write_table, Col, Provenance, Table};
+
+const NODES: &str = "node_id, x, y, z";
+const PARTS: &str = "part_id, name, kind (+ property columns)";
+const ELEMS2: &str = "element_id, part_id, n1, n2";
+const ELEMS1: &str = "element_id, part_id, n1";
+const SETS: &str = "set, node_id, order";
+const CONS: &str = "node_id, fix_x, fix_y, fix_z";
+const LOADS: &str = "load_id, node_id, fx, fy, fz, law, start (+ duration, curve)";
+const CURVES: &str = "curve, t, value";
+const VELS: &str = "node_id, vx, vy, vz";
+const ANALYSIS: &str = "end_time, output_interval (+ optional settings)";
+
+/// Names of the model tables, in the order they are written.
+pub const MODEL_TABLES: &[&str] = &[
+    "nodes.parquet",
+    "parts.parquet",
+    "elements_truss.parquet",
+    "elements_link.parquet",
+    "elements_point_mass.parquet",
+    "node_sets.parquet",
+    "constraints.parquet",
+    "loads.parquet",
+    "curves.parquet",
+    "initial_velocities.parquet",
+    "analysis.parquet",
+];
+
+fn opt_table(dir: &Path, name: &str) -> Result<Option<Table>> {
+    let p = dir.join(name);
+    if p.exists() {
+        Table::read(&p).map(Some)
+    } else {
+        Ok(None)
+    }
+}
+
+/// Map node ids of a column to node indices; a dangling id is an error naming the row.
+fn node_refs(t: &Table, col: &str, ids: &[i64], map: &HashMap<i64, usize>) -> Result<Vec<usize>> {
+    ids.iter()
+        .enumerate()
+        .map(|(row, id)| {
+            map.get(id).copied().ok_or_else(|| {
+                t.value_error(
+                    col,
+                    row,
+                    format!("node id `{id}` does not exist in nodes.parquet"),
+                )
+                .expected("the id of a node in nodes.parquet")
+                .hint("a dangling reference: regenerate the model or add the node")
+            })
+        })
+        .collect()
+}
+
+/// Read and validate a model folder.
+pub fn read_model(dir: &Path) -> Result<Model> {
+    let nodes_path = dir.join("nodes.parquet");
+    if !nodes_path.exists() {
+        return Err(WeftError::input(format!(
+            "`{}` is not a model folder: it has no nodes.parquet",
+            dir.display()
+        ))
+        .expected("a folder of model tables (docs/tables.md)")
+        .hint("create one with `weft-weave rod --out DIR`"));
+    }
+    read_model_inner(dir).map_err(|e| e.in_file(dir))
+}
+
+fn read_model_inner(dir: &Path) -> Result<Model> {
+    let mut m = Model::default();
+    let t = Table::read(&dir.join("nodes.parquet"))?;
+    m.node_id = t.i64("node_id", NODES)?;
+    let (x, y, z) = (t.f64("x", NODES)?, t.f64("y", NODES)?, t.f64("z", NODES)?);
+    m.coords = (0..x.len()).map(|i| [x[i], y[i], z[i]]).collect();
+    if m.node_id.is_empty() {
+        return Err(WeftError::input("the model has no nodes")
+            .in_file(&t.path)
+            .expected("at least one node"));
+    }
+    // Duplicate node ids are checked here, where the file is known.
+    let mut map = HashMap::new();
+    for (row, id) in m.node_id.iter().enumerate() {
+        if map.insert(*id, row).is_some() {
+            return Err(t
+                .value_error("node_id", row, format!("duplicate node id `{id}`"))
+                .expected("unique node ids"));
+        }
+    }
+
+    let t = Table::read(&dir.join("parts.parquet"))?;
+    let ids = t.i64("part_id", PARTS)?;
+    let names = t.str("name", PARTS)?;
+    let kinds = t.str("kind", PARTS)?;
+    let f = |c: &str| -> Result<Vec<Option<f64>>> {
+        Ok(t.f64_opt(c)?.unwrap_or_else(|| vec![None; ids.len()]))
+    };
+    let (e, rho, area) = (f("youngs_modulus")?, f("density")?, f("area")?);
+    let (kx, ky, kz) = (f("kx")?, f("ky")?, f("kz")?);
+    let (cx, cy, cz) = (f("cx")?, f("cy")?, f("cz")?);
+    let (slip, mass) = (f("slip_force")?, f("mass")?);
+    let tension_only = t
+        .bool_opt("tension_only")?
+        .unwrap_or_else(|| vec![None; ids.len()]);
+    for row in 0..ids.len() {
+        let kind = ElementKind::parse(&kinds[row]).ok_or_else(|| {
+            t.value_error(
+                "kind",
+                row,
+                format!("unknown element kind `{}`", kinds[row]),
+            )
+            .expected(format!(
+                "one of {}",
+                ElementKind::ALL
+                    .map(|k| format!("`{}`", k.name()))
+                    .join(", ")
+            ))
+        })?;
+        let part = Part {
+            id: ids[row],
+            name: names[row].clone(),
+            kind,
+            props: PartProps {
+                youngs_modulus: e[row],
+                density: rho[row],
+                area: area[row],
+                tension_only: tension_only[row],
+                kx: kx[row],
+                ky: ky[row],
+                kz: kz[row],
+                cx: cx[row],
+                cy: cy[row],
+                cz: cz[row],
+                slip_force: slip[row],
+                mass: mass[row],
+            },
+        };
+        validate_part(&part).map_err(|err| err.in_file(&t.path).at_row(row))?;
+        m.parts.push(part);
+    }
+    let mut part_map = HashMap::new();
+    for (row, p) in m.parts.iter().enumerate() {
+        if part_map.insert(p.id, row).is_some() {
+            return Err(t
+                .value_error("part_id", row, format!("duplicate part id `{}`", p.id))
+                .expected("unique part ids"));
+        }
+    }
+
+    // Element tables: every elements_*.parquet must be a known kind.
+    let entries = std::fs::read_dir(dir).map_err(|e| WeftError::io(dir, e))?;
+    for entry in entries {
+        let entry = entry.map_err(|e| WeftError::io(dir, e))?;
+        let name = entry.file_name().to_string_lossy().to_string();
+        if let Some(kind) = name
+            .strip_prefix("elements_")
+            .and_then(|s| s.strip_suffix(".parquet"))
+        {
+            if ElementKind::parse(kind).is_none() {
+                return Err(WeftError::input(format!("unknown element table `{name}`"))
+                    .in_file(entry.path())
+                    .expected(format!(
+                        "one of {}",
+                        ElementKind::ALL
+                            .map(|k| format!("elements_{}.parquet", k.name()))
+                            .join(", ")
+                    ))
+                    .hint("this weft version does not know that element kind"));
+            }
+        }
+    }
+    for kind in ElementKind::ALL {
+        let Some(t) = opt_table(dir, &format!("elements_{}.parquet", kind.name()))? else {
+            continue;
+        };
+        let exp = if kind.nodes_per_element() == 2 {
+            ELEMS2
+        } else {
+            ELEMS1
+        };
+        let eid = t.i64("element_id", exp)?;
+        let pid = t.i64("part_id", exp)?;
+        let mut cols = Vec::new();
+        for c in ["n1", "n2"].iter().take(kind.nodes_per_element()) {
+            let ids = t.i64(c, exp)?;
+            cols.push(node_refs(&t, c, &ids, &map)?);
+        }
+        let mut b = ElementBlock::default();
+        for row in 0..eid.len() {
+            let part = *part_map.get(&pid[row]).ok_or_else(|| {
+                t.value_error(
+                    "part_id",
+                    row,
+                    format!("part id `{}` does not exist in parts.parquet", pid[row]),
+                )
+                .expected("the id of a part in parts.parquet")
+            })?;
+            b.id.push(eid[row]);
+            b.part.push(part);
+            for c in &cols {
+                b.nodes.push(c[row]);
+            }
+        }
+        m.elements.insert(kind, b);
+    }
+
+    if let Some(t) = opt_table(dir, "node_sets.parquet")? {
+        let names = t.str("set", SETS)?;
+        let ids = t.i64("node_id", SETS)?;
+        let order = t.i64("order", SETS)?;
+        let idx = node_refs(&t, "node_id", &ids, &map)?;
+        let mut sets: BTreeMap<String, Vec<(i64, usize)>> = BTreeMap::new();
+        for row in 0..names.len() {
+            sets.entry(names[row].clone())
+                .or_default()
+                .push((order[row], idx[row]));
+        }
+        for (name, mut v) in sets {
+            v.sort_by_key(|p| p.0);
+            m.node_sets
+                .insert(name, v.into_iter().map(|p| p.1).collect());
+        }
+    }
+    if let Some(t) = opt_table(dir, "constraints.parquet")? {
+        let ids = t.i64("node_id", CONS)?;
+        let idx = node_refs(&t, "node_id", &ids, &map)?;
+        let (fx, fy, fz) = (
+            t.bool("fix_x", CONS)?,
+            t.bool("fix_y", CONS)?,
+            t.bool("fix_z", CONS)?,
+        );
+        m.constraints = (0..idx.len())
+            .map(|i| (idx[i], [fx[i], fy[i], fz[i]]))
+            .collect();
+    }
+    if let Some(t) = opt_table(dir, "curves.parquet")? {
+        let names = t.str("curve", CURVES)?;
+        let ts = t.f64("t", CURVES)?;
+        let vs = t.f64("value", CURVES)?;
+        let mut curves: BTreeMap<String, Curve> = BTreeMap::new();
+        for row in 0..names.len() {
+            let c = curves.entry(names[row].clone()).or_insert(Curve {
+                t: vec![],
+                value: vec![],
+            });
+            if let Some(&last) = c.t.last() {
+                if ts[row] <= last {
+                    return Err(t
+                        .value_error(
+                            "t",
+                            row,
+                            format!(
+                                "curve `{}` time `{}` does not increase (previous {last})",
+                                names[row], ts[row]
+                            ),
+                        )
+                        .expected("strictly increasing times within a curve"));
+                }
+            }
+            c.t.push(ts[row]);
+            c.value.push(vs[row]);
+        }
+        m.curves = curves.into_iter().map(|(k, v)| (k, Arc::new(v))).collect();
+    }
+    if let Some(t) = opt_table(dir, "loads.parquet")? {
+        let lid = t.i64("load_id", LOADS)?;
+        let ids = t.i64("node_id", LOADS)?;
+        let idx = node_refs(&t, "node_id", &ids, &map)?;
+        let (fx, fy, fz) = (
+            t.f64("fx", LOADS)?,
+            t.f64("fy", LOADS)?,
+            t.f64("fz", LOADS)?,
+        );
+        let law = t.str("law", LOADS)?;
+        let start = t.f64("start", LOADS)?;
+        let duration = t
+            .f64_opt("duration")?
+            .unwrap_or_else(|| vec![None; lid.len()]);
+        let curve = t.str_opt("curve")?.unwrap_or_else(|| vec![None; lid.len()]);
+        for row in 0..lid.len() {
+            let need_duration = || {
+                duration[row].filter(|d| *d > 0.0).ok_or_else(|| {
+                    t.value_error(
+                        "duration",
+                        row,
+                        format!(
+                            "load `{}` ({}) has duration {:?}",
+                            lid[row], law[row], duration[row]
+                        ),
+                    )
+                    .expected("a duration > 0 s for sine_pulse and ramp")
+                })
+            };
+            let l = match law[row].as_str() {
+                "sine_pulse" => TimeLaw::SinePulse {
+                    start: start[row],
+                    duration: need_duration()?,
+                },
+                "ramp" => TimeLaw::Ramp {
+                    start: start[row],
+                    duration: need_duration()?,
+                },
+                "step" => TimeLaw::Step { start: start[row] },
+                "tabulated" => {
+                    let name = curve[row].clone().unwrap_or_default();
+                    let c = m.curves.get(&name).cloned().ok_or_else(|| {
+                        t.value_error("curve", row, format!("load `{}` names curve `{name}`, which curves.parquet does not define", lid[row]))
+                            .expected("the name of a curve in curves.parquet")
+                    })?;
+                    TimeLaw::Tabulated { name, curve: c }
+                }
+                other => {
+                    return Err(t
+                        .value_error("law", row, format!("unknown time law `{other}`"))
+                        .expected("one of `sine_pulse`, `step`, `ramp`, `tabulated`"))
+                }
+            };
+            m.loads.push(Load {
+                id: lid[row],
+                node: idx[row],
+                force: [fx[row], fy[row], fz[row]],
+                law: l,
+            });
+        }
+    }
+    if let Some(t) = opt_table(dir, "initial_velocities.parquet")? {
+        let ids = t.i64("node_id", VELS)?;
+        let idx = node_refs(&t, "node_id", &ids, &map)?;
+        let (vx, vy, vz) = (t.f64("vx", VELS)?, t.f64("vy", VELS)?, t.f64("vz", VELS)?);
+        m.initial_velocities = (0..idx.len())
+            .map(|i| (idx[i], [vx[i], vy[i], vz[i]]))
+            .collect();
+    }
+    if let Some(t) = opt_table(dir, "analysis.parquet")? {
+        if t.num_rows() != 1 {
+            return Err(
+                WeftError::input(format!("analysis table has {} rows", t.num_rows()))
+                    .in_file(&t.path)
+                    .expected("exactly one row"),
+            );
+        }
+        let d = Analysis::default();
+        let get = |c: &str, dflt: Option<f64>| -> Result<Option<f64>> {
+            Ok(t.f64_opt(c)?.and_then(|v| v[0]).or(dflt))
+        };
+        let sets = t
+            .str_opt("history_sets")?
+            .and_then(|v| v[0].clone())
+            .unwrap_or_default();
+        m.analysis = Analysis {
+            end_time: t.f64("end_time", ANALYSIS)?[0],
+            output_interval: t.f64("output_interval", ANALYSIS)?[0],
+            dt_safety: get("dt_safety", Some(d.dt_safety))?.unwrap(),
+            mass_damping: get("mass_damping", Some(d.mass_damping))?.unwrap(),
+            time_step: get("time_step", None)?,
+            target_time_step: get("target_time_step", None)?,
+            history_sets: sets
+                .split(',')
+                .map(str::trim)
+                .filter(|s| !s.is_empty())
+                .map(String::from)
+                .collect(),
+            max_energy_error: get("max_energy_error", Some(d.max_energy_error))?.unwrap(),
+        };
+    }
+    m.validate()?;
+    Ok(m)
+}
+
+/// Write a model folder. The folder is assembled beside the target and swapped into
+/// place, so a reader never sees a mix of old and new tables.
+pub fn write_model(m: &Model, dir: &Path, prov: &Provenance) -> Result<()> {
+    m.validate()?;
+    let parent = dir
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    std::fs::create_dir_all(parent).map_err(|e| WeftError::io(parent, e))?;
+    let name = dir
+        .file_name()
+        .map(|s| s.to_string_lossy().to_string())
+        .unwrap_or_else(|| "model".into());
+    let tmp = parent.join(format!(".{name}.tmp-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&tmp);
+    std::fs::create_dir_all(&tmp).map_err(|e| WeftError::io(&tmp, e))?;
+    let res = write_tables(m, &tmp, prov);
+    if let Err(e) = res {
+        let _ = std::fs::remove_dir_all(&tmp);
+        return Err(e);
+    }
+    let old: PathBuf = parent.join(format!(".{name}.old-{}", std::process::id()));
+    if dir.exists() {
+        std::fs::rename(dir, &old).map_err(|e| WeftError::io(dir, e))?;
+    }
+    std::fs::rename(&tmp, dir).map_err(|e| WeftError::io(dir, e))?;
+    let _ = std::fs::remove_dir_all(&old);
+    Ok(())
+}
+
+fn write_tables(m: &Model, dir: &Path, prov: &Provenance) -> Result<()> {
+    let ids = |v: &[usize]| v.iter().map(|&i| m.node_id[i]).collect::<Vec<_>>();
+    write_table(
+        &dir.join("nodes.parquet"),
+        &batch(vec![
+            Col::I64("node_id", m.node_id.clone()),
+            Col::F64("x", m.coords.iter().map(|c| c[0]).collect()),
+            Col::F64("y", m.coords.iter().map(|c| c[1]).collect()),
+            Col::F64("z", m.coords.iter().map(|c| c[2]).collect()),
+        ]),
+        prov,
+    )?;
+    let p = &m.parts;
+    let pc = |f: fn(&PartProps) -> Option<f64>| p.iter().map(|x| f(&x.props)).collect::<Vec<_>>();
+    write_table(
+        &dir.join("parts.parquet"),
+        &batch(vec![
+            Col::I64("part_id", p.iter().map(|x| x.id).collect()),
+            Col::Str("name", p.iter().map(|x| x.name.clone()).collect()),
+            Col::Str(
+                "kind",
+                p.iter().map(|x| x.kind.name().to_string()).collect(),
+            ),
+            Col::OptF64("youngs_modulus", pc(|q| q.youngs_modulus)),
+            Col::OptF64("density", pc(|q| q.density)),
+            Col::OptF64("area", pc(|q| q.area)),
+            Col::OptBool(
+                "tension_only",
+                p.iter().map(|x| x.props.tension_only).collect(),
+            ),
+            Col::OptF64("kx", pc(|q| q.kx)),
+            Col::OptF64("ky", pc(|q| q.ky)),
+            Col::OptF64("kz", pc(|q| q.kz)),
+            Col::OptF64("cx", pc(|q| q.cx)),
+            Col::OptF64("cy", pc(|q| q.cy)),
+            Col::OptF64("cz", pc(|q| q.cz)),
+            Col::OptF64("slip_force", pc(|q| q.slip_force)),
+            Col::OptF64("mass", pc(|q| q.mass)),
+        ]),
+        prov,
+    )?;
+    for (kind, b) in &m.elements {
+        if b.is_empty() {
+            continue;
+        }
+        let npe = kind.nodes_per_element();
+        let mut cols = vec![
+            Col::I64("element_id", b.id.clone()),
+            Col::I64("part_id", b.part.iter().map(|&i| m.parts[i].id).collect()),
+        ];
+        for (j, c) in ["n1", "n2"].into_iter().take(npe).enumerate() {
+            let v: Vec<usize> = b.nodes.iter().skip(j).step_by(npe).copied().collect();
+            cols.push(Col::I64(c, ids(&v)));
+        }
+        write_table(
+            &dir.join(format!("elements_{}.parquet", kind.name())),
+            &batch(cols),
+            prov,
+        )?;
+    }
+    if !m.node_sets.is_empty() {
+        let (mut s, mut n, mut o) = (vec![], vec![], vec![]);
+        for (name, set) in &m.node_sets {
+            for (k, &i) in set.iter().enumerate() {
+                s.push(name.clone());
+                n.push(m.node_id[i]);
+                o.push(k as i64);
+            }
+        }
+        write_table(
+            &dir.join("node_sets.parquet"),
+            &batch(vec![
+                Col::Str("set", s),
+                Col::I64("node_id", n),
+                Col::I64("order", o),
+            ]),
+            prov,
+        )?;
+    }
+    if !m.constraints.is_empty() {
+        let c = &m.constraints;
+        write_table(
+            &dir.join("constraints.parquet"),
+            &batch(vec![
+                Col::I64("node_id", c.iter().map(|x| m.node_id[x.0]).collect()),
+                Col::Bool("fix_x", c.iter().map(|x| x.1[0]).collect()),
+                Col::Bool("fix_y", c.iter().map(|x| x.1[1]).collect()),
+                Col::Bool("fix_z", c.iter().map(|x| x.1[2]).collect()),
+            ]),
+            prov,
+        )?;
+    }
+    if !m.curves.is_empty() {
+        let (mut n, mut t, mut v) = (vec![], vec![], vec![]);
+        for (name, c) in &m.curves {
+            for k in 0..c.t.len() {
+                n.push(name.clone());
+                t.push(c.t[k]);
+                v.push(c.value[k]);
+            }
+        }
+        write_table(
+            &dir.join("curves.parquet"),
+            &batch(vec![
+                Col::Str("curve", n),
+                Col::F64("t", t),
+                Col::F64("value", v),
+            ]),
+            prov,
+        )?;
+    }
+    if !m.loads.is_empty() {
+        let l = &m.loads;
+        let start = |law: &TimeLaw| match law {
+            TimeLaw::SinePulse { start, .. }
+            | TimeLaw::Ramp { start, .. }
+            | TimeLaw::Step { start } => *start,
+            TimeLaw::Tabulated { .. } => 0.0,
+        };
+        let duration = |law: &TimeLaw| match law {
+            TimeLaw::SinePulse { duration, .. } | TimeLaw::Ramp { duration, .. } => Some(*duration),
+            _ => None,
+        };
+        let curve = |law: &TimeLaw| match law {
+            TimeLaw::Tabulated { name, .. } => Some(name.clone()),
+            _ => None,
+        };
+        let mut cols = vec![
+            Col::I64("load_id", l.iter().map(|x| x.id).collect()),
+            Col::I64("node_id", l.iter().map(|x| m.node_id[x.node]).collect()),
+            Col::F64("fx", l.iter().map(|x| x.force[0]).collect()),
+            Col::F64("fy", l.iter().map(|x| x.force[1]).collect()),
+            Col::F64("fz", l.iter().map(|x| x.force[2]).collect()),
+            Col::Str("law", l.iter().map(|x| x.law.name().to_string()).collect()),
+            Col::F64("start", l.iter().map(|x| start(&x.law)).collect()),
+            Col::OptF64("duration", l.iter().map(|x| duration(&x.law)).collect()),
+        ];
+        let curves: Vec<Option<String>> = l.iter().map(|x| curve(&x.law)).collect();
+        let (f, a) = (
+            arrow_schema::Field::new("curve", arrow_schema::DataType::Utf8, true),
+            Arc::new(arrow_array::StringArray::from(curves)) as arrow_array::ArrayRef,
+        );
+        let b = batch(std::mem::take(&mut cols));
+        let mut fields: Vec<arrow_schema::Field> = b
+            .schema()
+            .fields()
+            .iter()
+            .map(|x| x.as_ref().clone())
+            .collect();
+        let mut arrays = b.columns().to_vec();
+        fields.push(f);
+        arrays.push(a);
+        let b =
+            arrow_array::RecordBatch::try_new(Arc::new(arrow_schema::Schema::new(fields)), arrays)
+                .expect("equal lengths");
+        write_table(&dir.join("loads.parquet"), &b, prov)?;
+    }
+    if !m.initial_velocities.is_empty() {
+        let v = &m.initial_velocities;
+        write_table(
+            &dir.join("initial_velocities.parquet"),
+            &batch(vec![
+                Col::I64("node_id", v.iter().map(|x| m.node_id[x.0]).collect()),
+                Col::F64("vx", v.iter().map(|x| x.1[0]).collect()),
+                Col::F64("vy", v.iter().map(|x| x.1[1]).collect()),
+                Col::F64("vz", v.iter().map(|x| x.1[2]).collect()),
+            ]),
+            prov,
+        )?;
+    }
+    let a = &m.analysis;
+    write_table(
+        &dir.join("analysis.parquet"),
+        &batch(vec![
+            Col::F64("end_time", vec![a.end_time]),
+            Col::F64("output_interval", vec![a.output_interval]),
+            Col::F64("dt_safety", vec![a.dt_safety]),
+            Col::F64("mass_damping", vec![a.mass_damping]),
+            Col::OptF64("time_step", vec![a.time_step]),
+            Col::OptF64("target_time_step", vec![a.target_time_step]),
+            Col::Str("history_sets", vec![a.history_sets.join(",")]),
+            Col::F64("max_energy_error", vec![a.max_energy_error]),
+        ]),
+        prov,
+    )?;
+    Ok(())
+}

@@ -1,0 +1,602 @@
+//! The model: nodes, parts, elements by kind, node sets, constraints, loads with time
+//! laws, initial velocities and analysis settings, all in SI units.
+//!
+//! A model lives on disk as a folder of Parquet tables (see [`io`] and
+//! `docs/tables.md`); in memory, elements refer to nodes and parts by index. Generators
+//! build models with [`Model`]'s `add_*` methods; [`Model::validate`] checks every
+//! property and reference and names the offending part, element, node or row.
+
+pub mod io;
+
+use std::collections::{BTreeMap, HashMap};
+use std::sync::Arc;
+
+use crate::error::{Result, WeftError};
+
+/// Element families known to the solver. The string form is the `kind` column of
+/// `parts.parquet` and the suffix of `elements_<kind>.parquet`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum ElementKind {
+    /// Two-node corotational truss (rod), optionally tension-only.
+    Truss,
+    /// Two-node discrete link: spring and dashpot per global axis, optional friction
+    /// slider in the global x–y plane.
+    Link,
+    /// One-node point mass.
+    PointMass,
+}
+
+impl ElementKind {
+    pub const ALL: [ElementKind; 3] = [
+        ElementKind::Truss,
+        ElementKind::Link,
+        ElementKind::PointMass,
+    ];
+    pub fn name(self) -> &'static str {
+        match self {
+            ElementKind::Truss => "truss",
+            ElementKind::Link => "link",
+            ElementKind::PointMass => "point_mass",
+        }
+    }
+    pub fn nodes_per_element(self) -> usize {
+        match self {
+            ElementKind::Truss | ElementKind::Link => 2,
+            ElementKind::PointMass => 1,
+        }
+    }
+    pub fn parse(s: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|k| k.name() == s)
+    }
+}
+
+/// Part properties. Which ones apply depends on the part's element kind (see
+/// `docs/tables.md`); the others stay `None`.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct PartProps {
+    /// Young's modulus E [Pa] (truss).
+    pub youngs_modulus: Option<f64>,
+    /// Mass density ρ [kg/m³] (truss).
+    pub density: Option<f64>,
+    /// Cross-section area A [m²] (truss).
+    pub area: Option<f64>,
+    /// Truss carries no compression when true.
+    pub tension_only: Option<bool>,
+    /// Link spring stiffnesses along global x, y, z [N/m].
+    pub kx: Option<f64>,
+    pub ky: Option<f64>,
+    pub kz: Option<f64>,
+    /// Link dashpot coefficients along global x, y, z [N·s/m].
+    pub cx: Option<f64>,
+    pub cy: Option<f64>,
+    pub cz: Option<f64>,
+    /// Link friction slider: tangential (x–y) force limit [N]; `None` = no slider.
+    pub slip_force: Option<f64>,
+    /// Point mass [kg].
+    pub mass: Option<f64>,
+}
+
+#[derive(Debug, Clone)]
+pub struct Part {
+    pub id: i64,
+    pub name: String,
+    pub kind: ElementKind,
+    pub props: PartProps,
+}
+
+/// Elements of one kind, struct-of-arrays; `nodes` holds `nodes_per_element` node
+/// indices per element.
+#[derive(Debug, Clone, Default)]
+pub struct ElementBlock {
+    pub id: Vec<i64>,
+    /// Index into [`Model::parts`].
+    pub part: Vec<usize>,
+    /// Node indices, `nodes_per_element` consecutive entries per element.
+    pub nodes: Vec<usize>,
+}
+
+impl ElementBlock {
+    pub fn len(&self) -> usize {
+        self.id.len()
+    }
+    pub fn is_empty(&self) -> bool {
+        self.id.is_empty()
+    }
+}
+
+/// A tabulated function of time g(t), linearly interpolated, held constant beyond its
+/// first and last points.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Curve {
+    pub t: Vec<f64>,
+    pub value: Vec<f64>,
+}
+
+impl Curve {
+    pub fn eval(&self, t: f64) -> f64 {
+        let n = self.t.len();
+        if t <= self.t[0] {
+            return self.value[0];
+        }
+        if t >= self.t[n - 1] {
+            return self.value[n - 1];
+        }
+        let i = self.t.partition_point(|&ti| ti <= t) - 1;
+        let w = (t - self.t[i]) / (self.t[i + 1] - self.t[i]);
+        self.value[i] + w * (self.value[i + 1] - self.value[i])
+    }
+}
+
+/// Time law g(t) of a load: the applied force is F(t) = F·g(t).
+#[derive(Debug, Clone, PartialEq)]
+pub enum TimeLaw {
+    /// g = sin(π (t − t0)/T_F) for t0 ≤ t ≤ t0 + T_F, 0 otherwise.
+    SinePulse { start: f64, duration: f64 },
+    /// g = 0 before t0, 1 from t0 on.
+    Step { start: f64 },
+    /// g = 0 before t0, rising linearly to 1 at t0 + T, 1 after.
+    Ramp { start: f64, duration: f64 },
+    /// g = the named curve of `curves.parquet`, evaluated at t.
+    Tabulated { name: String, curve: Arc<Curve> },
+}
+
+impl TimeLaw {
+    pub fn name(&self) -> &'static str {
+        match self {
+            TimeLaw::SinePulse { .. } => "sine_pulse",
+            TimeLaw::Step { .. } => "step",
+            TimeLaw::Ramp { .. } => "ramp",
+            TimeLaw::Tabulated { .. } => "tabulated",
+        }
+    }
+    pub fn eval(&self, t: f64) -> f64 {
+        match self {
+            TimeLaw::SinePulse { start, duration } => {
+                let s = t - start;
+                if (0.0..=*duration).contains(&s) {
+                    (std::f64::consts::PI * s / duration).sin()
+                } else {
+                    0.0
+                }
+            }
+            TimeLaw::Step { start } => {
+                if t >= *start {
+                    1.0
+                } else {
+                    0.0
+                }
+            }
+            TimeLaw::Ramp { start, duration } => ((t - start) / duration).clamp(0.0, 1.0),
+            TimeLaw::Tabulated { curve, .. } => curve.eval(t),
+        }
+    }
+}
+
+/// A nodal force F·g(t).
+#[derive(Debug, Clone)]
+pub struct Load {
+    pub id: i64,
+    pub node: usize,
+    /// Force vector amplitude [N].
+    pub force: [f64; 3],
+    pub law: TimeLaw,
+}
+
+/// Analysis settings (`analysis.parquet`); command-line flags of `weft-simulate`
+/// override them.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Analysis {
+    /// Simulated time [s].
+    pub end_time: f64,
+    /// Spacing of the output time grid [s]; outputs at k·Δt_out, k = 0..=round(end/Δt_out).
+    pub output_interval: f64,
+    /// Safety factor on the stable time step (0 < f ≤ 1). Default 0.9: the usual
+    /// explicit-code margin for the step estimate's neglect of element coupling.
+    pub dt_safety: f64,
+    /// Mass-proportional damping coefficient α [1/s]: f_d = −α m v.
+    pub mass_damping: f64,
+    /// Fixed time step [s]; must not exceed the stable step. `None`: the stable step.
+    pub time_step: Option<f64>,
+    /// Target time step for mass scaling [s]: elements whose stable step is below it get
+    /// added nodal mass. `None`: no mass scaling.
+    pub target_time_step: Option<f64>,
+    /// Node sets written to `history.parquet`; empty = all nodes.
+    pub history_sets: Vec<String>,
+    /// Stop when |energy balance error| exceeds this fraction of the reference energy.
+    /// Default 0.1: far above the O(Δt²) drift of a stable run, far below the energy
+    /// growth of an instability, which is exponential.
+    pub max_energy_error: f64,
+}
+
+impl Default for Analysis {
+    fn default() -> Self {
+        Analysis {
+            end_time: 1e-4,
+            output_interval: 1e-6,
+            dt_safety: 0.9,
+            mass_damping: 0.0,
+            time_step: None,
+            target_time_step: None,
+            history_sets: Vec::new(),
+            max_energy_error: 0.1,
+        }
+    }
+}
+
+#[derive(Debug, Clone, Default)]
+pub struct Model {
+    pub node_id: Vec<i64>,
+    /// Initial coordinates [m].
+    pub coords: Vec<[f64; 3]>,
+    pub parts: Vec<Part>,
+    /// Element blocks by kind.
+    pub elements: BTreeMap<ElementKind, ElementBlock>,
+    /// Named ordered node sets (node indices).
+    pub node_sets: BTreeMap<String, Vec<usize>>,
+    /// Fixed degrees of freedom per constrained node: (node index, [x, y, z] fixed).
+    pub constraints: Vec<(usize, [bool; 3])>,
+    pub loads: Vec<Load>,
+    /// Tabulated curves by name.
+    pub curves: BTreeMap<String, Arc<Curve>>,
+    /// Initial velocities [m/s]: (node index, v).
+    pub initial_velocities: Vec<(usize, [f64; 3])>,
+    pub analysis: Analysis,
+}
+
+impl Model {
+    pub fn num_nodes(&self) -> usize {
+        self.node_id.len()
+    }
+
+    /// Add a node; returns its index.
+    pub fn add_node(&mut self, id: i64, x: [f64; 3]) -> usize {
+        self.node_id.push(id);
+        self.coords.push(x);
+        self.node_id.len() - 1
+    }
+
+    /// Add a part; returns its index.
+    pub fn add_part(&mut self, id: i64, name: &str, kind: ElementKind, props: PartProps) -> usize {
+        self.parts.push(Part {
+            id,
+            name: name.to_string(),
+            kind,
+            props,
+        });
+        self.parts.len() - 1
+    }
+
+    /// Add an element of the part's kind on the given node indices.
+    pub fn add_element(&mut self, id: i64, part: usize, nodes: &[usize]) {
+        let kind = self.parts[part].kind;
+        assert_eq!(
+            nodes.len(),
+            kind.nodes_per_element(),
+            "node count of a {}",
+            kind.name()
+        );
+        let b = self.elements.entry(kind).or_default();
+        b.id.push(id);
+        b.part.push(part);
+        b.nodes.extend_from_slice(nodes);
+    }
+
+    pub fn block(&self, kind: ElementKind) -> Option<&ElementBlock> {
+        self.elements.get(&kind).filter(|b| !b.is_empty())
+    }
+
+    pub fn num_elements(&self) -> usize {
+        self.elements.values().map(|b| b.len()).sum()
+    }
+
+    pub fn part_index(&self, name: &str) -> Option<usize> {
+        self.parts.iter().position(|p| p.name == name)
+    }
+
+    /// Index of a node by id.
+    pub fn node_index_map(&self) -> HashMap<i64, usize> {
+        self.node_id
+            .iter()
+            .enumerate()
+            .map(|(i, &id)| (id, i))
+            .collect()
+    }
+
+    /// Check ids, references and properties. Errors name the part, element or node and
+    /// the value (rows refer to the tables' row order).
+    pub fn validate(&self) -> Result<()> {
+        let mut seen = HashMap::new();
+        for (row, id) in self.node_id.iter().enumerate() {
+            if let Some(first) = seen.insert(*id, row) {
+                return Err(WeftError::input(format!(
+                    "duplicate node id `{id}` (first at row {first})"
+                ))
+                .in_file("nodes.parquet")
+                .in_column("node_id")
+                .at_row(row)
+                .expected("unique node ids")
+                .hint("renumber the nodes or merge coincident ones"));
+            }
+        }
+        for (row, x) in self.coords.iter().enumerate() {
+            for (c, v) in ["x", "y", "z"].iter().zip(x) {
+                if !v.is_finite() {
+                    return Err(WeftError::input(format!(
+                        "node `{}` has non-finite coordinate `{v}`",
+                        self.node_id[row]
+                    ))
+                    .in_file("nodes.parquet")
+                    .in_column(*c)
+                    .at_row(row)
+                    .expected("a finite coordinate in m"));
+                }
+            }
+        }
+        let mut part_ids = HashMap::new();
+        for (row, p) in self.parts.iter().enumerate() {
+            if let Some(first) = part_ids.insert(p.id, row) {
+                return Err(WeftError::input(format!(
+                    "duplicate part id `{}` (first at row {first})",
+                    p.id
+                ))
+                .in_file("parts.parquet")
+                .in_column("part_id")
+                .at_row(row)
+                .expected("unique part ids"));
+            }
+            validate_part(p).map_err(|e| e.in_file("parts.parquet").at_row(row))?;
+        }
+        let mut elem_ids: HashMap<i64, ElementKind> = HashMap::new();
+        for (kind, b) in &self.elements {
+            let file = format!("elements_{}.parquet", kind.name());
+            let npe = kind.nodes_per_element();
+            for (row, id) in b.id.iter().enumerate() {
+                if let Some(k) = elem_ids.insert(*id, *kind) {
+                    return Err(WeftError::input(format!(
+                        "duplicate element id `{id}` (also a {} element)",
+                        k.name()
+                    ))
+                    .in_file(&file)
+                    .in_column("element_id")
+                    .at_row(row)
+                    .expected("element ids unique across all element tables"));
+                }
+                let p = &self.parts[b.part[row]];
+                if p.kind != *kind {
+                    return Err(WeftError::input(format!(
+                        "element `{id}` refers to part `{}` of kind `{}`",
+                        p.id,
+                        p.kind.name()
+                    ))
+                    .in_file(&file)
+                    .in_column("part_id")
+                    .at_row(row)
+                    .expected(format!("a part of kind `{}`", kind.name())));
+                }
+                let ns = &b.nodes[row * npe..(row + 1) * npe];
+                if npe == 2 && ns[0] == ns[1] {
+                    return Err(WeftError::input(format!(
+                        "element `{id}` joins node `{}` to itself",
+                        self.node_id[ns[0]]
+                    ))
+                    .in_file(&file)
+                    .in_column("n2")
+                    .at_row(row)
+                    .expected("two distinct nodes"));
+                }
+                if *kind == ElementKind::Truss {
+                    let (a, c) = (self.coords[ns[0]], self.coords[ns[1]]);
+                    let l = ((c[0] - a[0]).powi(2) + (c[1] - a[1]).powi(2) + (c[2] - a[2]).powi(2))
+                        .sqrt();
+                    if l <= 0.0 {
+                        return Err(WeftError::input(format!(
+                            "truss `{id}` has zero length: nodes `{}` and `{}` coincide",
+                            self.node_id[ns[0]], self.node_id[ns[1]]
+                        ))
+                        .in_file(&file)
+                        .at_row(row)
+                        .expected("a truss between distinct positions")
+                        .hint("use a link between coincident nodes"));
+                    }
+                }
+            }
+        }
+        for (name, set) in &self.node_sets {
+            if set.is_empty() {
+                return Err(WeftError::input(format!("node set `{name}` is empty"))
+                    .in_file("node_sets.parquet")
+                    .expected("at least one node per set"));
+            }
+        }
+        for l in &self.loads {
+            let ok = match &l.law {
+                TimeLaw::SinePulse { start, duration } | TimeLaw::Ramp { start, duration } => {
+                    start.is_finite() && *duration > 0.0
+                }
+                TimeLaw::Step { start } => start.is_finite(),
+                TimeLaw::Tabulated { .. } => true,
+            };
+            if !ok {
+                return Err(WeftError::input(format!(
+                    "load `{}` ({}) has a non-positive duration",
+                    l.id,
+                    l.law.name()
+                ))
+                .in_file("loads.parquet")
+                .in_column("duration")
+                .expected("duration > 0 s for sine_pulse and ramp"));
+            }
+        }
+        // A node both fixed and given an initial velocity in that direction is a
+        // contradiction, not something to resolve silently.
+        let mut fixed = vec![[false; 3]; self.num_nodes()];
+        for (n, f) in &self.constraints {
+            for d in 0..3 {
+                fixed[*n][d] |= f[d];
+            }
+        }
+        for (row, (n, v)) in self.initial_velocities.iter().enumerate() {
+            for d in 0..3 {
+                if fixed[*n][d] && v[d] != 0.0 {
+                    return Err(WeftError::input(format!(
+                        "node `{}` has fixed {} but initial velocity {} = {}",
+                        self.node_id[*n],
+                        ["x", "y", "z"][d],
+                        ["vx", "vy", "vz"][d],
+                        v[d]
+                    ))
+                    .in_file("initial_velocities.parquet")
+                    .at_row(row)
+                    .expected("zero initial velocity along fixed directions")
+                    .hint("remove the constraint or the velocity"));
+                }
+            }
+        }
+        validate_analysis(&self.analysis)
+    }
+}
+
+fn require_pos(p: &Part, col: &str, v: Option<f64>, unit: &str) -> Result<()> {
+    match v {
+        Some(x) if x > 0.0 && x.is_finite() => Ok(()),
+        Some(x) => Err(WeftError::input(format!(
+            "part `{}` ({}) has {col} = `{x}`",
+            p.name,
+            p.kind.name()
+        ))
+        .in_column(col)
+        .expected(format!("a value > 0 {unit}"))),
+        None => Err(WeftError::input(format!(
+            "part `{}` ({}) has no {col}",
+            p.name,
+            p.kind.name()
+        ))
+        .in_column(col)
+        .expected(format!("a value > 0 {unit}"))
+        .hint(format!("every {} part needs `{col}`", p.kind.name()))),
+    }
+}
+
+fn require_nonneg(p: &Part, col: &str, v: Option<f64>, unit: &str) -> Result<()> {
+    match v {
+        Some(x) if x < 0.0 || !x.is_finite() => Err(WeftError::input(format!(
+            "part `{}` ({}) has {col} = `{x}`",
+            p.name,
+            p.kind.name()
+        ))
+        .in_column(col)
+        .expected(format!("a value ≥ 0 {unit}, or null for 0"))),
+        _ => Ok(()),
+    }
+}
+
+/// Check the properties a part's kind needs.
+pub fn validate_part(p: &Part) -> Result<()> {
+    let q = &p.props;
+    match p.kind {
+        ElementKind::Truss => {
+            require_pos(p, "youngs_modulus", q.youngs_modulus, "in Pa")?;
+            require_pos(p, "density", q.density, "in kg/m³")?;
+            require_pos(p, "area", q.area, "in m²")?;
+        }
+        ElementKind::Link => {
+            for (c, v) in [("kx", q.kx), ("ky", q.ky), ("kz", q.kz)] {
+                require_nonneg(p, c, v, "in N/m")?;
+            }
+            for (c, v) in [("cx", q.cx), ("cy", q.cy), ("cz", q.cz)] {
+                require_nonneg(p, c, v, "in N·s/m")?;
+            }
+            if q.slip_force.is_some() {
+                require_pos(p, "slip_force", q.slip_force, "in N")?;
+                for (c, v) in [("kx", q.kx), ("ky", q.ky)] {
+                    require_pos(
+                        p,
+                        c,
+                        v,
+                        "in N/m (a friction slider needs tangential stiffness)",
+                    )?;
+                }
+            }
+        }
+        ElementKind::PointMass => require_pos(p, "mass", q.mass, "in kg")?,
+    }
+    Ok(())
+}
+
+fn validate_analysis(a: &Analysis) -> Result<()> {
+    let err = |col: &str, v: f64, exp: &str| {
+        Err(WeftError::input(format!("analysis setting {col} = `{v}`"))
+            .in_file("analysis.parquet")
+            .in_column(col)
+            .expected(exp.to_string()))
+    };
+    if !(a.end_time > 0.0 && a.end_time.is_finite()) {
+        return err("end_time", a.end_time, "a time > 0 s");
+    }
+    if !(a.output_interval > 0.0 && a.output_interval <= a.end_time) {
+        return err(
+            "output_interval",
+            a.output_interval,
+            "0 < output_interval ≤ end_time (s)",
+        );
+    }
+    if a.end_time / a.output_interval > 1e7 {
+        return err(
+            "output_interval",
+            a.output_interval,
+            "at most 10⁷ output samples",
+        );
+    }
+    if !(a.dt_safety > 0.0 && a.dt_safety <= 1.0) {
+        return err("dt_safety", a.dt_safety, "0 < dt_safety ≤ 1");
+    }
+    if !(a.mass_damping >= 0.0 && a.mass_damping.is_finite()) {
+        return err("mass_damping", a.mass_damping, "α ≥ 0 in 1/s");
+    }
+    if let Some(dt) = a.time_step {
+        if !(dt > 0.0 && dt.is_finite()) {
+            return err("time_step", dt, "a step > 0 s, or null for the stable step");
+        }
+    }
+    if let Some(dt) = a.target_time_step {
+        if !(dt > 0.0 && dt.is_finite()) {
+            return err(
+                "target_time_step",
+                dt,
+                "a step > 0 s, or null for no mass scaling",
+            );
+        }
+    }
+    if !(a.max_energy_error > 0.0) {
+        return err("max_energy_error", a.max_energy_error, "a fraction > 0");
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sine_pulse_law() {
+        let law = TimeLaw::SinePulse {
+            start: 1.0,
+            duration: 2.0,
+        };
+        assert_eq!(law.eval(0.5), 0.0);
+        assert!((law.eval(2.0) - 1.0).abs() < 1e-15);
+        assert_eq!(law.eval(3.5), 0.0);
+    }
+
+    #[test]
+    fn curve_interpolates_and_holds() {
+        let c = Curve {
+            t: vec![0.0, 1.0, 3.0],
+            value: vec![0.0, 2.0, 0.0],
+        };
+        assert_eq!(c.eval(-1.0), 0.0);
+        assert_eq!(c.eval(0.5), 1.0);
+        assert_eq!(c.eval(2.0), 1.0);
+        assert_eq!(c.eval(5.0), 0.0);
+    }
+}

@@ -1,0 +1,171 @@
+//! The `simulate` stage: read a model folder, run the explicit solver, write
+//! `history.parquet`, `energy.parquet` and `summary.parquet` atomically.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use serde::Serialize;
+
+use crate::error::{Result, WeftError};
+use crate::model::io::read_model;
+use crate::model::Model;
+use crate::solver::output::ParquetSink;
+use crate::solver::{RunStats, Solver};
+use crate::table::{batch, write_table, Col, Provenance};
+
+/// Settings of one `simulate` run; `None` keeps the model's `analysis.parquet` value.
+#[derive(Debug, Clone, Default, Serialize)]
+pub struct Config {
+    pub model: PathBuf,
+    pub out: PathBuf,
+    pub threads: Option<usize>,
+    pub end_time: Option<f64>,
+    pub output_interval: Option<f64>,
+    pub dt_safety: Option<f64>,
+    pub time_step: Option<f64>,
+    pub target_time_step: Option<f64>,
+    pub mass_damping: Option<f64>,
+    pub history_sets: Option<Vec<String>>,
+    pub max_energy_error: Option<f64>,
+}
+
+/// What a run reports back to the binary.
+#[derive(Debug, Clone)]
+pub struct Report {
+    pub stats: RunStats,
+    pub dt: f64,
+    pub dt_stable: f64,
+    pub controlling: String,
+    pub added_mass: f64,
+    pub added_fraction: f64,
+    pub out: PathBuf,
+}
+
+/// Apply command-line overrides to a model's analysis settings.
+pub fn apply_overrides(m: &mut Model, c: &Config) {
+    let a = &mut m.analysis;
+    if let Some(v) = c.end_time {
+        a.end_time = v;
+    }
+    if let Some(v) = c.output_interval {
+        a.output_interval = v;
+    }
+    if let Some(v) = c.dt_safety {
+        a.dt_safety = v;
+    }
+    if let Some(v) = c.time_step {
+        a.time_step = Some(v);
+    }
+    if let Some(v) = c.target_time_step {
+        a.target_time_step = Some(v);
+    }
+    if let Some(v) = c.mass_damping {
+        a.mass_damping = v;
+    }
+    if let Some(v) = &c.history_sets {
+        a.history_sets = v.clone();
+    }
+    if let Some(v) = c.max_energy_error {
+        a.max_energy_error = v;
+    }
+}
+
+/// Human-readable name of the element controlling the step.
+pub fn controlling_name(s: &Solver) -> String {
+    match s.stable.element {
+        Some((k, id)) => format!("{} {id} (node {})", k.name(), s.node_id[s.stable.node]),
+        None => format!("node {}", s.node_id[s.stable.node]),
+    }
+}
+
+/// Run the stage. `progress` receives the fraction of simulated time done.
+pub fn run(c: &Config, progress: &mut (dyn FnMut(f64) + Send)) -> Result<Report> {
+    let t_setup = Instant::now();
+    let mut m = read_model(&c.model)?;
+    apply_overrides(&mut m, c);
+    m.validate()?;
+    let threads = c.threads.unwrap_or(0);
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| WeftError::input(format!("cannot start {threads} threads: {e}")))?;
+    let mut prov = Provenance::new(
+        "simulate",
+        serde_json::to_value(c).expect("config serialises"),
+    );
+    for entry in std::fs::read_dir(&c.model).map_err(|e| WeftError::io(&c.model, e))? {
+        let p = entry.map_err(|e| WeftError::io(&c.model, e))?.path();
+        if p.extension().is_some_and(|x| x == "parquet") {
+            prov = prov.with_input(&p)?;
+        }
+    }
+    std::fs::create_dir_all(&c.out).map_err(|e| WeftError::io(&c.out, e))?;
+    let mut solver = Solver::new(&m)?;
+    let setup = t_setup.elapsed();
+    let mut sink = ParquetSink::create(&c.out, solver.node_id.clone(), &prov)?;
+    let mut stats = pool.install(|| solver.run(&mut sink, progress))?;
+    stats.threads = pool.current_num_threads();
+    stats.times.setup = setup;
+    let t_write = Instant::now();
+    sink.finish(&c.out, &prov)?;
+    stats.times.output += t_write.elapsed();
+    let sc = solver.scaling.clone().unwrap_or_default();
+    let report = Report {
+        dt: solver.stable.dt,
+        dt_stable: solver.stable.dt_stable,
+        controlling: controlling_name(&solver),
+        added_mass: sc.added_mass,
+        added_fraction: sc.added_fraction,
+        out: c.out.clone(),
+        stats,
+    };
+    write_summary(&c.out, &report, &solver, &prov)?;
+    Ok(report)
+}
+
+/// `summary.parquet`: one row describing the run. Written last, so its presence means
+/// the run completed.
+pub fn write_summary(out: &Path, r: &Report, s: &Solver, prov: &Provenance) -> Result<()> {
+    let st = &r.stats;
+    let (kind, id) = match s.stable.element {
+        Some((k, id)) => (k.name().to_string(), id),
+        None => (String::new(), -1),
+    };
+    let sc = s.scaling.clone();
+    write_table(
+        &out.join("summary.parquet"),
+        &batch(vec![
+            Col::I64("steps", vec![st.steps as i64]),
+            Col::F64("end_time", vec![st.end_time]),
+            Col::F64("dt", vec![r.dt]),
+            Col::F64("dt_stable", vec![r.dt_stable]),
+            Col::Str("controlling_kind", vec![kind]),
+            Col::I64("controlling_element", vec![id]),
+            Col::I64("controlling_node", vec![s.node_id[s.stable.node]]),
+            Col::OptF64(
+                "dt_stable_unscaled",
+                vec![sc.as_ref().map(|x| x.dt_stable_unscaled)],
+            ),
+            Col::F64("added_mass", vec![r.added_mass]),
+            Col::F64("added_mass_fraction", vec![r.added_fraction]),
+            Col::F64("model_mass", vec![s.physical_mass]),
+            Col::I64("nodes", vec![st.nodes as i64]),
+            Col::I64("elements", vec![st.elements as i64]),
+            Col::I64("threads", vec![st.threads as i64]),
+            Col::F64("wall_time_setup", vec![st.times.setup.as_secs_f64()]),
+            Col::F64("wall_time_loads", vec![st.times.loads.as_secs_f64()]),
+            Col::F64("wall_time_forces", vec![st.times.forces.as_secs_f64()]),
+            Col::F64("wall_time_update", vec![st.times.update.as_secs_f64()]),
+            Col::F64("wall_time_output", vec![st.times.output.as_secs_f64()]),
+            Col::F64(
+                "element_updates_per_second",
+                vec![st.element_updates_per_second()],
+            ),
+            Col::F64(
+                "max_balance_error_relative",
+                vec![st.max_balance_error_relative],
+            ),
+        ]),
+        prov,
+    )
+}

@@ -1,0 +1,1039 @@
+//! Explicit central-difference solver with lumped masses.
+//!
+//! Glossary: n step index; t_n time; x^n positions; v^{n−½} half-step velocities;
+//! Δt^{n+½} = t_{n+1} − t_n; a^n = M⁻¹(f_ext^n + f_int^n); α mass-proportional damping
+//! [1/s]; u = x − X displacement.
+//!
+//! One step (Belytschko, Liu, Moran, *Nonlinear Finite Elements*, Box 6.1, with the
+//! damping force −α m v^n evaluated at the full step):
+//!   v^n     = (v^{n−½} + ½ Δt^{n−½} a^n) / (1 + ½ α Δt^{n−½})
+//!   v^{n+½} = v^n (1 − ½ α Δt^{n+½}) + ½ Δt^{n+½} a^n
+//!   x^{n+1} = x^n + Δt^{n+½} v^{n+½}
+//! At n = 0, Δt^{−½} = 0, so v^0 is the initial velocity and the first step is the
+//! usual half step.
+//!
+//! Phases of a step: loads (f_ext at t_n, external work) → element forces (per element,
+//! in parallel chunks, into a per-element force buffer) → node update (each node gathers
+//! its elements' forces in a fixed order through a node→slot index, then advances).
+//! Every sum runs in an order that does not depend on the thread count, and reductions
+//! use fixed chunks summed in chunk order, so results are bit-identical for any number of
+//! threads. Buffers are allocated once at setup; the step allocates nothing.
+//!
+//! Stable step: a nodal Gershgorin bound. For elements joining nodes a, b with axial
+//! stiffness k_e, the Rayleigh quotient of M⁻¹K is bounded by max_i S_i/m_i with
+//! S_i = Σ_{e∋i} 2 k_e, so ω_max² ≤ max_i S_i/m_i. This is exact for a uniform chain of
+//! trusses (Δt = L/c) and accounts for point masses, links and mass scaling without
+//! special cases. With dashpots (C_i = Σ 2 c_e) and mass damping, ξ_i = (C_i/m_i + α)/(2ω_i)
+//! and Δt_i = (2/ω_i)(√(1+ξ_i²) − ξ_i) (Belytschko et al. eq. 6.2.23). The step is
+//! safety × min_i Δt_i; the report names the node and its stiffest element.
+
+pub mod link;
+pub mod output;
+pub mod truss;
+
+use std::time::{Duration, Instant};
+
+use rayon::prelude::*;
+
+use crate::error::{Result, WeftError};
+use crate::model::{ElementKind, Load, Model};
+use link::{LinkProps, LinkState};
+
+/// Elements per parallel chunk. Fixed, so that chunked reductions do not depend on the
+/// thread count; large enough (≈100 kB of element data) to amortise task overhead.
+pub const CHUNK: usize = 2048;
+
+/// The energy-balance stop applies from this step on. In the first steps every energy
+/// is O(Δt⁴) and the trapezoidal external work lags the kinetic energy by a relative O(1)
+/// (Belytschko et al. §6.2.3); an instability grows exponentially and is caught soon
+/// after. NaN and infinity are caught from the first step.
+pub const ENERGY_CHECK_AFTER: u64 = 100;
+
+/// Trusses, struct-of-arrays.
+#[derive(Debug, Clone, Default)]
+pub struct TrussGroup {
+    pub id: Vec<i64>,
+    pub nodes: Vec<[u32; 2]>,
+    /// Axial stiffness E·A/L₀ [N/m].
+    pub k: Vec<f64>,
+    /// Initial length L₀ [m].
+    pub l0: Vec<f64>,
+    pub tension_only: Vec<bool>,
+    /// First slot of this group in the element-force buffer.
+    pub slot0: usize,
+}
+
+/// Links, struct-of-arrays.
+#[derive(Debug, Clone, Default)]
+pub struct LinkGroup {
+    pub id: Vec<i64>,
+    pub nodes: Vec<[u32; 2]>,
+    pub props: Vec<LinkProps>,
+    /// Initial offset X₂ − X₁ [m].
+    pub d0: Vec<[f64; 3]>,
+    pub state: Vec<LinkState>,
+    pub slot0: usize,
+}
+
+/// The stable time step and what controls it.
+#[derive(Debug, Clone)]
+pub struct StableStep {
+    /// The step used [s].
+    pub dt: f64,
+    /// The stable step estimate without the safety factor [s].
+    pub dt_stable: f64,
+    /// Node that controls the step (index).
+    pub node: usize,
+    /// Its stiffest element.
+    pub element: Option<(ElementKind, i64)>,
+}
+
+/// Mass added by mass scaling.
+#[derive(Debug, Clone, Default)]
+pub struct MassScaling {
+    /// Stable step before scaling [s] (without safety factor).
+    pub dt_stable_unscaled: f64,
+    pub added_mass: f64,
+    /// Added mass over the model's physical mass.
+    pub added_fraction: f64,
+    pub nodes_scaled: usize,
+    /// Largest nodal mass ratio m_scaled / m.
+    pub max_ratio: f64,
+}
+
+/// Energies at one time [J].
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Energies {
+    pub kinetic: f64,
+    /// Stored elastic energy of all elements.
+    pub internal: f64,
+    /// Dissipated by dashpots and mass-proportional damping.
+    pub damping: f64,
+    /// Dissipated by friction sliders.
+    pub friction: f64,
+    /// Hourglass energy (membrane elements; 0 until they exist).
+    pub hourglass: f64,
+    /// Contact energy (projectile contact; 0 until it exists).
+    pub contact: f64,
+    pub external_work: f64,
+    /// kinetic + internal + damping + friction + hourglass + contact − initial − external work.
+    pub balance_error: f64,
+    /// |balance_error| over the reference energy max(initial, |external work|,
+    /// kinetic + internal).
+    pub balance_error_relative: f64,
+}
+
+impl Energies {
+    fn lerp(&self, o: &Energies, w: f64) -> Energies {
+        let l = |a: f64, b: f64| a + w * (b - a);
+        Energies {
+            kinetic: l(self.kinetic, o.kinetic),
+            internal: l(self.internal, o.internal),
+            damping: l(self.damping, o.damping),
+            friction: l(self.friction, o.friction),
+            hourglass: l(self.hourglass, o.hourglass),
+            contact: l(self.contact, o.contact),
+            external_work: l(self.external_work, o.external_work),
+            balance_error: l(self.balance_error, o.balance_error),
+            balance_error_relative: l(self.balance_error_relative, o.balance_error_relative),
+        }
+    }
+}
+
+/// Receives the output samples on the output time grid.
+pub trait Sink {
+    /// Displacements and velocities of the output nodes at time t.
+    fn history(&mut self, t: f64, nodes: &[usize], u: &[[f64; 3]], v: &[[f64; 3]]) -> Result<()>;
+    fn energy(&mut self, t: f64, e: &Energies) -> Result<()>;
+}
+
+/// Wall time per phase.
+#[derive(Debug, Clone, Default)]
+pub struct PhaseTimes {
+    pub setup: Duration,
+    pub loads: Duration,
+    pub forces: Duration,
+    pub update: Duration,
+    pub output: Duration,
+}
+
+/// What a run did.
+#[derive(Debug, Clone)]
+pub struct RunStats {
+    pub steps: u64,
+    pub end_time: f64,
+    pub times: PhaseTimes,
+    pub threads: usize,
+    pub max_balance_error_relative: f64,
+    pub final_energies: Energies,
+    pub elements: usize,
+    pub nodes: usize,
+}
+
+impl RunStats {
+    /// Element updates per second over the force and node-update phases.
+    pub fn element_updates_per_second(&self) -> f64 {
+        let s = (self.times.forces + self.times.update + self.times.loads).as_secs_f64();
+        if s > 0.0 {
+            self.steps as f64 * self.elements as f64 / s
+        } else {
+            0.0
+        }
+    }
+}
+
+#[derive(Debug, Clone, Copy, Default)]
+struct NodePartial {
+    ke: f64,
+    damp_power: f64,
+    bad: usize,
+}
+
+/// One snapshot of the output nodes at a step.
+#[derive(Debug, Clone, Default)]
+struct Snapshot {
+    t: f64,
+    u: Vec<[f64; 3]>,
+    v: Vec<[f64; 3]>,
+    e: Energies,
+}
+
+/// The explicit solver: owns the state and scratch buffers of one model.
+pub struct Solver {
+    pub node_id: Vec<i64>,
+    pub x0: Vec<[f64; 3]>,
+    /// Positions x^n.
+    pub x: Vec<[f64; 3]>,
+    /// Half-step velocities v^{n−½}.
+    pub v: Vec<[f64; 3]>,
+    /// Lumped nodal masses (with mass scaling) [kg].
+    pub mass: Vec<f64>,
+    /// Physical model mass (without scaling) [kg].
+    pub physical_mass: f64,
+    inv_m: Vec<f64>,
+    /// Bit d set when direction d is fixed.
+    fixed: Vec<u8>,
+    fext: Vec<[f64; 3]>,
+    slot_ptr: Vec<u32>,
+    slots: Vec<u32>,
+    /// Per-element nodal forces, one slot per element node.
+    fe: Vec<[f64; 3]>,
+    pub truss: TrussGroup,
+    pub link: LinkGroup,
+    loads: Vec<Load>,
+    loaded_nodes: Vec<usize>,
+    fext_prev: Vec<[f64; 3]>,
+    /// Output nodes (indices).
+    pub output_nodes: Vec<usize>,
+    xn: Vec<[f64; 3]>,
+    vn: Vec<[f64; 3]>,
+    partials: Vec<NodePartial>,
+    alpha: f64,
+    pub t: f64,
+    pub step: u64,
+    dt_prev: f64,
+    w_ext: f64,
+    e_mass_damp: f64,
+    pub stable: StableStep,
+    pub scaling: Option<MassScaling>,
+    pub analysis: crate::model::Analysis,
+}
+
+fn add(a: &mut [f64; 3], b: &[f64; 3]) {
+    a[0] += b[0];
+    a[1] += b[1];
+    a[2] += b[2];
+}
+
+fn dot(a: &[f64; 3], b: &[f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+/// Stable step of one node: Δt = (2/ω)(√(1+ξ²) − ξ), ω² = S/m, 2ξω = C/m + α.
+fn nodal_dt(s: f64, c: f64, m: f64, alpha: f64) -> f64 {
+    let damp = c / m + alpha;
+    if s <= 0.0 {
+        return if damp > 0.0 {
+            2.0 / damp
+        } else {
+            f64::INFINITY
+        };
+    }
+    let w = (s / m).sqrt();
+    let xi = damp / (2.0 * w);
+    (2.0 / w) * ((1.0 + xi * xi).sqrt() - xi)
+}
+
+impl Solver {
+    /// Set up a solver for a validated model: masses, element groups, the gather index,
+    /// the stable step and (when asked) mass scaling.
+    pub fn new(m: &Model) -> Result<Solver> {
+        m.validate()?;
+        let nn = m.num_nodes();
+        if nn >= u32::MAX as usize {
+            return Err(WeftError::input(format!(
+                "{nn} nodes exceed the solver's limit of 2³²−1"
+            )));
+        }
+        let mut mass = vec![0.0; nn];
+        let mut truss = TrussGroup::default();
+        let mut linkg = LinkGroup::default();
+        if let Some(b) = m.block(ElementKind::Truss) {
+            for e in 0..b.len() {
+                let p = &m.parts[b.part[e]].props;
+                let (a, c) = (b.nodes[2 * e], b.nodes[2 * e + 1]);
+                let d = [
+                    m.coords[c][0] - m.coords[a][0],
+                    m.coords[c][1] - m.coords[a][1],
+                    m.coords[c][2] - m.coords[a][2],
+                ];
+                let l0 = dot(&d, &d).sqrt();
+                let (e_mod, rho, area) = (
+                    p.youngs_modulus.unwrap(),
+                    p.density.unwrap(),
+                    p.area.unwrap(),
+                );
+                let me = rho * area * l0;
+                mass[a] += 0.5 * me;
+                mass[c] += 0.5 * me;
+                truss.id.push(b.id[e]);
+                truss.nodes.push([a as u32, c as u32]);
+                truss.k.push(e_mod * area / l0);
+                truss.l0.push(l0);
+                truss.tension_only.push(p.tension_only.unwrap_or(false));
+            }
+        }
+        if let Some(b) = m.block(ElementKind::Link) {
+            for e in 0..b.len() {
+                let p = &m.parts[b.part[e]].props;
+                let (a, c) = (b.nodes[2 * e], b.nodes[2 * e + 1]);
+                let z = |v: Option<f64>| v.unwrap_or(0.0);
+                linkg.id.push(b.id[e]);
+                linkg.nodes.push([a as u32, c as u32]);
+                linkg.props.push(LinkProps {
+                    k: [z(p.kx), z(p.ky), z(p.kz)],
+                    c: [z(p.cx), z(p.cy), z(p.cz)],
+                    slip_force: p.slip_force.unwrap_or(f64::INFINITY),
+                });
+                linkg.d0.push([
+                    m.coords[c][0] - m.coords[a][0],
+                    m.coords[c][1] - m.coords[a][1],
+                    m.coords[c][2] - m.coords[a][2],
+                ]);
+                linkg.state.push(LinkState::default());
+            }
+        }
+        if let Some(b) = m.block(ElementKind::PointMass) {
+            for e in 0..b.len() {
+                mass[b.nodes[e]] += m.parts[b.part[e]].props.mass.unwrap();
+            }
+        }
+        truss.slot0 = 0;
+        linkg.slot0 = 2 * truss.id.len();
+        let nslots = linkg.slot0 + 2 * linkg.id.len();
+
+        let mut fixed = vec![0u8; nn];
+        for (n, f) in &m.constraints {
+            for d in 0..3 {
+                if f[d] {
+                    fixed[*n] |= 1 << d;
+                }
+            }
+        }
+
+        // Gather index: node → its element slots in ascending slot order.
+        let mut count = vec![0u32; nn + 1];
+        let slot_nodes: Vec<u32> = truss
+            .nodes
+            .iter()
+            .chain(linkg.nodes.iter())
+            .flat_map(|p| [p[0], p[1]])
+            .collect();
+        for &n in &slot_nodes {
+            count[n as usize + 1] += 1;
+        }
+        for i in 0..nn {
+            count[i + 1] += count[i];
+        }
+        let slot_ptr = count.clone();
+        let mut fill = count;
+        let mut slots = vec![0u32; nslots];
+        for (s, &n) in slot_nodes.iter().enumerate() {
+            slots[fill[n as usize] as usize] = s as u32;
+            fill[n as usize] += 1;
+        }
+
+        // Nodes that can move must have mass.
+        let mut loaded = vec![false; nn];
+        for l in &m.loads {
+            loaded[l.node] = true;
+        }
+        for i in 0..nn {
+            let attached = slot_ptr[i + 1] > slot_ptr[i];
+            if mass[i] <= 0.0 && fixed[i] != 0b111 && (attached || loaded[i]) {
+                return Err(WeftError::input(format!(
+                    "node `{}` has no mass but can move and {}",
+                    m.node_id[i],
+                    if attached {
+                        "has elements attached"
+                    } else {
+                        "carries a load"
+                    }
+                ))
+                .in_file("nodes.parquet")
+                .expected("mass > 0 at every free node that elements or loads act on")
+                .hint(
+                    "links carry no mass: attach a truss or a point_mass to the node, or fix it",
+                ));
+            }
+        }
+        let physical_mass: f64 = mass.iter().sum();
+
+        let mut x = m.coords.clone();
+        let mut v = vec![[0.0; 3]; nn];
+        for (n, vel) in &m.initial_velocities {
+            v[*n] = *vel;
+        }
+        let _ = &mut x;
+        let output_nodes: Vec<usize> = if m.analysis.history_sets.is_empty() {
+            (0..nn).collect()
+        } else {
+            let mut sel = vec![false; nn];
+            for s in &m.analysis.history_sets {
+                let set = m.node_sets.get(s).ok_or_else(|| {
+                    WeftError::input(format!("history node set `{s}` does not exist"))
+                        .in_file("analysis.parquet")
+                        .in_column("history_sets")
+                        .expected(format!(
+                            "one of the model's node sets: {}",
+                            m.node_sets
+                                .keys()
+                                .map(|k| format!("`{k}`"))
+                                .collect::<Vec<_>>()
+                                .join(", ")
+                        ))
+                })?;
+                for &i in set {
+                    sel[i] = true;
+                }
+            }
+            (0..nn).filter(|&i| sel[i]).collect()
+        };
+        let mut loaded_nodes: Vec<usize> = m.loads.iter().map(|l| l.node).collect();
+        loaded_nodes.sort_unstable();
+        loaded_nodes.dedup();
+        let nchunks = nn.div_ceil(CHUNK);
+        let mut s = Solver {
+            node_id: m.node_id.clone(),
+            x0: m.coords.clone(),
+            x,
+            v,
+            inv_m: vec![0.0; nn],
+            mass,
+            physical_mass,
+            fixed,
+            fext: vec![[0.0; 3]; nn],
+            slot_ptr,
+            slots,
+            fe: vec![[0.0; 3]; nslots],
+            truss,
+            link: linkg,
+            loads: m.loads.clone(),
+            fext_prev: vec![[0.0; 3]; loaded_nodes.len()],
+            loaded_nodes,
+            output_nodes,
+            xn: vec![[0.0; 3]; nn],
+            vn: vec![[0.0; 3]; nn],
+            partials: vec![NodePartial::default(); nchunks],
+            alpha: m.analysis.mass_damping,
+            t: 0.0,
+            step: 0,
+            dt_prev: 0.0,
+            w_ext: 0.0,
+            e_mass_damp: 0.0,
+            stable: StableStep {
+                dt: 0.0,
+                dt_stable: 0.0,
+                node: 0,
+                element: None,
+            },
+            scaling: None,
+            analysis: m.analysis.clone(),
+        };
+        let a = &m.analysis;
+        if a.time_step.is_some() && a.target_time_step.is_some() {
+            return Err(
+                WeftError::input("both time_step and target_time_step are set")
+                    .in_file("analysis.parquet")
+                    .expected(
+                        "at most one: a fixed step, or a target step reached by mass scaling",
+                    ),
+            );
+        }
+        if let Some(target) = a.target_time_step {
+            s.scale_mass(target, a.dt_safety);
+        }
+        s.update_inv_mass();
+        let (dt_stable, node) = s.stable_step();
+        if !dt_stable.is_finite() {
+            return Err(WeftError::input(
+                "no element limits the time step (the model has no stiffness)",
+            )
+            .expected("at least one truss, or a link with stiffness or damping")
+            .hint("set `time_step` in analysis.parquet for a model of free masses"));
+        }
+        let dt = match (a.time_step, a.target_time_step) {
+            (Some(dt), _) => {
+                if dt > dt_stable {
+                    let (k, id) = s
+                        .controlling_element(node)
+                        .unwrap_or((ElementKind::PointMass, -1));
+                    return Err(WeftError::input(format!(
+                        "time_step {dt:e} s exceeds the stable step {dt_stable:e} s set by node `{}` ({} `{id}`)",
+                        s.node_id[node],
+                        k.name()
+                    ))
+                    .in_file("analysis.parquet")
+                    .in_column("time_step")
+                    .expected(format!("a step ≤ {dt_stable:e} s"))
+                    .hint("leave time_step empty to use the stable step, or use target_time_step for mass scaling"));
+                }
+                dt
+            }
+            (None, Some(target)) => target.min(a.dt_safety * dt_stable),
+            (None, None) => a.dt_safety * dt_stable,
+        };
+        s.stable = StableStep {
+            dt,
+            dt_stable,
+            node,
+            element: s.controlling_element(node),
+        };
+        Ok(s)
+    }
+
+    fn update_inv_mass(&mut self) {
+        for (im, m) in self.inv_m.iter_mut().zip(&self.mass) {
+            *im = if *m > 0.0 { 1.0 / m } else { 0.0 };
+        }
+    }
+
+    /// Per-node stiffness and damping sums S_i = Σ 2k_e, C_i = Σ 2c_e.
+    fn nodal_sums(&self) -> (Vec<f64>, Vec<f64>) {
+        let nn = self.x.len();
+        let (mut s, mut c) = (vec![0.0; nn], vec![0.0; nn]);
+        for (e, p) in self.truss.nodes.iter().enumerate() {
+            for &n in p {
+                s[n as usize] += 2.0 * self.truss.k[e];
+            }
+        }
+        for (e, p) in self.link.nodes.iter().enumerate() {
+            let pr = &self.link.props[e];
+            let kmax = pr.k.iter().cloned().fold(0.0, f64::max);
+            let cmax = pr.c.iter().cloned().fold(0.0, f64::max);
+            for &n in p {
+                s[n as usize] += 2.0 * kmax;
+                c[n as usize] += 2.0 * cmax;
+            }
+        }
+        (s, c)
+    }
+
+    /// The stable step (without safety factor) and its controlling node.
+    pub fn stable_step(&self) -> (f64, usize) {
+        let (s, c) = self.nodal_sums();
+        let mut best = (f64::INFINITY, 0);
+        for i in 0..self.x.len() {
+            if self.fixed[i] == 0b111 || self.mass[i] <= 0.0 {
+                continue;
+            }
+            let dt = nodal_dt(s[i], c[i], self.mass[i], self.alpha);
+            if dt < best.0 {
+                best = (dt, i);
+            }
+        }
+        best
+    }
+
+    /// The stiffest element attached to a node.
+    pub fn controlling_element(&self, node: usize) -> Option<(ElementKind, i64)> {
+        let mut best: Option<(f64, ElementKind, i64)> = None;
+        for &slot in &self.slots[self.slot_ptr[node] as usize..self.slot_ptr[node + 1] as usize] {
+            let (kind, id, k) = self.slot_element(slot as usize);
+            if best.map_or(true, |b| k > b.0) {
+                best = Some((k, kind, id));
+            }
+        }
+        best.map(|b| (b.1, b.2))
+    }
+
+    /// Element of a force slot: kind, id, stiffness.
+    fn slot_element(&self, slot: usize) -> (ElementKind, i64, f64) {
+        if slot < self.link.slot0 {
+            let e = slot / 2;
+            (ElementKind::Truss, self.truss.id[e], self.truss.k[e])
+        } else {
+            let e = (slot - self.link.slot0) / 2;
+            let p = &self.link.props[e];
+            let k = p.k.iter().chain(p.c.iter()).cloned().fold(0.0, f64::max);
+            (ElementKind::Link, self.link.id[e], k)
+        }
+    }
+
+    /// Conventional mass scaling applied selectively: only nodes whose stable step is
+    /// below the target get mass, just enough to reach it (with the safety factor).
+    fn scale_mass(&mut self, target: f64, safety: f64) {
+        let (s, c) = self.nodal_sums();
+        let dt_before = {
+            let mut best = f64::INFINITY;
+            for i in 0..self.x.len() {
+                if self.fixed[i] != 0b111 && self.mass[i] > 0.0 {
+                    best = best.min(nodal_dt(s[i], c[i], self.mass[i], self.alpha));
+                }
+            }
+            best
+        };
+        let mut rep = MassScaling {
+            dt_stable_unscaled: dt_before,
+            max_ratio: 1.0,
+            ..Default::default()
+        };
+        for i in 0..self.x.len() {
+            if self.fixed[i] == 0b111 || self.mass[i] <= 0.0 {
+                continue;
+            }
+            let m0 = self.mass[i];
+            let mut m = m0;
+            // Δt grows like √m (faster with damping): a few multiplicative passes converge.
+            for _ in 0..60 {
+                let dt = safety * nodal_dt(s[i], c[i], m, self.alpha);
+                if dt >= target {
+                    break;
+                }
+                m *= (target / dt).powi(2) * (1.0 + 1e-12);
+            }
+            if m > m0 {
+                rep.added_mass += m - m0;
+                rep.nodes_scaled += 1;
+                rep.max_ratio = rep.max_ratio.max(m / m0);
+                self.mass[i] = m;
+            }
+        }
+        rep.added_fraction = rep.added_mass / self.physical_mass.max(f64::MIN_POSITIVE);
+        self.scaling = Some(rep);
+    }
+
+    fn apply_loads(&mut self) {
+        let t = self.t;
+        for &n in &self.loaded_nodes {
+            self.fext[n] = [0.0; 3];
+        }
+        for l in &self.loads {
+            let g = l.law.eval(t);
+            let f = &mut self.fext[l.node];
+            f[0] += l.force[0] * g;
+            f[1] += l.force[1] * g;
+            f[2] += l.force[2] * g;
+        }
+        // External work, trapezoidal: W += ½ Δu^n · (f^{n−1} + f^n), Δu^n = Δt^{n−½} v^{n−½}.
+        let mut w = 0.0;
+        for (j, &n) in self.loaded_nodes.iter().enumerate() {
+            let f = self.fext[n];
+            let fp = self.fext_prev[j];
+            let vv = self.v[n];
+            w += 0.5 * self.dt_prev * dot(&vv, &[f[0] + fp[0], f[1] + fp[1], f[2] + fp[2]]);
+            self.fext_prev[j] = f;
+        }
+        self.w_ext += w;
+    }
+
+    fn element_forces(&mut self) {
+        let x = &self.x;
+        let v = &self.v;
+        let (fe_truss, fe_link) = self.fe.split_at_mut(self.link.slot0);
+        let g = &self.truss;
+        let truss_chunk = |(ci, out): (usize, &mut [[f64; 3]])| {
+            let e0 = ci * CHUNK;
+            let n = out.len() / 2;
+            for (((pair, nodes), k), (l0, to)) in out
+                .chunks_exact_mut(2)
+                .zip(&g.nodes[e0..e0 + n])
+                .zip(&g.k[e0..e0 + n])
+                .zip(g.l0[e0..e0 + n].iter().zip(&g.tension_only[e0..e0 + n]))
+            {
+                let f2 = truss::force(&x[nodes[0] as usize], &x[nodes[1] as usize], *k, *l0, *to);
+                pair[0] = [-f2[0], -f2[1], -f2[2]];
+                pair[1] = f2;
+            }
+        };
+        if g.id.len() <= CHUNK {
+            fe_truss
+                .chunks_mut(2 * CHUNK)
+                .enumerate()
+                .for_each(truss_chunk);
+        } else {
+            fe_truss
+                .par_chunks_mut(2 * CHUNK)
+                .enumerate()
+                .for_each(truss_chunk);
+        }
+        let lg = &mut self.link;
+        let dt_prev = self.dt_prev;
+        let (nodes, props, d0) = (&lg.nodes, &lg.props, &lg.d0);
+        let link_chunk = |(ci, (out, st)): (usize, (&mut [[f64; 3]], &mut [LinkState]))| {
+            let e0 = ci * CHUNK;
+            for (j, (pair, s)) in out.chunks_exact_mut(2).zip(st.iter_mut()).enumerate() {
+                let e = e0 + j;
+                let [a, b] = nodes[e];
+                let (a, b) = (a as usize, b as usize);
+                let d = link::rel_disp(&x[a], &x[b], &d0[e]);
+                let dd = [v[b][0] - v[a][0], v[b][1] - v[a][1], v[b][2] - v[a][2]];
+                let f2 = link::force_update(&d, &dd, &props[e], s, dt_prev);
+                pair[0] = [-f2[0], -f2[1], -f2[2]];
+                pair[1] = f2;
+            }
+        };
+        if lg.id.len() <= CHUNK {
+            fe_link
+                .chunks_mut(2 * CHUNK)
+                .zip(lg.state.chunks_mut(CHUNK))
+                .enumerate()
+                .for_each(link_chunk);
+        } else {
+            fe_link
+                .par_chunks_mut(2 * CHUNK)
+                .zip(lg.state.par_chunks_mut(CHUNK))
+                .enumerate()
+                .for_each(link_chunk);
+        }
+    }
+
+    /// Gather forces and advance every node; returns (kinetic energy at t_n when
+    /// `SNAP`, mass-damping power α Σ m |v^n|²).
+    fn update_nodes<const SNAP: bool>(&mut self, dt_next: f64) -> Result<(f64, f64)> {
+        let (alpha, dt_prev) = (self.alpha, self.dt_prev);
+        let c1 = 1.0 / (1.0 + 0.5 * alpha * dt_prev);
+        let c2 = 1.0 - 0.5 * alpha * dt_next;
+        let (h_prev, h_next) = (0.5 * dt_prev, 0.5 * dt_next);
+        let (fe, slots, ptr) = (&self.fe, &self.slots, &self.slot_ptr);
+        let (fext, inv_m, mass, fixed) = (&self.fext, &self.inv_m, &self.mass, &self.fixed);
+        let body = |(ci, ((((x, v), xn), vn), part)): (
+            usize,
+            (
+                (
+                    ((&mut [[f64; 3]], &mut [[f64; 3]]), &mut [[f64; 3]]),
+                    &mut [[f64; 3]],
+                ),
+                &mut NodePartial,
+            ),
+        )| {
+            let i0 = ci * CHUNK;
+            let (mut ke, mut dp, mut bad) = (0.0, 0.0, usize::MAX);
+            for j in 0..x.len() {
+                let i = i0 + j;
+                let mut f = fext[i];
+                for &s in &slots[ptr[i] as usize..ptr[i + 1] as usize] {
+                    add(&mut f, &fe[s as usize]);
+                }
+                let im = inv_m[i];
+                let mut a = [f[0] * im, f[1] * im, f[2] * im];
+                let fx = fixed[i];
+                if fx != 0 {
+                    for (d, ad) in a.iter_mut().enumerate() {
+                        if fx & (1 << d) != 0 {
+                            *ad = 0.0;
+                        }
+                    }
+                }
+                let vo = v[j];
+                let vh = [
+                    (vo[0] + h_prev * a[0]) * c1,
+                    (vo[1] + h_prev * a[1]) * c1,
+                    (vo[2] + h_prev * a[2]) * c1,
+                ];
+                let vnew = [
+                    vh[0] * c2 + h_next * a[0],
+                    vh[1] * c2 + h_next * a[1],
+                    vh[2] * c2 + h_next * a[2],
+                ];
+                let v2 = dot(&vh, &vh);
+                if SNAP {
+                    xn[j] = x[j];
+                    vn[j] = vh;
+                    ke += 0.5 * mass[i] * v2;
+                }
+                dp += mass[i] * v2;
+                let xo = x[j];
+                let xnew = [
+                    xo[0] + dt_next * vnew[0],
+                    xo[1] + dt_next * vnew[1],
+                    xo[2] + dt_next * vnew[2],
+                ];
+                if !(vnew[0] + vnew[1] + vnew[2] + xnew[0] + xnew[1] + xnew[2]).is_finite()
+                    && bad == usize::MAX
+                {
+                    bad = i;
+                }
+                v[j] = vnew;
+                x[j] = xnew;
+            }
+            *part = NodePartial {
+                ke,
+                damp_power: alpha * dp,
+                bad,
+            };
+        };
+        let it_len = self.x.len();
+        if it_len <= CHUNK {
+            self.x
+                .chunks_mut(CHUNK)
+                .zip(self.v.chunks_mut(CHUNK))
+                .zip(self.xn.chunks_mut(CHUNK))
+                .zip(self.vn.chunks_mut(CHUNK))
+                .zip(self.partials.iter_mut())
+                .enumerate()
+                .for_each(body);
+        } else {
+            self.x
+                .par_chunks_mut(CHUNK)
+                .zip(self.v.par_chunks_mut(CHUNK))
+                .zip(self.xn.par_chunks_mut(CHUNK))
+                .zip(self.vn.par_chunks_mut(CHUNK))
+                .zip(self.partials.par_iter_mut())
+                .enumerate()
+                .for_each(body);
+        }
+        let (mut ke, mut dp) = (0.0, 0.0);
+        for p in &self.partials {
+            if p.bad != usize::MAX {
+                return Err(self.nan_error(p.bad));
+            }
+            ke += p.ke;
+            dp += p.damp_power;
+        }
+        Ok((ke, dp))
+    }
+
+    fn nan_error(&self, node: usize) -> WeftError {
+        let mut culprit = String::new();
+        for &slot in &self.slots[self.slot_ptr[node] as usize..self.slot_ptr[node + 1] as usize] {
+            let f = self.fe[slot as usize];
+            if !(f[0] + f[1] + f[2]).is_finite() {
+                let (k, id, _) = self.slot_element(slot as usize);
+                culprit = format!("; the force of {} `{id}` is not finite", k.name());
+                break;
+            }
+        }
+        if culprit.is_empty()
+            && !(self.fext[node][0] + self.fext[node][1] + self.fext[node][2]).is_finite()
+        {
+            culprit = "; its external load is not finite".into();
+        }
+        WeftError::Numerical {
+            what: format!(
+                "velocity or position of node `{}` became NaN or infinite{culprit}",
+                self.node_id[node]
+            ),
+            step: self.step,
+            time: self.t,
+            hint: Some(format!(
+                "the step is {:e} s against a stable estimate of {:e} s; check for extreme properties or loads near this node",
+                self.stable.dt, self.stable.dt_stable
+            )),
+        }
+    }
+
+    /// Stored elastic energy of all elements at the current positions (fixed-chunk sums).
+    pub fn internal_energy(&self) -> (f64, f64, f64) {
+        let x = &self.x;
+        let g = &self.truss;
+        let truss_e: f64 = {
+            let parts: Vec<f64> = (0..g.id.len().div_ceil(CHUNK))
+                .into_par_iter()
+                .map(|ci| {
+                    let r = ci * CHUNK..((ci + 1) * CHUNK).min(g.id.len());
+                    r.map(|e| {
+                        let [a, b] = g.nodes[e];
+                        truss::energy(
+                            &x[a as usize],
+                            &x[b as usize],
+                            g.k[e],
+                            g.l0[e],
+                            g.tension_only[e],
+                        )
+                    })
+                    .sum()
+                })
+                .collect();
+            parts.iter().sum()
+        };
+        let lg = &self.link;
+        let mut link_e = 0.0;
+        let (mut damp, mut fric) = (0.0, 0.0);
+        for e in 0..lg.id.len() {
+            let [a, b] = lg.nodes[e];
+            let d = link::rel_disp(&x[a as usize], &x[b as usize], &lg.d0[e]);
+            link_e += link::energy(&d, &lg.props[e], &lg.state[e].slip);
+            damp += lg.state[e].damping_energy;
+            fric += lg.state[e].friction_energy;
+        }
+        (truss_e + link_e, damp, fric)
+    }
+
+    /// Current force of every link on its node 2 (elastic part, at the current slip).
+    pub fn link_elastic_forces(&self) -> Vec<[f64; 3]> {
+        let lg = &self.link;
+        (0..lg.id.len())
+            .map(|e| {
+                let [a, b] = lg.nodes[e];
+                let d = link::rel_disp(&self.x[a as usize], &self.x[b as usize], &lg.d0[e]);
+                link::elastic_force(&d, &lg.props[e], &lg.state[e].slip)
+            })
+            .collect()
+    }
+
+    /// Run to the end time, sending samples on the output grid to `sink`. `progress` is
+    /// called now and then with the fraction of simulated time done.
+    pub fn run(
+        &mut self,
+        sink: &mut (dyn Sink + Send),
+        progress: &mut (dyn FnMut(f64) + Send),
+    ) -> Result<RunStats> {
+        let a = self.analysis.clone();
+        let n_out = (a.end_time / a.output_interval).round() as u64;
+        let t_out = |k: u64| k as f64 * a.output_interval;
+        let dt = self.stable.dt;
+        let mut times = PhaseTimes::default();
+        let nout = self.output_nodes.len();
+        let mut prev = Snapshot {
+            u: vec![[0.0; 3]; nout],
+            v: vec![[0.0; 3]; nout],
+            ..Default::default()
+        };
+        let mut cur = prev.clone();
+        let mut have_prev = false;
+        let mut k = 0u64;
+        let mut e0: Option<f64> = None;
+        let mut ref_energy: f64 = 0.0;
+        let mut max_rel: f64 = 0.0;
+        let mut interp_u = vec![[0.0; 3]; nout];
+        let mut interp_v = vec![[0.0; 3]; nout];
+        let progress_every = ((n_out / 200).max(1)) as u64;
+        let mut last_e = Energies::default();
+        while k <= n_out {
+            let t0 = Instant::now();
+            self.apply_loads();
+            let t1 = Instant::now();
+            self.element_forces();
+            let t2 = Instant::now();
+            times.loads += t1 - t0;
+            times.forces += t2 - t1;
+            let dt_next = dt;
+            let snap = t_out(k) <= self.t + dt_next;
+            let (ke, dp) = if snap {
+                self.update_nodes::<true>(dt_next)?
+            } else {
+                self.update_nodes::<false>(dt_next)?
+            };
+            self.e_mass_damp += 0.5 * self.dt_prev * dp;
+            let t3 = Instant::now();
+            times.update += t3 - t2;
+            if snap {
+                // Energies at t_n (positions x^n are in xn; internal energy from them).
+                std::mem::swap(&mut self.x, &mut self.xn);
+                let (ie, damp, fric) = self.internal_energy();
+                std::mem::swap(&mut self.x, &mut self.xn);
+                let total = ke + ie + damp + self.e_mass_damp + fric;
+                let e_init = *e0.get_or_insert(total);
+                let err = total - e_init - self.w_ext;
+                ref_energy = ref_energy
+                    .max(e_init.abs())
+                    .max(self.w_ext.abs())
+                    .max(ke + ie);
+                let rel = if ref_energy > 0.0 {
+                    err.abs() / ref_energy
+                } else {
+                    0.0
+                };
+                cur.t = self.t;
+                cur.e = Energies {
+                    kinetic: ke,
+                    internal: ie,
+                    damping: damp + self.e_mass_damp,
+                    friction: fric,
+                    hourglass: 0.0,
+                    contact: 0.0,
+                    external_work: self.w_ext,
+                    balance_error: err,
+                    balance_error_relative: rel,
+                };
+                last_e = cur.e;
+                if self.step >= ENERGY_CHECK_AFTER {
+                    max_rel = max_rel.max(rel);
+                }
+                if rel > a.max_energy_error && self.step >= ENERGY_CHECK_AFTER {
+                    return Err(WeftError::Numerical {
+                        what: format!(
+                            "energy balance error {:.3e} J is {:.1} % of the reference energy {:.3e} J (limit {:.1} %): the run is unstable or a force is not conservative",
+                            err, 100.0 * rel, ref_energy, 100.0 * a.max_energy_error
+                        ),
+                        step: self.step,
+                        time: self.t,
+                        hint: Some(format!(
+                            "the step is {:e} s (stable estimate {:e} s); lower dt_safety, or raise max_energy_error if the loss is physical",
+                            self.stable.dt, self.stable.dt_stable
+                        )),
+                    });
+                }
+                for (j, &i) in self.output_nodes.iter().enumerate() {
+                    let (x, x0) = (self.xn[i], self.x0[i]);
+                    cur.u[j] = [x[0] - x0[0], x[1] - x0[1], x[2] - x0[2]];
+                    cur.v[j] = self.vn[i];
+                }
+                while k <= n_out && t_out(k) <= self.t {
+                    let tk = t_out(k);
+                    let w = if have_prev && prev.t < tk {
+                        (tk - prev.t) / (self.t - prev.t)
+                    } else {
+                        1.0
+                    };
+                    let (src_u, src_v, e) = if w >= 1.0 {
+                        (&cur.u, &cur.v, cur.e)
+                    } else {
+                        for j in 0..nout {
+                            for d in 0..3 {
+                                interp_u[j][d] = prev.u[j][d] + w * (cur.u[j][d] - prev.u[j][d]);
+                                interp_v[j][d] = prev.v[j][d] + w * (cur.v[j][d] - prev.v[j][d]);
+                            }
+                        }
+                        (&interp_u, &interp_v, prev.e.lerp(&cur.e, w))
+                    };
+                    sink.history(tk, &self.output_nodes, src_u, src_v)?;
+                    sink.energy(tk, &e)?;
+                    if k % progress_every == 0 {
+                        progress(tk / a.end_time);
+                    }
+                    k += 1;
+                }
+                std::mem::swap(&mut prev, &mut cur);
+                have_prev = true;
+                times.output += t3.elapsed();
+            }
+            self.e_mass_damp += 0.5 * dt_next * dp;
+            self.t += dt_next;
+            self.dt_prev = dt_next;
+            self.step += 1;
+        }
+        progress(1.0);
+        Ok(RunStats {
+            steps: self.step,
+            end_time: a.end_time,
+            times,
+            threads: rayon::current_num_threads(),
+            max_balance_error_relative: max_rel,
+            final_energies: last_e,
+            elements: self.truss.id.len() + self.link.id.len(),
+            nodes: self.x.len(),
+        })
+    }
+}

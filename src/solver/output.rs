@@ -1,0 +1,164 @@
+//! Output sinks: in memory (tests, the fit stage) and streaming Parquet (the
+//! `simulate` stage). Layouts of `history.parquet` and `energy.parquet`: docs/tables.md.
+
+use std::path::Path;
+use std::sync::Arc;
+
+use arrow_array::{Float64Array, Int64Array, RecordBatch};
+use arrow_schema::{DataType, Field, Schema, SchemaRef};
+
+use super::{Energies, Sink};
+use crate::error::Result;
+use crate::table::{batch, AtomicTableWriter, Col, Provenance};
+
+/// Everything in memory: `u[k][j]` is the displacement of output node j at sample k.
+#[derive(Debug, Clone, Default)]
+pub struct MemorySink {
+    pub t: Vec<f64>,
+    pub nodes: Vec<usize>,
+    pub u: Vec<Vec<[f64; 3]>>,
+    pub v: Vec<Vec<[f64; 3]>>,
+    pub energy_t: Vec<f64>,
+    pub energy: Vec<Energies>,
+}
+
+impl Sink for MemorySink {
+    fn history(&mut self, t: f64, nodes: &[usize], u: &[[f64; 3]], v: &[[f64; 3]]) -> Result<()> {
+        if self.nodes.is_empty() {
+            self.nodes = nodes.to_vec();
+        }
+        self.t.push(t);
+        self.u.push(u.to_vec());
+        self.v.push(v.to_vec());
+        Ok(())
+    }
+    fn energy(&mut self, t: f64, e: &Energies) -> Result<()> {
+        self.energy_t.push(t);
+        self.energy.push(*e);
+        Ok(())
+    }
+}
+
+impl MemorySink {
+    /// Time series of one component (0..3 = ux, uy, uz) of output node `j`.
+    pub fn series(&self, j: usize, comp: usize) -> Vec<f64> {
+        self.u.iter().map(|s| s[j][comp]).collect()
+    }
+    pub fn velocity_series(&self, j: usize, comp: usize) -> Vec<f64> {
+        self.v.iter().map(|s| s[j][comp]).collect()
+    }
+}
+
+pub fn history_schema() -> SchemaRef {
+    Arc::new(Schema::new(
+        ["t", "node_id", "ux", "uy", "uz", "vx", "vy", "vz"]
+            .iter()
+            .map(|n| {
+                Field::new(
+                    *n,
+                    if *n == "node_id" {
+                        DataType::Int64
+                    } else {
+                        DataType::Float64
+                    },
+                    false,
+                )
+            })
+            .collect::<Vec<_>>(),
+    ))
+}
+
+const FLUSH_ROWS: usize = 1 << 18;
+
+/// Streams `history.parquet` and collects `energy.parquet`; nothing appears under the
+/// final names until [`ParquetSink::finish`].
+pub struct ParquetSink {
+    node_id: Vec<i64>,
+    hist: AtomicTableWriter,
+    cols: [Vec<f64>; 7],
+    ids: Vec<i64>,
+    energy_t: Vec<f64>,
+    energy: Vec<Energies>,
+}
+
+impl ParquetSink {
+    pub fn create(out: &Path, node_id: Vec<i64>, prov: &Provenance) -> Result<Self> {
+        Ok(ParquetSink {
+            node_id,
+            hist: AtomicTableWriter::create(&out.join("history.parquet"), history_schema(), prov)?,
+            cols: Default::default(),
+            ids: Vec::new(),
+            energy_t: Vec::new(),
+            energy: Vec::new(),
+        })
+    }
+
+    fn flush(&mut self) -> Result<()> {
+        if self.ids.is_empty() {
+            return Ok(());
+        }
+        let c = std::mem::take(&mut self.cols);
+        let [t, ux, uy, uz, vx, vy, vz] = c;
+        let b = RecordBatch::try_new(
+            history_schema(),
+            vec![
+                Arc::new(Float64Array::from(t)),
+                Arc::new(Int64Array::from(std::mem::take(&mut self.ids))),
+                Arc::new(Float64Array::from(ux)),
+                Arc::new(Float64Array::from(uy)),
+                Arc::new(Float64Array::from(uz)),
+                Arc::new(Float64Array::from(vx)),
+                Arc::new(Float64Array::from(vy)),
+                Arc::new(Float64Array::from(vz)),
+            ],
+        )
+        .expect("history columns of equal length");
+        self.hist.write(&b)
+    }
+
+    /// Write the energy table and move both tables into place.
+    pub fn finish(mut self, out: &Path, prov: &Provenance) -> Result<()> {
+        self.flush()?;
+        let e = &self.energy;
+        let col = |f: fn(&Energies) -> f64| e.iter().map(f).collect::<Vec<_>>();
+        let eb = batch(vec![
+            Col::F64("t", self.energy_t.clone()),
+            Col::F64("kinetic", col(|x| x.kinetic)),
+            Col::F64("internal", col(|x| x.internal)),
+            Col::F64("damping", col(|x| x.damping)),
+            Col::F64("friction", col(|x| x.friction)),
+            Col::F64("hourglass", col(|x| x.hourglass)),
+            Col::F64("contact", col(|x| x.contact)),
+            Col::F64("external_work", col(|x| x.external_work)),
+            Col::F64("balance_error", col(|x| x.balance_error)),
+            Col::F64("balance_error_relative", col(|x| x.balance_error_relative)),
+        ]);
+        let mut ew = AtomicTableWriter::create(&out.join("energy.parquet"), eb.schema(), prov)?;
+        ew.write(&eb)?;
+        ew.finish()?;
+        self.hist.finish()?;
+        Ok(())
+    }
+}
+
+impl Sink for ParquetSink {
+    fn history(&mut self, t: f64, nodes: &[usize], u: &[[f64; 3]], v: &[[f64; 3]]) -> Result<()> {
+        for (j, &i) in nodes.iter().enumerate() {
+            self.cols[0].push(t);
+            self.ids.push(self.node_id[i]);
+            for d in 0..3 {
+                self.cols[1 + d].push(u[j][d]);
+                self.cols[4 + d].push(v[j][d]);
+            }
+        }
+        if self.ids.len() >= FLUSH_ROWS {
+            self.flush()?;
+        }
+        Ok(())
+    }
+    fn energy(&mut self, t: f64, e: &Energies) -> Result<()> {
+        self.energy_t.push(t);
+        self.energy.push(*e);
+        Ok(())
+    }
+}
