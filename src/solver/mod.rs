@@ -20,10 +20,12 @@
 //! threads. Buffers are allocated once at setup; the step allocates nothing.
 //!
 //! Stable step: a nodal Gershgorin bound. For elements joining nodes a, b with axial
-//! stiffness k_e, the Rayleigh quotient of M⁻¹K is bounded by max_i S_i/m_i with
-//! S_i = Σ_{e∋i} 2 k_e, so ω_max² ≤ max_i S_i/m_i. This is exact for a uniform chain of
-//! trusses (Δt = L/c) and accounts for point masses, links and mass scaling without
-//! special cases. With dashpots (C_i = Σ 2 c_e) and mass damping, ξ_i = (C_i/m_i + α)/(2ω_i)
+//! stiffness k_e, Σ_e k_e (e·(u_a − u_b))² ≤ Σ_e k_e · 2(|u_a|² + |u_b|²), so the Rayleigh
+//! quotient of M⁻¹K, hence ω_max², is bounded by max_i S_i/m_i with S_i = Σ_{e∋i} 2 k_e
+//! (k_e alone when the other node is fully fixed). This is exact for a uniform chain of
+//! trusses (Δt = L/c) and for a mass on a spring to ground (Δt = 2√(m/k)), and accounts
+//! for point masses, links and mass scaling without special cases. With dashpots
+//! (C_i = Σ 2 c_e, same rule) and mass damping, ξ_i = (C_i/m_i + α)/(2ω_i)
 //! and Δt_i = (2/ω_i)(√(1+ξ_i²) − ξ_i) (Belytschko et al. eq. 6.2.23). The step is
 //! safety × min_i Δt_i; the report names the node and its stiffest element.
 
@@ -522,18 +524,26 @@ impl Solver {
     fn nodal_sums(&self) -> (Vec<f64>, Vec<f64>) {
         let nn = self.x.len();
         let (mut s, mut c) = (vec![0.0; nn], vec![0.0; nn]);
-        for (e, p) in self.truss.nodes.iter().enumerate() {
-            for &n in p {
-                s[n as usize] += 2.0 * self.truss.k[e];
+        // Row sum of |K| for node i: k_e on the diagonal, plus k_e off the diagonal when
+        // the other node can move (a fully fixed node's degrees of freedom are eliminated).
+        let w = |other: u32| {
+            if self.fixed[other as usize] == 0b111 {
+                1.0
+            } else {
+                2.0
             }
+        };
+        for (e, p) in self.truss.nodes.iter().enumerate() {
+            s[p[0] as usize] += w(p[1]) * self.truss.k[e];
+            s[p[1] as usize] += w(p[0]) * self.truss.k[e];
         }
         for (e, p) in self.link.nodes.iter().enumerate() {
             let pr = &self.link.props[e];
             let kmax = pr.k.iter().cloned().fold(0.0, f64::max);
             let cmax = pr.c.iter().cloned().fold(0.0, f64::max);
-            for &n in p {
-                s[n as usize] += 2.0 * kmax;
-                c[n as usize] += 2.0 * cmax;
+            for (n, o) in [(p[0], p[1]), (p[1], p[0])] {
+                s[n as usize] += w(o) * kmax;
+                c[n as usize] += w(o) * cmax;
             }
         }
         (s, c)
@@ -880,14 +890,16 @@ impl Solver {
         (truss_e + link_e, damp, fric)
     }
 
-    /// Current force of every link on its node 2 (elastic part, at the current slip).
-    pub fn link_elastic_forces(&self) -> Vec<[f64; 3]> {
+    /// Current force of every link on its node 2 at the current positions: spring and
+    /// slider (the slider return-mapped on a copy of its state), without the dashpot.
+    pub fn link_forces(&self) -> Vec<[f64; 3]> {
         let lg = &self.link;
         (0..lg.id.len())
             .map(|e| {
                 let [a, b] = lg.nodes[e];
                 let d = link::rel_disp(&self.x[a as usize], &self.x[b as usize], &lg.d0[e]);
-                link::elastic_force(&d, &lg.props[e], &lg.state[e].slip)
+                let mut st = lg.state[e];
+                link::force_update(&d, &[0.0; 3], &lg.props[e], &mut st, 0.0)
             })
             .collect()
     }
@@ -1036,4 +1048,13 @@ impl Solver {
             nodes: self.x.len(),
         })
     }
+}
+
+/// Set up and run a model in the current thread pool, keeping every output sample in
+/// memory (tests, and stages that run the solver in-process).
+pub fn run_in_memory(m: &Model) -> Result<(Solver, output::MemorySink, RunStats)> {
+    let mut s = Solver::new(m)?;
+    let mut sink = output::MemorySink::default();
+    let stats = s.run(&mut sink, &mut |_| {})?;
+    Ok((s, sink, stats))
 }
