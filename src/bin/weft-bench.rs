@@ -1,0 +1,162 @@
+//! `weft-bench`: element-updates per second of the explicit solver and stage wall times.
+//!
+//! Not a test: numbers depend on the machine. Run `cargo run --release --bin weft-bench`.
+
+use std::time::Instant;
+
+use clap::Parser;
+use weft::model::{ElementKind, Load, Model, PartProps, TimeLaw};
+use weft::solver::output::MemorySink;
+use weft::solver::Solver;
+
+#[derive(Parser)]
+#[command(
+    name = "weft-bench",
+    version,
+    about = "Measure solver throughput (element-updates/s) and stage wall times"
+)]
+struct Cli {
+    /// Element counts to measure.
+    #[arg(long, value_delimiter = ',', default_values_t = vec![10_000usize, 100_000, 1_000_000])]
+    sizes: Vec<usize>,
+    /// Thread counts to measure.
+    #[arg(long, value_delimiter = ',', default_values_t = vec![1usize, 2])]
+    threads: Vec<usize>,
+    /// Element updates per measurement (sets the number of steps).
+    #[arg(long, default_value_t = 3e8)]
+    updates: f64,
+}
+
+/// A chain of `n` elements along x: trusses, or point masses joined by links.
+fn chain(kind: ElementKind, n: usize) -> Model {
+    let mut m = Model::default();
+    let h = 1e-3;
+    for i in 0..=n {
+        m.add_node(i as i64 + 1, [i as f64 * h, 0.0, 0.0]);
+    }
+    let p = match kind {
+        ElementKind::Truss => m.add_part(
+            1,
+            "rod",
+            ElementKind::Truss,
+            PartProps {
+                youngs_modulus: Some(8e10),
+                density: Some(1440.0),
+                area: Some(1e-7),
+                ..Default::default()
+            },
+        ),
+        _ => {
+            let pm = m.add_part(
+                2,
+                "mass",
+                ElementKind::PointMass,
+                PartProps {
+                    mass: Some(1e-6),
+                    ..Default::default()
+                },
+            );
+            for i in 0..=n {
+                m.add_element((n + 1 + i) as i64, pm, &[i]);
+            }
+            m.add_part(
+                1,
+                "link",
+                ElementKind::Link,
+                PartProps {
+                    kx: Some(1e4),
+                    ky: Some(1e4),
+                    kz: Some(1e5),
+                    cx: Some(1e-4),
+                    cy: Some(1e-4),
+                    cz: Some(1e-4),
+                    slip_force: Some(1.0),
+                    ..Default::default()
+                },
+            )
+        }
+    };
+    for e in 0..n {
+        m.add_element(e as i64 + 1, p, &[e, e + 1]);
+    }
+    m.constraints.push((0, [true, true, true]));
+    m.loads.push(Load {
+        id: 1,
+        node: n,
+        force: [1.0, 0.5, 0.2],
+        law: TimeLaw::Step { start: 0.0 },
+    });
+    m.node_sets.insert("end".into(), vec![n]);
+    m.analysis.history_sets = vec!["end".into()];
+    m
+}
+
+fn main() -> anyhow::Result<()> {
+    let cli = Cli::parse();
+    println!("kind,elements,threads,steps,seconds,element_updates_per_second");
+    for kind in [ElementKind::Truss, ElementKind::Link] {
+        for &n in &cli.sizes {
+            let mut m = chain(kind, n);
+            let dt = Solver::new(&m)?.stable.dt;
+            let steps = ((cli.updates / n as f64).ceil() as u64).max(20);
+            m.analysis.end_time = dt * steps as f64;
+            m.analysis.output_interval = m.analysis.end_time;
+            let mut base = None;
+            for &t in &cli.threads {
+                let pool = rayon::ThreadPoolBuilder::new().num_threads(t).build()?;
+                let mut s = Solver::new(&m)?;
+                let mut sink = MemorySink::default();
+                let stats = pool.install(|| s.run(&mut sink, &mut |_| {}))?;
+                let secs =
+                    (stats.times.forces + stats.times.update + stats.times.loads).as_secs_f64();
+                let rate = stats.element_updates_per_second();
+                let speedup = base
+                    .map(|b: f64| format!(" (speed-up {:.2})", rate / b))
+                    .unwrap_or_default();
+                base.get_or_insert(rate);
+                println!(
+                    "{},{},{},{},{:.3},{:.4e}",
+                    kind.name(),
+                    n,
+                    t,
+                    stats.steps,
+                    secs,
+                    rate
+                );
+                eprintln!(
+                    "  {:>10} {:>8} elements, {t} thread(s): {rate:.3e} element-updates/s{speedup}",
+                    kind.name(),
+                    n
+                );
+            }
+        }
+    }
+    // Stage wall times: the canonical rod, generated, written, simulated, written.
+    let dir = std::env::temp_dir().join(format!("weft-bench-{}", std::process::id()));
+    let t0 = Instant::now();
+    let p = weft::generate::rod::RodParams::default();
+    let m = weft::generate::rod::build(&p)?;
+    let prov = weft::table::Provenance::new("bench", serde_json::json!({}));
+    weft::model::io::write_model(&m, &dir.join("rod"), &prov)?;
+    let t_weave = t0.elapsed();
+    let t1 = Instant::now();
+    let cfg = weft::simulate::Config {
+        model: dir.join("rod"),
+        out: dir.join("out"),
+        ..Default::default()
+    };
+    let r = weft::simulate::run(&cfg, &mut |_| {})?;
+    let t_sim = t1.elapsed();
+    let _ = std::fs::remove_dir_all(&dir);
+    eprintln!(
+        "stage wall times: weave rod {:.3} s; simulate rod {:.3} s ({} steps; setup {:.3} s, forces {:.3} s, update {:.3} s, output {:.3} s)",
+        t_weave.as_secs_f64(),
+        t_sim.as_secs_f64(),
+        r.stats.steps,
+        r.stats.times.setup.as_secs_f64(),
+        r.stats.times.forces.as_secs_f64(),
+        r.stats.times.update.as_secs_f64(),
+        r.stats.times.output.as_secs_f64()
+    );
+    Ok(())
+}
