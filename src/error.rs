@@ -16,6 +16,10 @@ pub struct Location {
     pub column: Option<String>,
     /// Zero-based row of a table.
     pub row: Option<usize>,
+    /// One-based line of a text file (pipeline files).
+    pub line: Option<usize>,
+    /// Dotted key in a text file (`stages.fit.outputs`).
+    pub key: Option<String>,
 }
 
 impl fmt::Display for Location {
@@ -29,6 +33,12 @@ impl fmt::Display for Location {
         }
         if let Some(r) = self.row {
             parts.push(format!("row {r}"));
+        }
+        if let Some(l) = self.line {
+            parts.push(format!("line {l}"));
+        }
+        if let Some(k) = &self.key {
+            parts.push(format!("key `{k}`"));
         }
         write!(f, "{}", parts.join(", "))
     }
@@ -127,6 +137,18 @@ impl WeftError {
     pub fn in_column(mut self, c: impl Into<String>) -> Self {
         if let WeftError::Input { at, .. } = &mut self {
             at.column = Some(c.into());
+        }
+        self
+    }
+    pub fn at_line(mut self, l: usize) -> Self {
+        if let WeftError::Input { at, .. } = &mut self {
+            at.line = Some(l);
+        }
+        self
+    }
+    pub fn at_key(mut self, k: impl Into<String>) -> Self {
+        if let WeftError::Input { at, .. } = &mut self {
+            at.key = Some(k.into());
         }
         self
     }

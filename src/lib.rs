@@ -9,6 +9,7 @@
 pub mod error;
 pub mod generate;
 pub mod model;
+pub mod pipeline;
 pub mod simulate;
 pub mod solver;
 pub mod table;

@@ -85,7 +85,9 @@ fn main_inner() -> anyhow::Result<()> {
         history_sets: (!cli.history_sets.is_empty()).then_some(cli.history_sets.clone()),
         max_energy_error: cli.max_energy_error,
     };
-    let bar = if cli.quiet {
+    // Under `weft run`, report progress as `weft-progress <fraction>` lines on stderr.
+    let protocol = std::env::var_os("WEFT_PROGRESS").is_some();
+    let bar = if cli.quiet || protocol {
         ProgressBar::hidden()
     } else {
         let b = ProgressBar::with_draw_target(Some(1000), ProgressDrawTarget::stderr());
@@ -97,7 +99,17 @@ fn main_inner() -> anyhow::Result<()> {
         );
         b
     };
-    let res = run(&cfg, &mut |f| bar.set_position((f * 1000.0) as u64));
+    let mut last = -1.0;
+    let res = run(&cfg, &mut |f| {
+        if protocol {
+            if f - last >= 0.01 || f >= 1.0 {
+                eprintln!("weft-progress {f:.4}");
+                last = f;
+            }
+        } else {
+            bar.set_position((f * 1000.0) as u64)
+        }
+    });
     bar.finish_and_clear();
     let r = res.with_context(|| {
         format!(

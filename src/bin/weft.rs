@@ -1,0 +1,338 @@
+//! `weft`: run study pipelines (`pipelines/*.toml`) with make-style reruns.
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use anyhow::{bail, Context};
+use clap::{Parser, Subcommand, ValueEnum};
+
+use weft::pipeline::engine::Outcome;
+use weft::pipeline::gather::{gather, records_table};
+use weft::pipeline::{run, Pipeline, RunOptions, Verdict, Workspace};
+use weft::table::{write_table, Provenance};
+
+#[derive(Parser)]
+#[command(
+    name = "weft",
+    version,
+    about = "Run weft study pipelines: only stages whose inputs, parameters, command or binary changed run again",
+    long_about = "Run weft study pipelines (pipelines/*.toml): stages with a command, inputs, outputs and \
+                  parameters, sweeps that expand a stage into named instances, and make-style reruns decided \
+                  on content (blake3), not timestamps.\n\nExamples:\n  weft run pipelines/rod_waves.toml          run what is stale\n  \
+                  weft status pipelines/rod_waves.toml       say what is stale and why\n  \
+                  weft run pipelines/rod_waves.toml -j 2 simulate   a stage and what it needs\n  \
+                  weft gather pipelines/rod_waves.toml --stage simulate --table summary.parquet --out runs/summary.parquet"
+)]
+struct Cli {
+    #[command(subcommand)]
+    cmd: Cmd,
+}
+
+#[derive(Subcommand)]
+enum Cmd {
+    /// Run the stale stages (all, or the named stages and what they need).
+    Run {
+        /// Pipeline file [default: the only file in pipelines/].
+        pipeline: Option<PathBuf>,
+        /// Stages (all instances) or instances to run, with their upstream stages.
+        targets: Vec<String>,
+        /// Parallel stages [default: number of cores].
+        #[arg(short, long)]
+        jobs: Option<usize>,
+        /// After a failure, keep running stages that do not depend on it.
+        #[arg(short, long)]
+        keep_going: bool,
+        /// Say what would run and why; run nothing.
+        #[arg(short = 'n', long)]
+        dry_run: bool,
+        /// Run even if fresh: every selected stage, or the named stage (repeatable).
+        #[arg(long, num_args = 0..=1, default_missing_value = "")]
+        force: Vec<String>,
+        /// Run only the targets, not their upstream stages (their inputs must exist).
+        #[arg(long)]
+        single: bool,
+        /// No progress view or stage lines.
+        #[arg(short, long)]
+        quiet: bool,
+    },
+    /// Say for each stage instance whether it is fresh, or why it would run.
+    Status { pipeline: Option<PathBuf> },
+    /// Print the stage graph.
+    Dag {
+        pipeline: Option<PathBuf>,
+        #[arg(long, value_enum, default_value_t = DagFormat::Text)]
+        format: DagFormat,
+    },
+    /// The record of every stage instance (command, parameters, hashes, times, exit status).
+    Records {
+        pipeline: Option<PathBuf>,
+        /// Write the records as a Parquet table instead of printing them.
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
+    /// Gather one table of every instance of a (sweep) stage into one Parquet table, with
+    /// the instance name and its parameters as columns.
+    Gather {
+        pipeline: Option<PathBuf>,
+        /// The stage whose instances to gather.
+        #[arg(long)]
+        stage: String,
+        /// Which output of the stage [default: its only output].
+        #[arg(long)]
+        output: Option<String>,
+        /// A table inside the output folder (e.g. `summary.parquet`); omit when the output is the table.
+        #[arg(long)]
+        table: Option<String>,
+        /// The gathered table.
+        #[arg(long)]
+        out: PathBuf,
+    },
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum DagFormat {
+    Text,
+    Dot,
+    Mermaid,
+}
+
+fn main() -> ExitCode {
+    match main_inner() {
+        Ok(code) => code,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn find_pipeline(p: Option<PathBuf>) -> anyhow::Result<PathBuf> {
+    if let Some(p) = p {
+        return Ok(p);
+    }
+    let dir = Path::new("pipelines");
+    let files: Vec<PathBuf> = std::fs::read_dir(dir)
+        .map(|rd| {
+            rd.flatten()
+                .map(|e| e.path())
+                .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+                .collect()
+        })
+        .unwrap_or_default();
+    match files.as_slice() {
+        [one] => Ok(one.clone()),
+        [] => bail!("no pipeline file given and none found in `pipelines/`\n  hint: `weft run pipelines/NAME.toml`"),
+        many => bail!(
+            "several pipeline files in `pipelines/`: {}\n  hint: name one, e.g. `weft run {}`",
+            many.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", "),
+            many[0].display()
+        ),
+    }
+}
+
+fn load(p: Option<PathBuf>) -> anyhow::Result<Pipeline> {
+    let f = find_pipeline(p)?;
+    Ok(Pipeline::load(&f)?)
+}
+
+fn main_inner() -> anyhow::Result<ExitCode> {
+    let cli = Cli::parse();
+    match cli.cmd {
+        Cmd::Run {
+            pipeline,
+            targets,
+            jobs,
+            keep_going,
+            dry_run,
+            force,
+            single,
+            quiet,
+        } => {
+            let p = load(pipeline)?;
+            let n = p.instances.len();
+            let selected = if targets.is_empty() {
+                vec![true; n]
+            } else {
+                let mut sel = vec![];
+                for t in &targets {
+                    sel.extend(p.select(t)?);
+                }
+                if single {
+                    let mut v = vec![false; n];
+                    for i in sel {
+                        v[i] = true;
+                    }
+                    v
+                } else {
+                    p.with_ancestors(&sel)
+                }
+            };
+            let mut forced = vec![false; n];
+            for f in &force {
+                if f.is_empty() {
+                    forced = selected.clone();
+                } else {
+                    for i in p.select(f)? {
+                        forced[i] = true;
+                    }
+                }
+            }
+            let jobs = jobs.unwrap_or_else(|| {
+                std::thread::available_parallelism()
+                    .map(|n| n.get())
+                    .unwrap_or(1)
+            });
+            let mut ws = Workspace::open(&p);
+            let opts = RunOptions {
+                jobs,
+                keep_going,
+                dry_run,
+                quiet,
+            };
+            let rep = run(&p, &mut ws, &selected, &forced, &opts)?;
+            if dry_run {
+                return Ok(ExitCode::SUCCESS);
+            }
+            let ran = rep.ran().len();
+            let fresh = rep
+                .outcomes
+                .iter()
+                .filter(|o| o.1 == Outcome::Fresh)
+                .count();
+            let failed = rep.failed();
+            let skipped = rep
+                .outcomes
+                .iter()
+                .filter(|o| matches!(o.1, Outcome::Skipped | Outcome::NotStarted))
+                .count();
+            if !quiet {
+                eprintln!("weft: {ran} ran, {fresh} fresh, {failed} failed, {skipped} not run");
+            }
+            if failed > 0 {
+                if !keep_going && skipped > 0 {
+                    eprintln!(
+                        "  hint: `--keep-going` runs the stages that do not depend on the failure"
+                    );
+                }
+                return Ok(ExitCode::FAILURE);
+            }
+            Ok(ExitCode::SUCCESS)
+        }
+        Cmd::Status { pipeline } => {
+            let p = load(pipeline)?;
+            let mut ws = Workspace::open(&p);
+            let n = p.instances.len();
+            let plan = ws.plan(&p, &vec![true; n], &vec![false; n])?;
+            ws.cache.save()?;
+            let mut stale = 0;
+            for &i in &p.order {
+                let name = &p.instances[i].name;
+                match &plan[i] {
+                    Verdict::Fresh => println!("fresh  {name}"),
+                    Verdict::Stale(r) | Verdict::Waiting(r) => {
+                        stale += 1;
+                        println!("stale  {name}: {r}")
+                    }
+                }
+            }
+            eprintln!("weft: {stale} of {n} stage instances would run");
+            Ok(ExitCode::SUCCESS)
+        }
+        Cmd::Dag { pipeline, format } => {
+            let p = load(pipeline)?;
+            let id = |i: usize| format!("n{i}");
+            match format {
+                DagFormat::Text => {
+                    for &i in &p.order {
+                        let inst = &p.instances[i];
+                        let deps: Vec<&str> = inst
+                            .deps
+                            .iter()
+                            .map(|&d| p.instances[d].name.as_str())
+                            .collect();
+                        if deps.is_empty() {
+                            println!("{}", inst.name);
+                        } else {
+                            println!("{} <- {}", inst.name, deps.join(", "));
+                        }
+                    }
+                }
+                DagFormat::Dot => {
+                    println!("digraph weft {{\n  rankdir=LR;\n  node [shape=box];");
+                    for (i, inst) in p.instances.iter().enumerate() {
+                        println!(
+                            "  {} [label=\"{}\"];",
+                            id(i),
+                            inst.name.replace('"', "\\\"")
+                        );
+                    }
+                    for (i, inst) in p.instances.iter().enumerate() {
+                        for &d in &inst.deps {
+                            println!("  {} -> {};", id(d), id(i));
+                        }
+                    }
+                    println!("}}");
+                }
+                DagFormat::Mermaid => {
+                    println!("graph LR");
+                    for (i, inst) in p.instances.iter().enumerate() {
+                        println!("  {}[\"{}\"]", id(i), inst.name.replace('"', "'"));
+                    }
+                    for (i, inst) in p.instances.iter().enumerate() {
+                        for &d in &inst.deps {
+                            println!("  {} --> {}", id(d), id(i));
+                        }
+                    }
+                }
+            }
+            Ok(ExitCode::SUCCESS)
+        }
+        Cmd::Records { pipeline, out } => {
+            let p = load(pipeline)?;
+            let b = records_table(&p);
+            match out {
+                Some(o) => {
+                    let prov = Provenance::new(
+                        "records",
+                        serde_json::json!({ "pipeline": p.file.display().to_string() }),
+                    );
+                    write_table(&o, &b, &prov)
+                        .with_context(|| format!("cannot write `{}`", o.display()))?;
+                    eprintln!("weft: {} records -> {}", b.num_rows(), o.display());
+                }
+                None => {
+                    let store = weft::pipeline::record::RecordStore::new(&p.root, &p.file);
+                    println!("instance\texit_status\tstart\tduration_s\tcommand");
+                    for inst in &p.instances {
+                        if let Some(r) = store.get(&inst.name) {
+                            println!(
+                                "{}\t{}\t{}\t{:.3}\t{}",
+                                r.instance,
+                                r.exit_status,
+                                r.start,
+                                r.end_unix - r.start_unix,
+                                r.command
+                            );
+                        }
+                    }
+                }
+            }
+            Ok(ExitCode::SUCCESS)
+        }
+        Cmd::Gather {
+            pipeline,
+            stage,
+            output,
+            table,
+            out,
+        } => {
+            let p = load(pipeline)?;
+            let rows = gather(&p, &stage, output.as_deref(), table.as_deref(), &out)?;
+            eprintln!(
+                "weft: gathered {rows} rows of `{stage}` -> {}",
+                out.display()
+            );
+            Ok(ExitCode::SUCCESS)
+        }
+    }
+}

@@ -1,0 +1,12 @@
+//! The pipeline engine behind `weft`: declarative study files (`pipelines/*.toml`) with
+//! make-style reruns decided on content, parallel execution, atomic outputs, one record
+//! per stage instance, and gathering of sweep outputs into one table.
+
+pub mod engine;
+pub mod gather;
+pub mod hash;
+pub mod record;
+pub mod spec;
+
+pub use engine::{run, RunOptions, Verdict, Workspace};
+pub use spec::Pipeline;
