@@ -12,7 +12,6 @@
 //! Parquet key-value metadata under `weft.provenance`, and under `PANDAS_ATTRS` so that
 //! pandas exposes it as `df.attrs["weft"]`.
 
-use std::collections::HashMap;
 use std::fs::File;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -68,15 +67,15 @@ impl Provenance {
         });
         Ok(self)
     }
-    fn metadata(&self) -> HashMap<String, String> {
+    fn metadata(&self) -> Vec<(String, String)> {
         let json = serde_json::to_value(self).expect("provenance serialises");
-        let mut m = HashMap::new();
-        m.insert(PROVENANCE_KEY.to_string(), json.to_string());
-        m.insert(
-            "PANDAS_ATTRS".to_string(),
-            serde_json::json!({ "weft": json }).to_string(),
-        );
-        m
+        vec![
+            (PROVENANCE_KEY.to_string(), json.to_string()),
+            (
+                "PANDAS_ATTRS".to_string(),
+                serde_json::json!({ "weft": json }).to_string(),
+            ),
+        ]
     }
 }
 
@@ -127,8 +126,18 @@ pub fn batch(cols: Vec<Col>) -> RecordBatch {
     RecordBatch::try_new(Arc::new(Schema::new(fields)), arrays).expect("columns of equal length")
 }
 
-fn writer_props() -> WriterProperties {
+fn writer_props(prov: &Provenance) -> WriterProperties {
+    // Provenance goes into the file's key-value metadata, where every Parquet reader
+    // (polars, arrow-rs, parquet-tools) finds it; the same keys also go into the Arrow
+    // schema's metadata, which arrow-rs stores only inside its `ARROW:schema` blob and
+    // from which pyarrow, hence pandas' `df.attrs`, takes them.
+    let kv = prov
+        .metadata()
+        .into_iter()
+        .map(|(k, v)| parquet::file::metadata::KeyValue::new(k, v))
+        .collect::<Vec<_>>();
     WriterProperties::builder()
+        .set_key_value_metadata(Some(kv))
         .set_compression(Compression::ZSTD(
             ZstdLevel::try_new(3).expect("valid level"),
         ))
@@ -161,11 +170,16 @@ impl AtomicTableWriter {
                 std::fs::create_dir_all(dir).map_err(|e| WeftError::io(dir, e))?;
             }
         }
-        let schema = Arc::new(schema.as_ref().clone().with_metadata(prov.metadata()));
+        let schema = Arc::new(
+            schema
+                .as_ref()
+                .clone()
+                .with_metadata(prov.metadata().into_iter().collect()),
+        );
         let tmp = tmp_path(path);
         let file = File::create(&tmp).map_err(|e| WeftError::io(&tmp, e))?;
         let writer =
-            ArrowWriter::try_new(file, schema.clone(), Some(writer_props())).map_err(|e| {
+            ArrowWriter::try_new(file, schema.clone(), Some(writer_props(prov))).map_err(|e| {
                 WeftError::Parquet {
                     path: path.to_path_buf(),
                     message: e.to_string(),
@@ -482,4 +496,40 @@ impl Table {
 pub fn hash_file(path: &Path) -> Result<String> {
     let bytes = std::fs::read(path).map_err(|e| WeftError::io(path, e))?;
     Ok(blake3::hash(&bytes).to_hex().to_string())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn provenance_is_in_the_parquet_key_value_metadata() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("t.parquet");
+        let prov = Provenance::new("unit", serde_json::json!({ "cells": 10 }));
+        write_table(&p, &batch(vec![Col::F64("x", vec![1.0, 2.0])]), &prov).unwrap();
+        let t = Table::read(&p).unwrap();
+        let j: serde_json::Value = serde_json::from_str(t.provenance.as_deref().unwrap()).unwrap();
+        assert_eq!(j["stage"], "unit");
+        assert_eq!(j["parameters"]["cells"], 10);
+        assert_eq!(j["version"], env!("CARGO_PKG_VERSION"));
+        // No temporary file is left beside the table.
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+    }
+
+    #[test]
+    fn an_unfinished_writer_leaves_nothing() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("t.parquet");
+        let b = batch(vec![Col::F64("x", vec![1.0])]);
+        let mut w = AtomicTableWriter::create(
+            &p,
+            b.schema(),
+            &Provenance::new("unit", serde_json::json!({})),
+        )
+        .unwrap();
+        w.write(&b).unwrap();
+        drop(w);
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+    }
 }

@@ -11,6 +11,7 @@ from pathlib import Path
 
 import pandas as pd
 import polars as pl
+import pyarrow.parquet as pq
 
 sim, model, out, scratch = sys.argv[1], Path(sys.argv[2]), Path(sys.argv[3]), Path(sys.argv[4])
 
@@ -38,6 +39,10 @@ for folder in (model, out):
         assert len(df) > 0, path
         prov = df.attrs.get("weft")
         assert prov and prov["tool"] == "weft" and prov["stage"], (path, df.attrs)
+        # The same provenance in the Parquet key-value metadata, for every reader.
+        assert b"weft.provenance" in pq.read_metadata(path).metadata, path
+        if hasattr(pl, "read_parquet_metadata"):
+            assert '"tool":"weft"' in pl.read_parquet_metadata(path)["weft.provenance"], path
         for col, dtype in EXPECT.get(path.name, {}).items():
             assert col in df.columns, f"{path}: missing {col}; has {list(df.columns)}"
             ok = pd.api.types.is_string_dtype(df[col]) if dtype == "string" else str(df[col].dtype) == dtype

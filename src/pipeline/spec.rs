@@ -355,18 +355,24 @@ impl Pipeline {
             }
         }
         if let Some((k, s, line)) = pending.first() {
-            let empty: Vec<(String, String)> = vec![];
-            let ctx = Ctx {
-                values: &vars,
-                inputs: &empty,
-                outputs: &empty,
-                stage: "",
-                instance: "",
+            let names: Vec<String> = pending.iter().map(|(n, _, _)| format!("`{n}`")).collect();
+            let refers_pending = pending
+                .iter()
+                .any(|(n, _, _)| s.contains(&format!("${{{n}}}")));
+            let what = if refers_pending {
+                format!("vars {} refer to each other in a cycle", names.join(", "))
+            } else {
+                let empty: Vec<(String, String)> = vec![];
+                let ctx = Ctx {
+                    values: &vars,
+                    inputs: &empty,
+                    outputs: &empty,
+                    stage: "",
+                    instance: "",
+                };
+                format!("var `{k}`: {}", render(s, &ctx).err().unwrap_or_default())
             };
-            let e = render(s, &ctx)
-                .err()
-                .unwrap_or_else(|| "cyclic reference".into());
-            return Err(err(format!("var `{k}`: {e}"), *line, &format!("vars.{k}"))
+            return Err(err(what, *line, &format!("vars.{k}"))
                 .hint("vars may refer to other vars, without cycles"));
         }
 
@@ -748,9 +754,9 @@ impl Pipeline {
                     let inst = &self.instances[next];
                     return Err(err(
                         format!(
-                            "the stages form a cycle: {} -> `{}`",
+                            "the stages form a cycle: {} -> {}",
                             cyc.join(" -> "),
-                            inst.name
+                            cyc[0]
                         ),
                         inst.line,
                         format!("stages.{}.inputs", inst.stage),
