@@ -25,6 +25,101 @@ struct Cli {
     /// Element updates per measurement (sets the number of steps).
     #[arg(long, default_value_t = 3e8)]
     updates: f64,
+    /// Benchmark the pipeline engine instead: a no-op `weft run` of a 20-stage pipeline,
+    /// and `weft status` over sweeps of the sizes in --instances.
+    #[arg(long)]
+    pipeline: bool,
+    /// Sweep sizes for the pipeline benchmark.
+    #[arg(long, value_delimiter = ',', default_values_t = vec![1000usize, 10_000])]
+    instances: Vec<usize>,
+}
+
+/// Run the `weft` binary next to this one; returns wall seconds.
+fn weft(dir: &std::path::Path, args: &[&str]) -> anyhow::Result<f64> {
+    let exe = std::env::current_exe()?.with_file_name("weft");
+    let t = Instant::now();
+    let o = std::process::Command::new(&exe)
+        .args(args)
+        .current_dir(dir)
+        .output()?;
+    let s = t.elapsed().as_secs_f64();
+    if !o.status.success() {
+        anyhow::bail!(
+            "`weft {}` failed: {}",
+            args.join(" "),
+            String::from_utf8_lossy(&o.stderr)
+        );
+    }
+    Ok(s)
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+fn bench_pipeline(sizes: &[usize]) -> anyhow::Result<()> {
+    let dir = std::env::temp_dir().join(format!("weft-bench-pipeline-{}", std::process::id()));
+    std::fs::create_dir_all(dir.join("pipelines"))?;
+    // 20 stages: 4 chains of 5, each stage copying its predecessor's output.
+    let mut s = String::new();
+    for c in 0..4 {
+        for k in 0..5 {
+            let name = format!("s{c}_{k}");
+            if k == 0 {
+                s += &format!("[stages.{name}]\ncmd = \"echo {c} > ${{outputs.o}}\"\noutputs = {{ o = \"out/{name}.txt\" }}\n\n");
+            } else {
+                s += &format!(
+                    "[stages.{name}]\ncmd = \"cp ${{inputs.i}} ${{outputs.o}}\"\ninputs = {{ i = \"out/s{c}_{}.txt\" }}\noutputs = {{ o = \"out/{name}.txt\" }}\n\n",
+                    k - 1
+                );
+            }
+        }
+    }
+    std::fs::write(dir.join("pipelines/twenty.toml"), s)?;
+    let first = weft(&dir, &["run", "pipelines/twenty.toml", "-q"])?;
+    let noop: Vec<f64> = (0..11)
+        .map(|_| weft(&dir, &["run", "pipelines/twenty.toml", "-q"]))
+        .collect::<anyhow::Result<_>>()?;
+    let status: Vec<f64> = (0..11)
+        .map(|_| weft(&dir, &["status", "pipelines/twenty.toml"]))
+        .collect::<anyhow::Result<_>>()?;
+    println!("pipeline,instances,operation,seconds");
+    println!("chains,20,first_run,{first:.4}");
+    println!("chains,20,noop_run_median,{:.4}", median(noop.clone()));
+    println!("chains,20,status_median,{:.4}", median(status));
+    eprintln!(
+        "  20-stage pipeline: first run {first:.3} s; no-op `weft run` median {:.4} s (min {:.4} s)",
+        median(noop.clone()),
+        noop.iter().cloned().fold(f64::INFINITY, f64::min)
+    );
+    for &n in sizes {
+        let f = format!("pipelines/sweep{n}.toml");
+        let vals: Vec<String> = (0..n).map(|i| i.to_string()).collect();
+        std::fs::write(
+            dir.join(&f),
+            format!(
+                "[stages.point]\ncmd = \"echo ${{i}} > ${{outputs.o}}\"\nmatrix = {{ i = [{}] }}\noutputs = {{ o = \"sweep{n}/${{i}}.txt\" }}\n",
+                vals.join(", ")
+            ),
+        )?;
+        let never = weft(&dir, &["status", &f])?;
+        let run = weft(&dir, &["run", &f, "-q"])?;
+        let st: Vec<f64> = (0..3)
+            .map(|_| weft(&dir, &["status", &f]))
+            .collect::<anyhow::Result<_>>()?;
+        let noop = weft(&dir, &["run", &f, "-q"])?;
+        println!("sweep,{n},status_never_run,{never:.4}");
+        println!("sweep,{n},first_run,{run:.4}");
+        println!("sweep,{n},status_fresh_median,{:.4}", median(st.clone()));
+        println!("sweep,{n},noop_run,{noop:.4}");
+        eprintln!(
+            "  sweep of {n:>6} instances: status {never:.3} s before any run, {:.3} s when all fresh; first run {run:.1} s; no-op run {noop:.3} s",
+            median(st)
+        );
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+    Ok(())
 }
 
 /// A chain of `n` elements along x: trusses, or point masses joined by links.
@@ -93,6 +188,9 @@ fn chain(kind: ElementKind, n: usize) -> Model {
 
 fn main() -> anyhow::Result<()> {
     let cli = Cli::parse();
+    if cli.pipeline {
+        return bench_pipeline(&cli.instances);
+    }
     println!("kind,elements,threads,steps,seconds,element_updates_per_second");
     for kind in [ElementKind::Truss, ElementKind::Link] {
         for &n in &cli.sizes {

@@ -51,6 +51,8 @@ pub struct Workspace {
     pub cache: HashCache,
     /// Directory of the running `weft` binary: stage binaries are looked up there first.
     pub exe_dir: Option<PathBuf>,
+    /// Resolved executables by command word.
+    bin_memo: std::cell::RefCell<std::collections::HashMap<String, Option<PathBuf>>>,
 }
 
 impl Workspace {
@@ -77,6 +79,7 @@ impl Workspace {
             exe_dir: std::env::current_exe()
                 .ok()
                 .and_then(|e| e.parent().map(Path::to_path_buf)),
+            bin_memo: Default::default(),
         }
     }
 
@@ -87,6 +90,17 @@ impl Workspace {
             .split_whitespace()
             .next()?
             .trim_matches(|c| c == '\'' || c == '"');
+        if let Some(hit) = self.bin_memo.borrow().get(first) {
+            return hit.clone();
+        }
+        let found = self.resolve(first);
+        self.bin_memo
+            .borrow_mut()
+            .insert(first.to_string(), found.clone());
+        found
+    }
+
+    fn resolve(&self, first: &str) -> Option<PathBuf> {
         if first.contains('/') {
             let p = self.root.join(first);
             return p.is_file().then_some(p);
@@ -286,24 +300,22 @@ fn tmp_sibling(p: &Path, tag: &str) -> PathBuf {
     p.with_file_name(format!(".{name}.weft-{tag}-{}", std::process::id()))
 }
 
-/// Remove temporaries left by runs whose process is gone.
-fn clean_stale_tmps(final_path: &Path) {
-    let (Some(dir), Some(name)) = (final_path.parent(), final_path.file_name()) else {
-        return;
-    };
-    let prefix = format!(".{}.weft-", name.to_string_lossy());
+/// Remove temporaries (`.NAME.weft-tmp-PID`, `.NAME.weft-old-PID`) left in a folder by
+/// runs whose process is gone. Called once per output folder per run.
+fn clean_stale_tmps(dir: &Path) {
     let Ok(rd) = std::fs::read_dir(dir) else {
         return;
     };
     for e in rd.flatten() {
         let n = e.file_name().to_string_lossy().to_string();
-        if let Some(rest) = n.strip_prefix(&prefix) {
-            let pid = rest.rsplit('-').next().and_then(|s| s.parse::<u32>().ok());
-            let alive = pid.is_some_and(|p| Path::new(&format!("/proc/{p}")).exists());
-            if !alive {
-                let _ =
-                    std::fs::remove_dir_all(e.path()).or_else(|_| std::fs::remove_file(e.path()));
-            }
+        if !(n.starts_with('.') && (n.contains(".weft-tmp-") || n.contains(".weft-old-"))) {
+            continue;
+        }
+        let pid = n.rsplit('-').next().and_then(|s| s.parse::<u32>().ok());
+        let alive = pid
+            .is_some_and(|p| p == std::process::id() || Path::new(&format!("/proc/{p}")).exists());
+        if !alive {
+            let _ = std::fs::remove_dir_all(e.path()).or_else(|_| std::fs::remove_file(e.path()));
         }
     }
 }
@@ -539,6 +551,7 @@ pub fn run(
     let mut reasons: BTreeMap<usize, String> = BTreeMap::new();
     let t0 = Instant::now();
     let mut visited = 0usize;
+    let mut cleaned: std::collections::HashSet<PathBuf> = Default::default();
     loop {
         // Launch every ready instance (deps done), judging it on current content.
         let mut progressed = false;
@@ -605,7 +618,11 @@ pub fn run(
                 if let Some(d) = dest.parent() {
                     std::fs::create_dir_all(d).map_err(|e| WeftError::io(d, e))?;
                 }
-                clean_stale_tmps(&dest);
+                if let Some(d) = dest.parent() {
+                    if cleaned.insert(d.to_path_buf()) {
+                        clean_stale_tmps(d);
+                    }
+                }
                 let tmp = tmp_sibling(&dest, "tmp");
                 let _ = remove_path(&tmp);
                 let rel = tmp

@@ -122,12 +122,20 @@ pub struct Pipeline {
     pub order: Vec<usize>,
 }
 
-fn line_of(src: &str, offset: usize) -> usize {
-    src[..offset.min(src.len())]
-        .bytes()
-        .filter(|&b| b == b'\n')
-        .count()
-        + 1
+/// Offsets of line starts, for byte offset → line number in O(log n).
+struct Lines(Vec<usize>);
+
+impl Lines {
+    fn new(src: &str) -> Lines {
+        Lines(
+            std::iter::once(0)
+                .chain(src.match_indices('\n').map(|(i, _)| i + 1))
+                .collect(),
+        )
+    }
+    fn of(&self, offset: usize) -> usize {
+        self.0.partition_point(|&s| s <= offset)
+    }
 }
 
 fn value_str(v: &toml::Value) -> Option<String> {
@@ -282,6 +290,8 @@ impl Pipeline {
                 .at_line(line)
                 .at_key(key.to_string())
         };
+        let lines = Lines::new(src);
+        let line_of = |_src: &str, offset: usize| lines.of(offset);
         let raw: RawFile = toml::from_str(src).map_err(|e| {
             let line = e.span().map(|s| line_of(src, s.start)).unwrap_or(0);
             let msg = e.message().to_string();
@@ -654,43 +664,37 @@ impl Pipeline {
             }
         }
         let n = self.instances.len();
-        // Index outputs by first component to keep matching fast for large sweeps.
-        let mut by_head: HashMap<std::ffi::OsString, Vec<usize>> = HashMap::new();
-        for (idx, (p, _, _)) in outs.iter().enumerate() {
-            let head = p
-                .components()
-                .next()
-                .map(|c| c.as_os_str().to_os_string())
-                .unwrap_or_default();
-            by_head.entry(head).or_default().push(idx);
-        }
+        // Outputs by path. PathBuf orders component by component, so everything inside a
+        // folder follows it contiguously: one range scan finds outputs inside an input,
+        // and an exact lookup of each ancestor finds outputs that contain it.
+        let out_map: BTreeMap<PathBuf, usize> =
+            outs.iter().map(|(p, j, _)| (p.clone(), *j)).collect();
         for i in 0..n {
             let mut deps = Vec::new();
             for (k, inp) in self.instances[i].inputs.clone() {
-                let head = inp
-                    .components()
-                    .next()
-                    .map(|c| c.as_os_str().to_os_string())
-                    .unwrap_or_default();
-                let mut produced = false;
-                for &o in by_head.get(&head).map(|v| v.as_slice()).unwrap_or(&[]) {
-                    let (op, j, _) = &outs[o];
-                    if within(&inp, op) || within(op, &inp) {
-                        if *j == i {
-                            return Err(err(
-                                format!(
-                                    "`{}` reads its own output `{}`",
-                                    self.instances[i].name,
-                                    inp.display()
-                                ),
-                                self.instances[i].line,
-                                format!("stages.{}.inputs.{k}", self.instances[i].stage),
-                            ));
-                        }
-                        produced = true;
-                        deps.push(*j);
-                    }
+                let mut found: Vec<usize> = inp
+                    .ancestors()
+                    .filter_map(|a| out_map.get(a).copied())
+                    .collect();
+                found.extend(
+                    out_map
+                        .range(inp.clone()..)
+                        .take_while(|(op, _)| op.starts_with(&inp))
+                        .map(|(_, j)| *j),
+                );
+                if found.contains(&i) {
+                    return Err(err(
+                        format!(
+                            "`{}` reads its own output `{}`",
+                            self.instances[i].name,
+                            inp.display()
+                        ),
+                        self.instances[i].line,
+                        format!("stages.{}.inputs.{k}", self.instances[i].stage),
+                    ));
                 }
+                let produced = !found.is_empty();
+                deps.extend(found);
                 if !produced && !self.root.join(&inp).exists() {
                     let inst = &self.instances[i];
                     return Err(err(
