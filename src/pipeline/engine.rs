@@ -19,7 +19,7 @@ use std::io::{BufRead, BufReader, Write};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::sync::mpsc;
-use std::time::{Instant, SystemTime, UNIX_EPOCH};
+use std::time::{SystemTime, UNIX_EPOCH};
 
 use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
 
@@ -501,7 +501,6 @@ pub fn run(
         return Ok(RunReport { outcomes });
     }
     let _lock = lock(&p.root)?;
-    let to_visit = selected.iter().filter(|&&s| s).count();
     let stale_count = (0..n)
         .filter(|&i| selected[i] && !plan[i].is_fresh())
         .count();
@@ -518,6 +517,7 @@ pub fn run(
         )
         .expect("template"),
     );
+    main.enable_steady_tick(std::time::Duration::from_millis(250));
     let say = |s: String| {
         if attended {
             let _ = mp.println(s);
@@ -548,9 +548,6 @@ pub fn run(
     let (tx, rx) = mpsc::channel::<Msg>();
     let mut bars: BTreeMap<usize, ProgressBar> = BTreeMap::new();
     let mut tmp_outputs: BTreeMap<usize, Vec<(PathBuf, PathBuf)>> = BTreeMap::new();
-    let mut reasons: BTreeMap<usize, String> = BTreeMap::new();
-    let t0 = Instant::now();
-    let mut visited = 0usize;
     let mut cleaned: std::collections::HashSet<PathBuf> = Default::default();
     loop {
         // Launch every ready instance (deps done), judging it on current content.
@@ -568,7 +565,7 @@ pub fn run(
                 st[i] = St::Skipped;
                 outcome.insert(i, Outcome::Skipped);
                 say(format!("skip  {} (an upstream stage failed)", inst.name));
-                visited += 1;
+
                 progressed = true;
                 continue;
             }
@@ -591,7 +588,7 @@ pub fn run(
                 Verdict::Fresh => {
                     st[i] = St::Ok;
                     outcome.insert(i, Outcome::Fresh);
-                    visited += 1;
+
                     progressed = true;
                     continue;
                 }
@@ -656,7 +653,7 @@ pub fn run(
             running += 1;
             progressed = true;
             say(format!("run   {} ({reason})", inst.name));
-            reasons.insert(i, reason);
+
             let bar = mp.insert_before(&main, ProgressBar::new(1000));
             bar.set_style(
                 ProgressStyle::with_template(
@@ -694,7 +691,7 @@ pub fn run(
             }
             Msg::Done(d) => {
                 running -= 1;
-                visited += 1;
+
                 main.inc(1);
                 if let Some(b) = bars.remove(&d.idx) {
                     b.finish_and_clear();
@@ -755,13 +752,11 @@ pub fn run(
                     }
                 }
                 forced_or_changed[d.idx] = false;
-                let _ = &reasons;
             }
         }
     }
     main.finish_and_clear();
     ws.cache.save()?;
-    let _ = (visited, to_visit, t0);
     let mut outcomes = vec![];
     for &i in &p.order {
         if selected[i] {

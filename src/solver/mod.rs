@@ -231,6 +231,8 @@ pub struct Solver {
     xn: Vec<[f64; 3]>,
     vn: Vec<[f64; 3]>,
     partials: Vec<NodePartial>,
+    /// Per-chunk energy sums: truss chunks, then link chunks.
+    energy_partials: Vec<[f64; 3]>,
     alpha: f64,
     pub t: f64,
     pub step: u64,
@@ -392,12 +394,11 @@ impl Solver {
         }
         let physical_mass: f64 = mass.iter().sum();
 
-        let mut x = m.coords.clone();
+        let x = m.coords.clone();
         let mut v = vec![[0.0; 3]; nn];
         for (n, vel) in &m.initial_velocities {
             v[*n] = *vel;
         }
-        let _ = &mut x;
         let output_nodes: Vec<usize> = if m.analysis.history_sets.is_empty() {
             (0..nn).collect()
         } else {
@@ -426,6 +427,10 @@ impl Solver {
         loaded_nodes.sort_unstable();
         loaded_nodes.dedup();
         let nchunks = nn.div_ceil(CHUNK);
+        let (truss_chunks, link_chunks) = (
+            truss.id.len().div_ceil(CHUNK),
+            linkg.id.len().div_ceil(CHUNK),
+        );
         let mut s = Solver {
             node_id: m.node_id.clone(),
             x0: m.coords.clone(),
@@ -448,6 +453,7 @@ impl Solver {
             xn: vec![[0.0; 3]; nn],
             vn: vec![[0.0; 3]; nn],
             partials: vec![NodePartial::default(); nchunks],
+            energy_partials: vec![[0.0; 3]; truss_chunks + link_chunks],
             alpha: m.analysis.mass_damping,
             t: 0.0,
             step: 0,
@@ -854,41 +860,58 @@ impl Solver {
         }
     }
 
-    /// Stored elastic energy of all elements at the current positions (fixed-chunk sums).
-    pub fn internal_energy(&self) -> (f64, f64, f64) {
+    /// Stored elastic energy of all elements at the current positions, and the energy
+    /// dissipated so far by dashpots and sliders: (internal, damping, friction). Sums
+    /// run over fixed chunks into preallocated partials, summed in chunk order.
+    pub fn internal_energy(&mut self) -> (f64, f64, f64) {
         let x = &self.x;
         let g = &self.truss;
-        let truss_e: f64 = {
-            let parts: Vec<f64> = (0..g.id.len().div_ceil(CHUNK))
-                .into_par_iter()
-                .map(|ci| {
-                    let r = ci * CHUNK..((ci + 1) * CHUNK).min(g.id.len());
-                    r.map(|e| {
-                        let [a, b] = g.nodes[e];
-                        truss::energy(
-                            &x[a as usize],
-                            &x[b as usize],
-                            g.k[e],
-                            g.l0[e],
-                            g.tension_only[e],
-                        )
-                    })
-                    .sum()
-                })
-                .collect();
-            parts.iter().sum()
+        let (tp, lp) = self
+            .energy_partials
+            .split_at_mut(g.id.len().div_ceil(CHUNK));
+        let truss_chunk = |(ci, out): (usize, &mut [f64; 3])| {
+            let r = ci * CHUNK..((ci + 1) * CHUNK).min(g.id.len());
+            let mut e = 0.0;
+            for k in r {
+                let [a, b] = g.nodes[k];
+                e += truss::energy(
+                    &x[a as usize],
+                    &x[b as usize],
+                    g.k[k],
+                    g.l0[k],
+                    g.tension_only[k],
+                );
+            }
+            *out = [e, 0.0, 0.0];
         };
         let lg = &self.link;
-        let mut link_e = 0.0;
-        let (mut damp, mut fric) = (0.0, 0.0);
-        for e in 0..lg.id.len() {
-            let [a, b] = lg.nodes[e];
-            let d = link::rel_disp(&x[a as usize], &x[b as usize], &lg.d0[e]);
-            link_e += link::energy(&d, &lg.props[e], &lg.state[e].slip);
-            damp += lg.state[e].damping_energy;
-            fric += lg.state[e].friction_energy;
+        let link_chunk = |(ci, out): (usize, &mut [f64; 3])| {
+            let r = ci * CHUNK..((ci + 1) * CHUNK).min(lg.id.len());
+            let mut acc = [0.0; 3];
+            for k in r {
+                let [a, b] = lg.nodes[k];
+                let d = link::rel_disp(&x[a as usize], &x[b as usize], &lg.d0[k]);
+                acc[0] += link::energy(&d, &lg.props[k], &lg.state[k].slip);
+                acc[1] += lg.state[k].damping_energy;
+                acc[2] += lg.state[k].friction_energy;
+            }
+            *out = acc;
+        };
+        tp.par_iter_mut()
+            .enumerate()
+            .with_min_len(4)
+            .for_each(truss_chunk);
+        lp.par_iter_mut()
+            .enumerate()
+            .with_min_len(4)
+            .for_each(link_chunk);
+        let mut sum = [0.0; 3];
+        for p in self.energy_partials.iter() {
+            for d in 0..3 {
+                sum[d] += p[d];
+            }
         }
-        (truss_e + link_e, damp, fric)
+        (sum[0], sum[1], sum[2])
     }
 
     /// Current force of every link on its node 2 at the current positions: spring and
