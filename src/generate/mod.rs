@@ -1,4 +1,5 @@
 //! Canonical model generators behind `weft-weave`. Each returns a validated [`Model`]
 //! with named node sets, ready to simulate.
 
+pub mod grid;
 pub mod rod;

@@ -11,6 +11,8 @@ const NODES: &str = "node_id, x, y, z";
 const PARTS: &str = "part_id, name, kind (+ property columns)";
 const ELEMS2: &str = "element_id, part_id, n1, n2";
 const ELEMS1: &str = "element_id, part_id, n1";
+const ELEMS3: &str = "element_id, part_id, n1, n2, n3";
+const ELEMS4: &str = "element_id, part_id, n1, n2, n3, n4";
 const SETS: &str = "set, node_id, order";
 const CONS: &str = "node_id, fix_x, fix_y, fix_z";
 const LOADS: &str = "load_id, node_id, fx, fy, fz, law, start (+ duration, curve)";
@@ -25,6 +27,8 @@ pub const MODEL_TABLES: &[&str] = &[
     "elements_truss.parquet",
     "elements_link.parquet",
     "elements_point_mass.parquet",
+    "elements_tri.parquet",
+    "elements_quad.parquet",
     "node_sets.parquet",
     "constraints.parquet",
     "loads.parquet",
@@ -106,6 +110,16 @@ fn read_model_inner(dir: &Path) -> Result<Model> {
     let (kx, ky, kz) = (f("kx")?, f("ky")?, f("kz")?);
     let (cx, cy, cz) = (f("cx")?, f("cy")?, f("cz")?);
     let (slip, mass) = (f("slip_force")?, f("mass")?);
+    let (e1, e2, nu12, g12) = (
+        f("youngs_modulus_1")?,
+        f("youngs_modulus_2")?,
+        f("poisson_ratio_12")?,
+        f("shear_modulus_12")?,
+    );
+    let (thick, hg, angle) = (f("thickness")?, f("hourglass")?, f("material_angle")?);
+    let no_comp = t
+        .bool_opt("no_compression")?
+        .unwrap_or_else(|| vec![None; ids.len()]);
     let tension_only = t
         .bool_opt("tension_only")?
         .unwrap_or_else(|| vec![None; ids.len()]);
@@ -140,6 +154,14 @@ fn read_model_inner(dir: &Path) -> Result<Model> {
                 cz: cz[row],
                 slip_force: slip[row],
                 mass: mass[row],
+                youngs_modulus_1: e1[row],
+                youngs_modulus_2: e2[row],
+                poisson_ratio_12: nu12[row],
+                shear_modulus_12: g12[row],
+                thickness: thick[row],
+                no_compression: no_comp[row],
+                hourglass: hg[row],
+                material_angle: angle[row],
             },
         };
         validate_part(&part).map_err(|err| err.in_file(&t.path).at_row(row))?;
@@ -180,15 +202,19 @@ fn read_model_inner(dir: &Path) -> Result<Model> {
         let Some(t) = opt_table(dir, &format!("elements_{}.parquet", kind.name()))? else {
             continue;
         };
-        let exp = if kind.nodes_per_element() == 2 {
-            ELEMS2
-        } else {
-            ELEMS1
+        let exp = match kind.nodes_per_element() {
+            1 => ELEMS1,
+            2 => ELEMS2,
+            3 => ELEMS3,
+            _ => ELEMS4,
         };
         let eid = t.i64("element_id", exp)?;
         let pid = t.i64("part_id", exp)?;
         let mut cols = Vec::new();
-        for c in ["n1", "n2"].iter().take(kind.nodes_per_element()) {
+        for c in ["n1", "n2", "n3", "n4"]
+            .iter()
+            .take(kind.nodes_per_element())
+        {
             let ids = t.i64(c, exp)?;
             cols.push(node_refs(&t, c, &ids, &map)?);
         }
@@ -442,6 +468,17 @@ fn write_tables(m: &Model, dir: &Path, prov: &Provenance) -> Result<()> {
             Col::OptF64("cz", pc(|q| q.cz)),
             Col::OptF64("slip_force", pc(|q| q.slip_force)),
             Col::OptF64("mass", pc(|q| q.mass)),
+            Col::OptF64("youngs_modulus_1", pc(|q| q.youngs_modulus_1)),
+            Col::OptF64("youngs_modulus_2", pc(|q| q.youngs_modulus_2)),
+            Col::OptF64("poisson_ratio_12", pc(|q| q.poisson_ratio_12)),
+            Col::OptF64("shear_modulus_12", pc(|q| q.shear_modulus_12)),
+            Col::OptF64("thickness", pc(|q| q.thickness)),
+            Col::OptBool(
+                "no_compression",
+                p.iter().map(|x| x.props.no_compression).collect(),
+            ),
+            Col::OptF64("hourglass", pc(|q| q.hourglass)),
+            Col::OptF64("material_angle", pc(|q| q.material_angle)),
         ]),
         prov,
     )?;
@@ -454,7 +491,7 @@ fn write_tables(m: &Model, dir: &Path, prov: &Provenance) -> Result<()> {
             Col::I64("element_id", b.id.clone()),
             Col::I64("part_id", b.part.iter().map(|&i| m.parts[i].id).collect()),
         ];
-        for (j, c) in ["n1", "n2"].into_iter().take(npe).enumerate() {
+        for (j, c) in ["n1", "n2", "n3", "n4"].into_iter().take(npe).enumerate() {
             let v: Vec<usize> = b.nodes.iter().skip(j).step_by(npe).copied().collect();
             cols.push(Col::I64(c, ids(&v)));
         }

@@ -24,6 +24,10 @@ pub enum ElementKind {
     Link,
     /// One-node point mass.
     PointMass,
+    /// Three-node constant-strain membrane triangle.
+    Tri,
+    /// Four-node one-point membrane quadrilateral with hourglass control.
+    Quad,
 }
 
 impl ElementKind {
@@ -37,12 +41,16 @@ impl ElementKind {
             ElementKind::Truss => "truss",
             ElementKind::Link => "link",
             ElementKind::PointMass => "point_mass",
+            ElementKind::Tri => "tri",
+            ElementKind::Quad => "quad",
         }
     }
     pub fn nodes_per_element(self) -> usize {
         match self {
             ElementKind::Truss | ElementKind::Link => 2,
             ElementKind::PointMass => 1,
+            ElementKind::Tri => 3,
+            ElementKind::Quad => 4,
         }
     }
     pub fn parse(s: &str) -> Option<Self> {
@@ -74,6 +82,28 @@ pub struct PartProps {
     pub slip_force: Option<f64>,
     /// Point mass [kg].
     pub mass: Option<f64>,
+    /// Membrane: Young's moduli along material directions 1 and 2 [Pa].
+    pub youngs_modulus_1: Option<f64>,
+    pub youngs_modulus_2: Option<f64>,
+    /// Membrane: Poisson's ratio ν₁₂ (null = 0).
+    pub poisson_ratio_12: Option<f64>,
+    /// Membrane: in-plane shear modulus G₁₂ [Pa].
+    pub shear_modulus_12: Option<f64>,
+    /// Membrane thickness s [m].
+    pub thickness: Option<f64>,
+    /// Membrane carries no compressive stress when true.
+    pub no_compression: Option<bool>,
+    /// Quad hourglass coefficient κ (null = 0.1).
+    pub hourglass: Option<f64>,
+    /// Angle of material direction 1 from the projected global x, about the normal [rad].
+    pub material_angle: Option<f64>,
+}
+
+impl PartProps {
+    /// Hourglass coefficient κ; 0.1, LS-DYNA's default, when not given.
+    pub fn hourglass_coefficient(&self) -> f64 {
+        self.hourglass.unwrap_or(0.1)
+    }
 }
 
 #[derive(Debug, Clone)]
@@ -519,6 +549,35 @@ pub fn validate_part(p: &Part) -> Result<()> {
             }
         }
         ElementKind::PointMass => require_pos(p, "mass", q.mass, "in kg")?,
+        ElementKind::Tri | ElementKind::Quad => {
+            require_pos(p, "youngs_modulus_1", q.youngs_modulus_1, "in Pa")?;
+            require_pos(p, "youngs_modulus_2", q.youngs_modulus_2, "in Pa")?;
+            require_pos(p, "shear_modulus_12", q.shear_modulus_12, "in Pa")?;
+            require_pos(p, "thickness", q.thickness, "in m")?;
+            require_pos(p, "density", q.density, "in kg/m³")?;
+            require_nonneg(p, "hourglass", q.hourglass, "")?;
+            let nu = q.poisson_ratio_12.unwrap_or(0.0);
+            let (e1, e2) = (q.youngs_modulus_1.unwrap(), q.youngs_modulus_2.unwrap());
+            if !(nu.is_finite() && nu * nu * e2 / e1 < 1.0 && nu > -1.0) {
+                return Err(WeftError::input(format!(
+                    "part `{}` has poisson_ratio_12 = `{nu}`",
+                    p.name
+                ))
+                .in_column("poisson_ratio_12")
+                .expected(format!(
+                    "−1 < ν₁₂ and ν₁₂² E₂/E₁ < 1 (here E₂/E₁ = {})",
+                    e2 / e1
+                )));
+            }
+            if q.material_angle.is_some_and(|a| !a.is_finite()) {
+                return Err(WeftError::input(format!(
+                    "part `{}` has a non-finite material_angle",
+                    p.name
+                ))
+                .in_column("material_angle")
+                .expected("an angle in rad"));
+            }
+        }
     }
     Ok(())
 }

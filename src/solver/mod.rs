@@ -30,6 +30,7 @@
 //! safety × min_i Δt_i; the report names the node and its stiffest element.
 
 pub mod link;
+pub mod membrane;
 pub mod output;
 pub mod truss;
 
@@ -76,6 +77,135 @@ pub struct LinkGroup {
     pub d0: Vec<[f64; 3]>,
     pub state: Vec<LinkState>,
     pub slot0: usize,
+}
+
+/// Membrane elements with `N` nodes (3: triangles, 4: quads), struct-of-arrays.
+#[derive(Debug, Clone, Default)]
+pub struct MembraneGroup<const N: usize> {
+    pub id: Vec<i64>,
+    pub nodes: Vec<[u32; N]>,
+    pub reference: Vec<membrane::Reference<N>>,
+    pub material: Vec<membrane::Material>,
+    pub thickness: Vec<f64>,
+    /// Hourglass stiffness k_hg [N/m] (quads).
+    pub k_hg: Vec<f64>,
+    /// Largest eigenvalue of the element stiffness [N/m] (stable step).
+    pub k_max: Vec<f64>,
+    pub slot0: usize,
+}
+
+impl<const N: usize> MembraneGroup<N> {
+    fn build(m: &Model, kind: ElementKind, mass: &mut [f64]) -> Result<Self> {
+        let mut g = MembraneGroup::<N> {
+            id: vec![],
+            nodes: vec![],
+            reference: vec![],
+            material: vec![],
+            thickness: vec![],
+            k_hg: vec![],
+            k_max: vec![],
+            slot0: 0,
+        };
+        let Some(b) = m.block(kind) else { return Ok(g) };
+        for e in 0..b.len() {
+            let part = &m.parts[b.part[e]];
+            let p = &part.props;
+            let ns: [usize; N] = std::array::from_fn(|a| b.nodes[N * e + a]);
+            let x: [[f64; 3]; N] = std::array::from_fn(|a| m.coords[ns[a]]);
+            let r = membrane::Reference::<N>::new(&x, p.material_angle.unwrap_or(0.0)).ok_or_else(
+                || {
+                    WeftError::input(format!(
+                        "{} `{}` is degenerate: zero area, inverted or (quad) not convex; nodes {}",
+                        kind.name(),
+                        b.id[e],
+                        ns.iter()
+                            .map(|&n| format!("`{}`", m.node_id[n]))
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                    ))
+                    .in_file(format!("elements_{}.parquet", kind.name()))
+                    .at_row(e)
+                    .expected(
+                        "nodes in counter-clockwise order around a convex element of positive area",
+                    )
+                },
+            )?;
+            let mat = membrane::Material::orthotropic(
+                p.youngs_modulus_1.unwrap(),
+                p.youngs_modulus_2.unwrap(),
+                p.poisson_ratio_12.unwrap_or(0.0),
+                p.shear_modulus_12.unwrap(),
+                p.no_compression.unwrap_or(false),
+            )
+            .map_err(|err| err.in_file("parts.parquet").in_column("poisson_ratio_12"))?;
+            let s = p.thickness.unwrap();
+            let k_hg = if N == 4 {
+                p.hourglass_coefficient() * mat.e_max() * s * r.area * r.grad2()
+            } else {
+                0.0
+            };
+            let me = p.density.unwrap() * s * r.area;
+            for &n in &ns {
+                mass[n] += me / N as f64;
+            }
+            g.k_max.push(membrane::max_stiffness(&r, &mat, s, k_hg));
+            g.id.push(b.id[e]);
+            g.nodes.push(std::array::from_fn(|a| ns[a] as u32));
+            g.reference.push(r);
+            g.material.push(mat);
+            g.thickness.push(s);
+            g.k_hg.push(k_hg);
+        }
+        Ok(g)
+    }
+
+    fn forces(&self, x: &[[f64; 3]], fe: &mut [[f64; 3]]) {
+        let body = |(ci, out): (usize, &mut [[f64; 3]])| {
+            let e0 = ci * CHUNK;
+            for (j, el) in out.chunks_exact_mut(N).enumerate() {
+                let e = e0 + j;
+                let nodes = &self.nodes[e];
+                let xe: [[f64; 3]; N] = std::array::from_fn(|a| x[nodes[a] as usize]);
+                let f = membrane::forces(
+                    &xe,
+                    &self.reference[e],
+                    &self.material[e],
+                    self.thickness[e],
+                    self.k_hg[e],
+                );
+                el.copy_from_slice(&f);
+            }
+        };
+        if self.id.len() <= CHUNK {
+            fe.chunks_mut(N * CHUNK).enumerate().for_each(body);
+        } else {
+            fe.par_chunks_mut(N * CHUNK).enumerate().for_each(body);
+        }
+    }
+
+    /// Per-chunk (membrane, hourglass) energies into `out`.
+    fn energies(&self, x: &[[f64; 3]], out: &mut [[f64; 3]]) {
+        out.par_iter_mut()
+            .enumerate()
+            .with_min_len(4)
+            .for_each(|(ci, o)| {
+                let mut acc = [0.0; 3];
+                for e in ci * CHUNK..((ci + 1) * CHUNK).min(self.id.len()) {
+                    let nodes = &self.nodes[e];
+                    let xe: [[f64; 3]; N] = std::array::from_fn(|a| x[nodes[a] as usize]);
+                    let (w, h) = membrane::energy(
+                        &xe,
+                        &self.reference[e],
+                        &self.material[e],
+                        self.thickness[e],
+                        self.k_hg[e],
+                    );
+                    acc[0] += w;
+                    acc[1] += h;
+                }
+                *o = acc;
+            });
+    }
 }
 
 /// The stable time step and what controls it.
@@ -223,6 +353,8 @@ pub struct Solver {
     fe: Vec<[f64; 3]>,
     pub truss: TrussGroup,
     pub link: LinkGroup,
+    pub tri: MembraneGroup<3>,
+    pub quad: MembraneGroup<4>,
     loads: Vec<Load>,
     loaded_nodes: Vec<usize>,
     fext_prev: Vec<[f64; 3]>,
@@ -233,6 +365,8 @@ pub struct Solver {
     partials: Vec<NodePartial>,
     /// Per-chunk energy sums: truss chunks, then link chunks.
     energy_partials: Vec<[f64; 3]>,
+    /// Per-chunk (membrane, hourglass) sums: triangle chunks, then quad chunks.
+    membrane_partials: Vec<[f64; 3]>,
     alpha: f64,
     pub t: f64,
     pub step: u64,
@@ -333,9 +467,13 @@ impl Solver {
                 mass[b.nodes[e]] += m.parts[b.part[e]].props.mass.unwrap();
             }
         }
+        let mut tri = MembraneGroup::<3>::build(m, ElementKind::Tri, &mut mass)?;
+        let mut quad = MembraneGroup::<4>::build(m, ElementKind::Quad, &mut mass)?;
         truss.slot0 = 0;
         linkg.slot0 = 2 * truss.id.len();
-        let nslots = linkg.slot0 + 2 * linkg.id.len();
+        tri.slot0 = linkg.slot0 + 2 * linkg.id.len();
+        quad.slot0 = tri.slot0 + 3 * tri.id.len();
+        let nslots = quad.slot0 + 4 * quad.id.len();
 
         let mut fixed = vec![0u8; nn];
         for (n, f) in &m.constraints {
@@ -353,6 +491,8 @@ impl Solver {
             .iter()
             .chain(linkg.nodes.iter())
             .flat_map(|p| [p[0], p[1]])
+            .chain(tri.nodes.iter().flatten().copied())
+            .chain(quad.nodes.iter().flatten().copied())
             .collect();
         for &n in &slot_nodes {
             count[n as usize + 1] += 1;
@@ -446,6 +586,12 @@ impl Solver {
             fe: vec![[0.0; 3]; nslots],
             truss,
             link: linkg,
+            membrane_partials: vec![
+                [0.0; 3];
+                tri.id.len().div_ceil(CHUNK) + quad.id.len().div_ceil(CHUNK)
+            ],
+            tri,
+            quad,
             loads: m.loads.clone(),
             fext_prev: vec![[0.0; 3]; loaded_nodes.len()],
             loaded_nodes,
@@ -553,6 +699,17 @@ impl Solver {
                 c[n as usize] += w(o) * cmax;
             }
         }
+        // Membranes: uₑᵀKₑuₑ ≤ λ_max(Kₑ) Σ_{a∈e} |u_a|², so each node of e gets λ_max(Kₑ).
+        for (p, k) in self.tri.nodes.iter().zip(&self.tri.k_max) {
+            for &n in p {
+                s[n as usize] += k;
+            }
+        }
+        for (p, k) in self.quad.nodes.iter().zip(&self.quad.k_max) {
+            for &n in p {
+                s[n as usize] += k;
+            }
+        }
         (s, c)
     }
 
@@ -589,11 +746,17 @@ impl Solver {
         if slot < self.link.slot0 {
             let e = slot / 2;
             (ElementKind::Truss, self.truss.id[e], self.truss.k[e])
-        } else {
+        } else if slot < self.tri.slot0 {
             let e = (slot - self.link.slot0) / 2;
             let p = &self.link.props[e];
             let k = p.k.iter().chain(p.c.iter()).cloned().fold(0.0, f64::max);
             (ElementKind::Link, self.link.id[e], k)
+        } else if slot < self.quad.slot0 {
+            let e = (slot - self.tri.slot0) / 3;
+            (ElementKind::Tri, self.tri.id[e], self.tri.k_max[e])
+        } else {
+            let e = (slot - self.quad.slot0) / 4;
+            (ElementKind::Quad, self.quad.id[e], self.quad.k_max[e])
         }
     }
 
@@ -667,7 +830,11 @@ impl Solver {
     fn element_forces(&mut self) {
         let x = &self.x;
         let v = &self.v;
-        let (fe_truss, fe_link) = self.fe.split_at_mut(self.link.slot0);
+        let (fe_rest, fe_quad) = self.fe.split_at_mut(self.quad.slot0);
+        let (fe_rest, fe_tri) = fe_rest.split_at_mut(self.tri.slot0);
+        self.tri.forces(x, fe_tri);
+        self.quad.forces(x, fe_quad);
+        let (fe_truss, fe_link) = fe_rest.split_at_mut(self.link.slot0);
         let g = &self.truss;
         let truss_chunk = |(ci, out): (usize, &mut [[f64; 3]])| {
             let e0 = ci * CHUNK;
@@ -860,10 +1027,11 @@ impl Solver {
         }
     }
 
-    /// Stored elastic energy of all elements at the current positions, and the energy
-    /// dissipated so far by dashpots and sliders: (internal, damping, friction). Sums
+    /// Stored elastic energy of all elements at the current positions, the energy
+    /// dissipated so far by dashpots and sliders, and the hourglass energy:
+    /// (internal, damping, friction, hourglass). Sums
     /// run over fixed chunks into preallocated partials, summed in chunk order.
-    pub fn internal_energy(&mut self) -> (f64, f64, f64) {
+    pub fn internal_energy(&mut self) -> (f64, f64, f64, f64) {
         let x = &self.x;
         let g = &self.truss;
         let (tp, lp) = self
@@ -905,13 +1073,23 @@ impl Solver {
             .enumerate()
             .with_min_len(4)
             .for_each(link_chunk);
+        let (mt, mq) = self
+            .membrane_partials
+            .split_at_mut(self.tri.id.len().div_ceil(CHUNK));
+        self.tri.energies(x, mt);
+        self.quad.energies(x, mq);
         let mut sum = [0.0; 3];
         for p in self.energy_partials.iter() {
             for d in 0..3 {
                 sum[d] += p[d];
             }
         }
-        (sum[0], sum[1], sum[2])
+        let (mut mem, mut hg) = (0.0, 0.0);
+        for p in self.membrane_partials.iter() {
+            mem += p[0];
+            hg += p[1];
+        }
+        (sum[0] + mem, sum[1], sum[2], hg)
     }
 
     /// Current force of every link on its node 2 at the current positions: spring and
@@ -977,9 +1155,9 @@ impl Solver {
             if snap {
                 // Energies at t_n (positions x^n are in xn; internal energy from them).
                 std::mem::swap(&mut self.x, &mut self.xn);
-                let (ie, damp, fric) = self.internal_energy();
+                let (ie, damp, fric, hg) = self.internal_energy();
                 std::mem::swap(&mut self.x, &mut self.xn);
-                let total = ke + ie + damp + self.e_mass_damp + fric;
+                let total = ke + ie + damp + self.e_mass_damp + fric + hg;
                 let e_init = *e0.get_or_insert(total);
                 let err = total - e_init - self.w_ext;
                 ref_energy = ref_energy
@@ -997,7 +1175,7 @@ impl Solver {
                     internal: ie,
                     damping: damp + self.e_mass_damp,
                     friction: fric,
-                    hourglass: 0.0,
+                    hourglass: hg,
                     contact: 0.0,
                     external_work: self.w_ext,
                     balance_error: err,
@@ -1068,7 +1246,10 @@ impl Solver {
             threads: rayon::current_num_threads(),
             max_balance_error_relative: max_rel,
             final_energies: last_e,
-            elements: self.truss.id.len() + self.link.id.len(),
+            elements: self.truss.id.len()
+                + self.link.id.len()
+                + self.tri.id.len()
+                + self.quad.id.len(),
             nodes: self.x.len(),
         })
     }
@@ -1081,4 +1262,23 @@ pub fn run_in_memory(m: &Model) -> Result<(Solver, output::MemorySink, RunStats)
     let mut sink = output::MemorySink::default();
     let stats = s.run(&mut sink, &mut |_| {})?;
     Ok((s, sink, stats))
+}
+
+impl Solver {
+    /// Internal nodal forces at the current positions (the forces the elements exert;
+    /// the dashpots see the current half-step velocities and the sliders do not advance).
+    pub fn internal_forces(&mut self) -> Vec<[f64; 3]> {
+        let saved = self.link.state.clone();
+        self.element_forces();
+        self.link.state = saved;
+        (0..self.x.len())
+            .map(|i| {
+                let mut f = [0.0; 3];
+                for &sl in &self.slots[self.slot_ptr[i] as usize..self.slot_ptr[i + 1] as usize] {
+                    add(&mut f, &self.fe[sl as usize]);
+                }
+                f
+            })
+            .collect()
+    }
 }

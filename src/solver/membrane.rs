@@ -1,0 +1,345 @@
+//! Membrane elements: three-node constant-strain triangle and four-node quadrilateral
+//! with one integration point and hourglass control. Orthotropic linear elasticity in
+//! material axes, large displacements and rotations, no bending stiffness.
+//!
+//! Glossary: X_a reference and x_a current node positions [m]; (g₁, g₂, g₃) the reference
+//! material frame: g₃ the element normal, g₁ the material direction 1 (global x
+//! projected on the element, turned by the material angle about g₃); X̂_a the reference
+//! coordinates in (g₁, g₂); ∇̂N_a the shape-function gradients in those coordinates (at
+//! the centre for the quad); A₀ reference area; s thickness.
+//!
+//! Kinematics (total Lagrangian): F = Σ_a x_a ⊗ ∇̂N_a (3×2: the current images of the
+//! material axes), Green strain E = ½(FᵀF − I) (2×2, in material axes). Any rigid motion
+//! leaves FᵀF unchanged, so the element is objective under large rotations and its
+//! material axes convect with it; for small strains E is the engineering strain.
+//! Material (plane stress, St Venant–Kirchhoff): S = D E with, in Voigt form
+//! [S₁₁, S₂₂, S₁₂] = D [E₁₁, E₂₂, 2E₁₂],
+//!   D = 1/(1 − ν₁₂ν₂₁) [[E₁, ν₁₂E₂, 0], [ν₁₂E₂, E₂, 0], [0, 0, G₁₂(1 − ν₁₂ν₂₁)]],
+//! ν₂₁ = ν₁₂E₂/E₁. With `no_compression`, negative principal stresses are set to zero
+//! (a tension field: the fabric wrinkles instead of carrying compression).
+//! Energy W = A₀ s ½ E:S; internal force f_a = −∂W/∂x_a = −A₀ s F S ∇̂N_a.
+//!
+//! Hourglass control (quad; Flanagan & Belytschko, IJNME 17, 1981): γ_a = ¼(h_a −
+//! (h·X̂)∇̂N_{a,1} − (h·Ŷ)∇̂N_{a,2}), h = (1, −1, 1, −1). γ is orthogonal to every affine
+//! field, so q = Σ_a γ_a x_a vanishes under rigid motion and uniform strain; the
+//! stiffness W_hg = ½ k_hg |q|², f_a = −k_hg γ_a q, with k_hg = κ E_max s A₀ Σ_a|∇̂N_a|²
+//! (κ = 0.1 by default, LS-DYNA's default hourglass coefficient).
+//!
+//! References: Belytschko, Liu, Moran, *Nonlinear Finite Elements*, §4.5 (total
+//! Lagrangian), §8.7 (one-point quadrature and hourglass control); Belytschko, Lin &
+//! Tsay, CMAME 42 (1984) (one-point membrane/shell element).
+
+use crate::error::{Result, WeftError};
+
+/// Orthotropic plane-stress material in material axes.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Material {
+    /// Voigt stiffness [Pa] for [E₁₁, E₂₂, 2E₁₂] → [S₁₁, S₂₂, S₁₂].
+    pub d: [[f64; 3]; 3],
+    pub no_compression: bool,
+}
+
+impl Material {
+    pub fn orthotropic(
+        e1: f64,
+        e2: f64,
+        nu12: f64,
+        g12: f64,
+        no_compression: bool,
+    ) -> Result<Material> {
+        let nu21 = nu12 * e2 / e1;
+        let den = 1.0 - nu12 * nu21;
+        if den <= 0.0 {
+            return Err(WeftError::input(format!(
+                "ν₁₂ = {nu12} with E₁ = {e1}, E₂ = {e2} gives 1 − ν₁₂ν₂₁ = {den}"
+            ))
+            .expected("ν₁₂² E₂/E₁ < 1 (a positive-definite material)"));
+        }
+        Ok(Material {
+            d: [
+                [e1 / den, nu12 * e2 / den, 0.0],
+                [nu12 * e2 / den, e2 / den, 0.0],
+                [0.0, 0.0, g12],
+            ],
+            no_compression,
+        })
+    }
+    /// Largest direct modulus, for the hourglass stiffness.
+    pub fn e_max(&self) -> f64 {
+        self.d[0][0].max(self.d[1][1])
+    }
+}
+
+/// Reference geometry of one membrane element with `N` nodes.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Reference<const N: usize> {
+    /// ∇̂N_a in material axes [1/m].
+    pub grad: [[f64; 2]; N],
+    /// Reference area A₀ [m²].
+    pub area: f64,
+    /// Hourglass vector γ (zero for the triangle).
+    pub gamma: [f64; N],
+}
+
+fn sub(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+fn cross(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+fn dot(a: &[f64; 3], b: &[f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+fn unit(a: [f64; 3]) -> Option<[f64; 3]> {
+    let n = dot(&a, &a).sqrt();
+    (n > 0.0).then(|| [a[0] / n, a[1] / n, a[2] / n])
+}
+
+impl<const N: usize> Reference<N> {
+    /// Set up from the reference positions; `angle` turns material direction 1 from the
+    /// projected global x about the element normal [rad]. `None` for a degenerate
+    /// element (zero area, inverted or non-convex quad).
+    pub fn new(x: &[[f64; 3]; N], angle: f64) -> Option<Reference<N>> {
+        assert!(N == 3 || N == 4);
+        let n = if N == 3 {
+            cross(&sub(&x[1], &x[0]), &sub(&x[2], &x[0]))
+        } else {
+            cross(&sub(&x[2], &x[0]), &sub(&x[3], &x[1]))
+        };
+        let g3 = unit(n)?;
+        let proj = |e: [f64; 3]| {
+            unit(sub(&e, &{
+                let d = dot(&e, &g3);
+                [d * g3[0], d * g3[1], d * g3[2]]
+            }))
+        };
+        let a = proj([1.0, 0.0, 0.0])
+            .filter(|a| dot(a, &[1.0, 0.0, 0.0]).abs() > 1e-6)
+            .or_else(|| proj([0.0, 1.0, 0.0]))?;
+        let b = cross(&g3, &a);
+        let (c, s) = (angle.cos(), angle.sin());
+        let g1 = [
+            c * a[0] + s * b[0],
+            c * a[1] + s * b[1],
+            c * a[2] + s * b[2],
+        ];
+        let g2 = cross(&g3, &g1);
+        let mut p = [[0.0; 2]; N];
+        for i in 0..N {
+            let d = sub(&x[i], &x[0]);
+            p[i] = [dot(&d, &g1), dot(&d, &g2)];
+        }
+        let mut grad = [[0.0; 2]; N];
+        let mut gamma = [0.0; N];
+        let area;
+        if N == 3 {
+            let a2 = (p[1][0] - p[0][0]) * (p[2][1] - p[0][1])
+                - (p[2][0] - p[0][0]) * (p[1][1] - p[0][1]);
+            if a2 <= 0.0 {
+                return None;
+            }
+            area = 0.5 * a2;
+            for i in 0..3 {
+                let (j, k) = ((i + 1) % 3, (i + 2) % 3);
+                grad[i] = [(p[j][1] - p[k][1]) / a2, (p[k][0] - p[j][0]) / a2];
+            }
+        } else {
+            let a2 = (p[2][0] - p[0][0]) * (p[3][1] - p[1][1])
+                + (p[1][0] - p[3][0]) * (p[2][1] - p[0][1]);
+            if a2 <= 0.0 {
+                return None;
+            }
+            area = 0.5 * a2;
+            for i in 0..4 {
+                let (j, l) = ((i + 1) % 4, (i + 3) % 4);
+                grad[i] = [(p[j][1] - p[l][1]) / a2, (p[l][0] - p[j][0]) / a2];
+            }
+            // Convexity: each corner's cross product has the orientation of the whole.
+            for i in 0..4 {
+                let (j, l) = ((i + 1) % 4, (i + 3) % 4);
+                let e1 = [p[j][0] - p[i][0], p[j][1] - p[i][1]];
+                let e2 = [p[l][0] - p[i][0], p[l][1] - p[i][1]];
+                if e1[0] * e2[1] - e1[1] * e2[0] <= 0.0 {
+                    return None;
+                }
+            }
+            let h = [1.0, -1.0, 1.0, -1.0];
+            let hx: f64 = (0..4).map(|i| h[i] * p[i][0]).sum();
+            let hy: f64 = (0..4).map(|i| h[i] * p[i][1]).sum();
+            for i in 0..4 {
+                gamma[i] = 0.25 * (h[i] - hx * grad[i][0] - hy * grad[i][1]);
+            }
+        }
+        Some(Reference { grad, area, gamma })
+    }
+
+    /// Σ_a |∇̂N_a|² [1/m²].
+    pub fn grad2(&self) -> f64 {
+        self.grad.iter().map(|g| g[0] * g[0] + g[1] * g[1]).sum()
+    }
+}
+
+/// Deformation gradient F (3×2 as two columns) and Green strain in Voigt form.
+#[inline(always)]
+fn kinematics<const N: usize>(x: &[[f64; 3]; N], r: &Reference<N>) -> ([[f64; 3]; 2], [f64; 3]) {
+    let mut f = [[0.0; 3]; 2];
+    for a in 0..N {
+        for c in 0..2 {
+            let g = r.grad[a][c];
+            f[c][0] += x[a][0] * g;
+            f[c][1] += x[a][1] * g;
+            f[c][2] += x[a][2] * g;
+        }
+    }
+    let c11 = dot(&f[0], &f[0]);
+    let c22 = dot(&f[1], &f[1]);
+    let c12 = dot(&f[0], &f[1]);
+    (f, [0.5 * (c11 - 1.0), 0.5 * (c22 - 1.0), c12])
+}
+
+/// Second Piola–Kirchhoff stress [S₁₁, S₂₂, S₁₂] from Voigt strain.
+#[inline(always)]
+pub fn stress(m: &Material, e: &[f64; 3]) -> [f64; 3] {
+    let d = &m.d;
+    let mut s = [
+        d[0][0] * e[0] + d[0][1] * e[1] + d[0][2] * e[2],
+        d[1][0] * e[0] + d[1][1] * e[1] + d[1][2] * e[2],
+        d[2][0] * e[0] + d[2][1] * e[1] + d[2][2] * e[2],
+    ];
+    if m.no_compression {
+        // Principal stresses of [[s0, s2], [s2, s1]]; drop the compressive ones.
+        let mean = 0.5 * (s[0] + s[1]);
+        let rad = (0.25 * (s[0] - s[1]).powi(2) + s[2] * s[2]).sqrt();
+        let (p1, p2) = (mean + rad, mean - rad);
+        if p1 <= 0.0 {
+            s = [0.0; 3];
+        } else if p2 < 0.0 {
+            // Keep p1 along its direction n: S = p1 n⊗n.
+            let (nx, ny) = if rad > 0.0 {
+                let t = 0.5 * (2.0 * s[2]).atan2(s[0] - s[1]);
+                (t.cos(), t.sin())
+            } else {
+                (1.0, 0.0)
+            };
+            s = [p1 * nx * nx, p1 * ny * ny, p1 * nx * ny];
+        }
+    }
+    s
+}
+
+/// Internal forces on the nodes [N] (membrane and hourglass).
+#[inline(always)]
+pub fn forces<const N: usize>(
+    x: &[[f64; 3]; N],
+    r: &Reference<N>,
+    m: &Material,
+    thickness: f64,
+    k_hg: f64,
+) -> [[f64; 3]; N] {
+    let (f, e) = kinematics(x, r);
+    let s = stress(m, &e);
+    let w = r.area * thickness;
+    let mut out = [[0.0; 3]; N];
+    for a in 0..N {
+        let g = r.grad[a];
+        // (S ∇N_a) in material axes, then F·that.
+        let t0 = s[0] * g[0] + s[2] * g[1];
+        let t1 = s[2] * g[0] + s[1] * g[1];
+        for c in 0..3 {
+            out[a][c] = -w * (f[0][c] * t0 + f[1][c] * t1);
+        }
+    }
+    if N == 4 && k_hg > 0.0 {
+        let mut q = [0.0; 3];
+        for a in 0..N {
+            for c in 0..3 {
+                q[c] += r.gamma[a] * x[a][c];
+            }
+        }
+        for a in 0..N {
+            for c in 0..3 {
+                out[a][c] -= k_hg * r.gamma[a] * q[c];
+            }
+        }
+    }
+    out
+}
+
+/// (membrane strain energy, hourglass energy) [J].
+#[inline(always)]
+pub fn energy<const N: usize>(
+    x: &[[f64; 3]; N],
+    r: &Reference<N>,
+    m: &Material,
+    thickness: f64,
+    k_hg: f64,
+) -> (f64, f64) {
+    let (_, e) = kinematics(x, r);
+    let s = stress(m, &e);
+    let w = 0.5 * r.area * thickness * (s[0] * e[0] + s[1] * e[1] + s[2] * e[2]);
+    let mut hg = 0.0;
+    if N == 4 && k_hg > 0.0 {
+        let mut q = [0.0; 3];
+        for a in 0..N {
+            for c in 0..3 {
+                q[c] += r.gamma[a] * x[a][c];
+            }
+        }
+        hg = 0.5 * k_hg * dot(&q, &q);
+    }
+    (w, hg)
+}
+
+/// Largest eigenvalue of the element's small-strain stiffness (membrane + hourglass) at
+/// the reference configuration [N/m], for the stable time step.
+pub fn max_stiffness<const N: usize>(
+    r: &Reference<N>,
+    m: &Material,
+    thickness: f64,
+    k_hg: f64,
+) -> f64 {
+    // In-plane stiffness in material axes: K = A₀ s Bᵀ D B (2N × 2N); the out-of-plane
+    // directions carry only the hourglass stiffness k_hg γγᵀ, whose eigenvalue is k_hg|γ|².
+    let n2 = 2 * N;
+    let mut k = nalgebra::DMatrix::<f64>::zeros(n2, n2);
+    let w = r.area * thickness;
+    for a in 0..N {
+        for b in 0..N {
+            let ba = [
+                [r.grad[a][0], 0.0],
+                [0.0, r.grad[a][1]],
+                [r.grad[a][1], r.grad[a][0]],
+            ];
+            let bb = [
+                [r.grad[b][0], 0.0],
+                [0.0, r.grad[b][1]],
+                [r.grad[b][1], r.grad[b][0]],
+            ];
+            for i in 0..2 {
+                for j in 0..2 {
+                    let mut v = 0.0;
+                    for p in 0..3 {
+                        for q in 0..3 {
+                            v += ba[p][i] * m.d[p][q] * bb[q][j];
+                        }
+                    }
+                    k[(2 * a + i, 2 * b + j)] += w * v;
+                }
+            }
+            for i in 0..2 {
+                k[(2 * a + i, 2 * b + i)] += k_hg * r.gamma[a] * r.gamma[b];
+            }
+        }
+    }
+    let g2: f64 = r.gamma.iter().map(|g| g * g).sum();
+    let lam = k
+        .symmetric_eigenvalues()
+        .iter()
+        .cloned()
+        .fold(0.0, f64::max);
+    lam.max(k_hg * g2)
+}
