@@ -19,6 +19,9 @@ const LOADS: &str = "load_id, node_id, fx, fy, fz, law, start (+ duration, curve
 const CURVES: &str = "curve, t, value";
 const VELS: &str = "node_id, vx, vy, vz";
 const ANALYSIS: &str = "end_time, output_interval (+ optional settings)";
+const PROJ: &str =
+    "projectile_id, shape, radius, mass, tip_x, tip_y, tip_z, vx, vy, vz (+ optional columns)";
+const SYM: &str = "normal (+ position, tolerance)";
 
 /// Names of the model tables, in the order they are written.
 pub const MODEL_TABLES: &[&str] = &[
@@ -34,6 +37,8 @@ pub const MODEL_TABLES: &[&str] = &[
     "loads.parquet",
     "curves.parquet",
     "initial_velocities.parquet",
+    "projectile.parquet",
+    "symmetry.parquet",
     "analysis.parquet",
 ];
 
@@ -364,6 +369,75 @@ fn read_model_inner(dir: &Path) -> Result<Model> {
             .map(|i| (idx[i], [vx[i], vy[i], vz[i]]))
             .collect();
     }
+    if let Some(t) = opt_table(dir, "projectile.parquet")? {
+        let n = t.num_rows();
+        let ids = t.i64("projectile_id", PROJ)?;
+        let shape = t.str("shape", PROJ)?;
+        let radius = t.f64("radius", PROJ)?;
+        let mass = t.f64("mass", PROJ)?;
+        let g = |c: &str| t.f64(c, PROJ);
+        let (tx, ty, tz) = (g("tip_x")?, g("tip_y")?, g("tip_z")?);
+        let (vx, vy, vz) = (g("vx")?, g("vy")?, g("vz")?);
+        let o = |c: &str| -> Result<Vec<Option<f64>>> {
+            Ok(t.f64_opt(c)?.unwrap_or_else(|| vec![None; n]))
+        };
+        let (ax, ay, az) = (o("axis_x")?, o("axis_y")?, o("axis_z")?);
+        let (len, k, mu) = (o("length")?, o("contact_stiffness")?, o("friction")?);
+        let presc = t
+            .bool_opt("prescribed_velocity")?
+            .unwrap_or_else(|| vec![None; n]);
+        for row in 0..n {
+            let sh = ProjectileShape::parse(&shape[row]).ok_or_else(|| {
+                t.value_error(
+                    "shape",
+                    row,
+                    format!("unknown projectile shape `{}`", shape[row]),
+                )
+                .expected("one of `sphere`, `flat`, `round`")
+            })?;
+            m.projectiles.push(ProjectileSpec {
+                id: ids[row],
+                shape: sh,
+                radius: radius[row],
+                length: len[row].unwrap_or(4.0 * radius[row]),
+                mass: mass[row],
+                tip: [tx[row], ty[row], tz[row]],
+                axis: [
+                    ax[row].unwrap_or(0.0),
+                    ay[row].unwrap_or(0.0),
+                    az[row].unwrap_or(-1.0),
+                ],
+                velocity: [vx[row], vy[row], vz[row]],
+                prescribed_velocity: presc[row].unwrap_or(false),
+                contact_stiffness: k[row],
+                friction: mu[row].unwrap_or(0.0),
+            });
+        }
+    }
+    if let Some(t) = opt_table(dir, "symmetry.parquet")? {
+        let normal = t.str("normal", SYM)?;
+        let n = normal.len();
+        let pos = t.f64_opt("position")?.unwrap_or_else(|| vec![None; n]);
+        let tol = t.f64_opt("tolerance")?.unwrap_or_else(|| vec![None; n]);
+        for row in 0..n {
+            let axis = ["x", "y", "z"]
+                .iter()
+                .position(|a| *a == normal[row])
+                .ok_or_else(|| {
+                    t.value_error(
+                        "normal",
+                        row,
+                        format!("unknown symmetry plane normal `{}`", normal[row]),
+                    )
+                    .expected("`x`, `y` or `z` (the plane x = position, ...)")
+                })?;
+            m.symmetry.push(SymmetryPlane {
+                normal: axis,
+                position: pos[row].unwrap_or(0.0),
+                tolerance: tol[row].unwrap_or(1e-9),
+            });
+        }
+    }
     if let Some(t) = opt_table(dir, "analysis.parquet")? {
         if t.num_rows() != 1 {
             return Err(
@@ -607,6 +681,59 @@ fn write_tables(m: &Model, dir: &Path, prov: &Provenance) -> Result<()> {
                 Col::F64("vx", v.iter().map(|x| x.1[0]).collect()),
                 Col::F64("vy", v.iter().map(|x| x.1[1]).collect()),
                 Col::F64("vz", v.iter().map(|x| x.1[2]).collect()),
+            ]),
+            prov,
+        )?;
+    }
+    if !m.projectiles.is_empty() {
+        let p = &m.projectiles;
+        let c = |f: fn(&ProjectileSpec) -> f64| p.iter().map(f).collect::<Vec<_>>();
+        write_table(
+            &dir.join("projectile.parquet"),
+            &batch(vec![
+                Col::I64("projectile_id", p.iter().map(|x| x.id).collect()),
+                Col::Str(
+                    "shape",
+                    p.iter().map(|x| x.shape.name().to_string()).collect(),
+                ),
+                Col::F64("radius", c(|x| x.radius)),
+                Col::F64("length", c(|x| x.length)),
+                Col::F64("mass", c(|x| x.mass)),
+                Col::F64("tip_x", c(|x| x.tip[0])),
+                Col::F64("tip_y", c(|x| x.tip[1])),
+                Col::F64("tip_z", c(|x| x.tip[2])),
+                Col::F64("axis_x", c(|x| x.axis[0])),
+                Col::F64("axis_y", c(|x| x.axis[1])),
+                Col::F64("axis_z", c(|x| x.axis[2])),
+                Col::F64("vx", c(|x| x.velocity[0])),
+                Col::F64("vy", c(|x| x.velocity[1])),
+                Col::F64("vz", c(|x| x.velocity[2])),
+                Col::Bool(
+                    "prescribed_velocity",
+                    p.iter().map(|x| x.prescribed_velocity).collect(),
+                ),
+                Col::OptF64(
+                    "contact_stiffness",
+                    p.iter().map(|x| x.contact_stiffness).collect(),
+                ),
+                Col::F64("friction", c(|x| x.friction)),
+            ]),
+            prov,
+        )?;
+    }
+    if !m.symmetry.is_empty() {
+        let s = &m.symmetry;
+        write_table(
+            &dir.join("symmetry.parquet"),
+            &batch(vec![
+                Col::Str(
+                    "normal",
+                    s.iter()
+                        .map(|x| ["x", "y", "z"][x.normal].to_string())
+                        .collect(),
+                ),
+                Col::F64("position", s.iter().map(|x| x.position).collect()),
+                Col::F64("tolerance", s.iter().map(|x| x.tolerance).collect()),
             ]),
             prov,
         )?;

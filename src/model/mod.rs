@@ -212,6 +212,72 @@ pub struct Load {
     pub law: TimeLaw,
 }
 
+/// Shape of a rigid projectile's nose.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ProjectileShape {
+    Sphere,
+    /// Flat-nosed cylinder.
+    Flat,
+    /// Round-nosed cylinder (hemispherical nose).
+    Round,
+}
+
+impl ProjectileShape {
+    pub fn name(self) -> &'static str {
+        match self {
+            ProjectileShape::Sphere => "sphere",
+            ProjectileShape::Flat => "flat",
+            ProjectileShape::Round => "round",
+        }
+    }
+    pub fn parse(s: &str) -> Option<Self> {
+        [
+            ProjectileShape::Sphere,
+            ProjectileShape::Flat,
+            ProjectileShape::Round,
+        ]
+        .into_iter()
+        .find(|k| k.name() == s)
+    }
+}
+
+/// A rigid projectile (`projectile.parquet`): translation only, contact with nodes.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ProjectileSpec {
+    pub id: i64,
+    pub shape: ProjectileShape,
+    /// Radius [m].
+    pub radius: f64,
+    /// Body length behind the nose tip [m] (cylinders).
+    pub length: f64,
+    /// Mass [kg].
+    pub mass: f64,
+    /// Nose tip position [m].
+    pub tip: [f64; 3],
+    /// Axis, pointing from the body to the tip (normalised on use).
+    pub axis: [f64; 3],
+    /// Initial velocity [m/s].
+    pub velocity: [f64; 3],
+    /// Moves at its initial velocity whatever the contact force.
+    pub prescribed_velocity: bool,
+    /// Penalty stiffness per node [N/m]; `None`: 0.1·m_node/Δt².
+    pub contact_stiffness: Option<f64>,
+    /// Coulomb friction coefficient μ.
+    pub friction: f64,
+}
+
+/// A symmetry plane (`symmetry.parquet`): nodes on it keep their displacement normal to
+/// it at zero (quarter models: x = 0 and y = 0).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SymmetryPlane {
+    /// Normal axis: 0 = x, 1 = y, 2 = z.
+    pub normal: usize,
+    /// Plane position along the normal [m].
+    pub position: f64,
+    /// Nodes within this distance lie on the plane [m].
+    pub tolerance: f64,
+}
+
 /// Analysis settings (`analysis.parquet`); command-line flags of `weft-simulate`
 /// override them.
 #[derive(Debug, Clone, PartialEq)]
@@ -270,6 +336,8 @@ pub struct Model {
     pub curves: BTreeMap<String, Arc<Curve>>,
     /// Initial velocities [m/s]: (node index, v).
     pub initial_velocities: Vec<(usize, [f64; 3])>,
+    pub projectiles: Vec<ProjectileSpec>,
+    pub symmetry: Vec<SymmetryPlane>,
     pub analysis: Analysis,
 }
 
@@ -480,6 +548,57 @@ impl Model {
                     .expected("zero initial velocity along fixed directions")
                     .hint("remove the constraint or the velocity"));
                 }
+            }
+        }
+        for (row, p) in self.projectiles.iter().enumerate() {
+            let bad = |col: &str, v: f64, exp: &str| {
+                Err(
+                    WeftError::input(format!("projectile `{}` has {col} = `{v}`", p.id))
+                        .in_file("projectile.parquet")
+                        .in_column(col)
+                        .at_row(row)
+                        .expected(exp.to_string()),
+                )
+            };
+            if !(p.radius > 0.0 && p.radius.is_finite()) {
+                return bad("radius", p.radius, "a radius > 0 in m");
+            }
+            if !(p.mass > 0.0 && p.mass.is_finite()) {
+                return bad("mass", p.mass, "a mass > 0 in kg");
+            }
+            if !(p.length >= 0.0 && p.length.is_finite()) {
+                return bad("length", p.length, "a length ≥ 0 in m");
+            }
+            if !(p.friction >= 0.0 && p.friction.is_finite()) {
+                return bad("friction", p.friction, "μ ≥ 0");
+            }
+            if let Some(k) = p.contact_stiffness {
+                if !(k > 0.0 && k.is_finite()) {
+                    return bad(
+                        "contact_stiffness",
+                        k,
+                        "a stiffness > 0 in N/m, or null for the automatic one",
+                    );
+                }
+            }
+            let n = (p.axis[0].powi(2) + p.axis[1].powi(2) + p.axis[2].powi(2)).sqrt();
+            if !(n > 0.0 && n.is_finite()) {
+                return bad(
+                    "axis_x",
+                    n,
+                    "a non-zero axis vector (axis_x, axis_y, axis_z)",
+                );
+            }
+        }
+        for (row, s) in self.symmetry.iter().enumerate() {
+            if !(s.tolerance >= 0.0 && s.position.is_finite()) {
+                return Err(WeftError::input(format!(
+                    "symmetry plane has position {} and tolerance {}",
+                    s.position, s.tolerance
+                ))
+                .in_file("symmetry.parquet")
+                .at_row(row)
+                .expected("a finite position and a tolerance ≥ 0 in m"));
             }
         }
         validate_analysis(&self.analysis)

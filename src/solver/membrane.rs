@@ -21,9 +21,11 @@
 //!
 //! Hourglass control (quad; Flanagan & Belytschko, IJNME 17, 1981): γ_a = ¼(h_a −
 //! (h·X̂)∇̂N_{a,1} − (h·Ŷ)∇̂N_{a,2}), h = (1, −1, 1, −1). γ is orthogonal to every affine
-//! field, so q = Σ_a γ_a x_a vanishes under rigid motion and uniform strain; the
-//! stiffness W_hg = ½ k_hg |q|², f_a = −k_hg γ_a q, with k_hg = κ E_max s A₀ Σ_a|∇̂N_a|²
-//! (κ = 0.1 by default, LS-DYNA's default hourglass coefficient).
+//! field, so q = Σ_a γ_a x_a vanishes under rigid motion and uniform strain. With n the
+//! current element normal and q = q_t + q_n n: W_hg = ½ k_hg (|q_t|² + r_n q_n²),
+//! f_a = −∂W_hg/∂x_a exactly (including the turning of n), k_hg = κ E_max s A₀ Σ_a|∇̂N_a|²
+//! (κ = 0.1 by default, LS-DYNA's
+//! default hourglass coefficient), r_n = [`NORMAL_RATIO`] for the warping mode.
 //!
 //! References: Belytschko, Liu, Moran, *Nonlinear Finite Elements*, §4.5 (total
 //! Lagrangian), §8.7 (one-point quadrature and hourglass control); Belytschko, Lin &
@@ -254,19 +256,56 @@ pub fn forces<const N: usize>(
         }
     }
     if N == 4 && k_hg > 0.0 {
-        let mut q = [0.0; 3];
+        let (q, n) = hourglass_q(x, r);
+        // Warping (normal) part of q with the stiffness k_hg·NORMAL_RATIO.
+        let qn = dot(&q, &n);
+        let kq: [f64; 3] =
+            std::array::from_fn(|c| k_hg * (q[c] - qn * n[c]) + k_hg * NORMAL_RATIO * qn * n[c]);
         for a in 0..N {
             for c in 0..3 {
-                q[c] += r.gamma[a] * x[a][c];
+                out[a][c] -= r.gamma[a] * kq[c];
             }
         }
-        for a in 0..N {
+        // The normal n = c/|c|, c = d₁ × d₂ (d₁ = x₃ − x₁, d₂ = x₄ − x₂), turns with the
+        // nodes: −∂W/∂x_a gains k(1 − r_n) q_n (∂c/∂x_a)ᵀ q_t / |c|.
+        let d1 = sub(&x[2], &x[0]);
+        let d2 = sub(&x[3 % N], &x[1]);
+        let cn = cross(&d1, &d2);
+        let cl = dot(&cn, &cn).sqrt();
+        if cl > 0.0 {
+            let s = k_hg * (1.0 - NORMAL_RATIO) * qn / cl;
+            let w: [f64; 3] = std::array::from_fn(|c| s * (q[c] - qn * n[c]));
+            let (a1, a2) = (cross(&d2, &w), cross(&w, &d1));
             for c in 0..3 {
-                out[a][c] -= k_hg * r.gamma[a] * q[c];
+                out[0][c] -= a1[c];
+                out[2][c] += a1[c];
+                out[1][c] -= a2[c];
+                out[3 % N][c] += a2[c];
             }
         }
     }
     out
+}
+
+/// The out-of-plane (warping) hourglass stiffness relative to the in-plane one. An
+/// unstressed membrane has no transverse stiffness at all; the transverse stiffness of a
+/// membrane under tension N is N/(E s) ≈ the strain (≈ 1 %) of its in-plane stiffness, so
+/// the warping mode gets 1 % of the in-plane hourglass stiffness. With the full κ E s it
+/// stiffens the membrane against transverse motion and throws nodes the wrong way under
+/// a point impact.
+pub const NORMAL_RATIO: f64 = 0.01;
+
+/// Hourglass vector q = Σ γ_a x_a and the current unit normal (from the diagonals).
+#[inline(always)]
+fn hourglass_q<const N: usize>(x: &[[f64; 3]; N], r: &Reference<N>) -> ([f64; 3], [f64; 3]) {
+    let mut q = [0.0; 3];
+    for a in 0..N {
+        for c in 0..3 {
+            q[c] += r.gamma[a] * x[a][c];
+        }
+    }
+    let n = unit(cross(&sub(&x[2], &x[0]), &sub(&x[3 % N], &x[1]))).unwrap_or([0.0, 0.0, 1.0]);
+    (q, n)
 }
 
 /// (membrane strain energy, hourglass energy) [J].
@@ -283,13 +322,9 @@ pub fn energy<const N: usize>(
     let w = 0.5 * r.area * thickness * (s[0] * e[0] + s[1] * e[1] + s[2] * e[2]);
     let mut hg = 0.0;
     if N == 4 && k_hg > 0.0 {
-        let mut q = [0.0; 3];
-        for a in 0..N {
-            for c in 0..3 {
-                q[c] += r.gamma[a] * x[a][c];
-            }
-        }
-        hg = 0.5 * k_hg * dot(&q, &q);
+        let (q, n) = hourglass_q(x, r);
+        let qn = dot(&q, &n);
+        hg = 0.5 * k_hg * (dot(&q, &q) - qn * qn + NORMAL_RATIO * qn * qn);
     }
     (w, hg)
 }

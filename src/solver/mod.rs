@@ -29,6 +29,7 @@
 //! and Δt_i = (2/ω_i)(√(1+ξ_i²) − ξ_i) (Belytschko et al. eq. 6.2.23). The step is
 //! safety × min_i Δt_i; the report names the node and its stiffest element.
 
+pub mod contact;
 pub mod link;
 pub mod membrane;
 pub mod output;
@@ -278,6 +279,10 @@ pub trait Sink {
     /// Displacements and velocities of the output nodes at time t.
     fn history(&mut self, t: f64, nodes: &[usize], u: &[[f64; 3]], v: &[[f64; 3]]) -> Result<()>;
     fn energy(&mut self, t: f64, e: &Energies) -> Result<()>;
+    /// A projectile at time t: tip position, velocity, contact force on it.
+    fn projectile(&mut self, _t: f64, _id: i64, _state: &[f64; 9]) -> Result<()> {
+        Ok(())
+    }
 }
 
 /// Wall time per phase.
@@ -329,6 +334,8 @@ struct Snapshot {
     u: Vec<[f64; 3]>,
     v: Vec<[f64; 3]>,
     e: Energies,
+    /// Per projectile: tip x, y, z, velocity, contact force.
+    proj: Vec<[f64; 9]>,
 }
 
 /// The explicit solver: owns the state and scratch buffers of one model.
@@ -355,6 +362,19 @@ pub struct Solver {
     pub link: LinkGroup,
     pub tri: MembraneGroup<3>,
     pub quad: MembraneGroup<4>,
+    /// Rigid projectiles.
+    pub projectiles: Vec<contact::Projectile>,
+    /// Contact forces on nodes, and the nodes that carry one.
+    fcon: Vec<[f64; 3]>,
+    con_nodes: Vec<usize>,
+    /// Default penalty stiffness per node κ_c m/Δt² [N/m].
+    k_contact: Vec<f64>,
+    /// Friction work dissipated in contact [J].
+    e_contact_friction: f64,
+    /// Work done by projectiles with prescribed velocity [J].
+    w_prescribed: f64,
+    /// Directions normal to the symmetry planes: projectiles cannot move along them.
+    proj_fixed: [bool; 3],
     loads: Vec<Load>,
     loaded_nodes: Vec<usize>,
     fext_prev: Vec<[f64; 3]>,
@@ -484,6 +504,14 @@ impl Solver {
             }
         }
 
+        for sp in &m.symmetry {
+            for i in 0..nn {
+                if (m.coords[i][sp.normal] - sp.position).abs() <= sp.tolerance {
+                    fixed[i] |= 1 << sp.normal;
+                }
+            }
+        }
+
         // Gather index: node → its element slots in ascending slot order.
         let mut count = vec![0u32; nn + 1];
         let slot_nodes: Vec<u32> = truss
@@ -592,6 +620,13 @@ impl Solver {
             ],
             tri,
             quad,
+            projectiles: m.projectiles.iter().map(contact::Projectile::new).collect(),
+            fcon: vec![[0.0; 3]; nn],
+            con_nodes: Vec::with_capacity(nn),
+            k_contact: vec![0.0; nn],
+            e_contact_friction: 0.0,
+            w_prescribed: 0.0,
+            proj_fixed: std::array::from_fn(|d| m.symmetry.iter().any(|sp| sp.normal == d)),
             loads: m.loads.clone(),
             fext_prev: vec![[0.0; 3]; loaded_nodes.len()],
             loaded_nodes,
@@ -664,6 +699,9 @@ impl Solver {
             node,
             element: s.controlling_element(node),
         };
+        for i in 0..nn {
+            s.k_contact[i] = contact::PENALTY_FACTOR * s.mass[i] / (dt * dt);
+        }
         Ok(s)
     }
 
@@ -892,6 +930,93 @@ impl Solver {
         }
     }
 
+    /// Penalty contact of every projectile against every node with mass, at x^n.
+    fn contact_forces(&mut self) {
+        for &i in &self.con_nodes {
+            self.fcon[i] = [0.0; 3];
+        }
+        self.con_nodes.clear();
+        let (x, v, mass, kc) = (&self.x, &self.v, &self.mass, &self.k_contact);
+        let dt_prev = self.dt_prev;
+        for p in self.projectiles.iter_mut() {
+            let mut ftot = [0.0; 3];
+            for i in 0..x.len() {
+                if mass[i] <= 0.0 {
+                    continue;
+                }
+                let Some((g, n)) = p.penetration(&x[i]) else {
+                    continue;
+                };
+                let fnorm = p.stiffness.unwrap_or(kc[i]) * g;
+                let mut f = [n[0] * fnorm, n[1] * fnorm, n[2] * fnorm];
+                if p.friction > 0.0 {
+                    let vr = [v[i][0] - p.v[0], v[i][1] - p.v[1], v[i][2] - p.v[2]];
+                    let vn = dot(&vr, &n);
+                    let vt = [vr[0] - vn * n[0], vr[1] - vn * n[1], vr[2] - vn * n[2]];
+                    let vtm = dot(&vt, &vt).sqrt();
+                    if vtm > 0.0 {
+                        let ft = p.friction * fnorm * (vtm / contact::V_REG).min(1.0);
+                        for d in 0..3 {
+                            f[d] -= ft * vt[d] / vtm;
+                        }
+                        self.e_contact_friction += ft * vtm * dt_prev;
+                    }
+                }
+                add(&mut self.fcon[i], &f);
+                ftot = [ftot[0] - f[0], ftot[1] - f[1], ftot[2] - f[2]];
+                self.con_nodes.push(i);
+            }
+            p.force = ftot;
+        }
+    }
+
+    /// Advance the projectiles (central difference, like the nodes); returns their
+    /// kinetic energy at t_n (free ones) and their velocities at t_n.
+    fn advance_projectiles(&mut self, dt_next: f64) -> (f64, Option<Vec<[f64; 3]>>) {
+        let mut ke = 0.0;
+        let mut vs = Vec::with_capacity(self.projectiles.len());
+        for p in self.projectiles.iter_mut() {
+            if p.prescribed {
+                // The work the imposed motion does on the system.
+                self.w_prescribed -= dt_next * dot(&p.force, &p.v);
+                vs.push(p.v);
+            } else {
+                // In a symmetric model the projectile stays on the symmetry planes.
+                let a: [f64; 3] = std::array::from_fn(|d| {
+                    if self.proj_fixed[d] {
+                        0.0
+                    } else {
+                        p.force[d] / p.mass
+                    }
+                });
+                let vn: [f64; 3] = std::array::from_fn(|d| p.v[d] + 0.5 * self.dt_prev * a[d]);
+                ke += 0.5 * p.mass * dot(&vn, &vn);
+                p.v = std::array::from_fn(|d| vn[d] + 0.5 * dt_next * a[d]);
+                vs.push(vn);
+            }
+            for d in 0..3 {
+                p.tip[d] += dt_next * p.v[d];
+            }
+        }
+        (ke, Some(vs))
+    }
+
+    /// Stored penalty energy ½ Σ k g² at the current positions.
+    fn contact_energy(&self) -> f64 {
+        let mut e = 0.0;
+        for p in &self.projectiles {
+            for i in 0..self.x.len() {
+                if self.mass[i] <= 0.0 {
+                    continue;
+                }
+                if let Some((g, _)) = p.penetration(&self.x[i]) {
+                    e += 0.5 * p.stiffness.unwrap_or(self.k_contact[i]) * g * g;
+                }
+            }
+        }
+        e
+    }
+
     /// Gather forces and advance every node; returns (kinetic energy at t_n when
     /// `SNAP`, mass-damping power α Σ m |v^n|²).
     fn update_nodes<const SNAP: bool>(&mut self, dt_next: f64) -> Result<(f64, f64)> {
@@ -901,6 +1026,7 @@ impl Solver {
         let (h_prev, h_next) = (0.5 * dt_prev, 0.5 * dt_next);
         let (fe, slots, ptr) = (&self.fe, &self.slots, &self.slot_ptr);
         let (fext, inv_m, mass, fixed) = (&self.fext, &self.inv_m, &self.mass, &self.fixed);
+        let fcon = (!self.projectiles.is_empty()).then_some(&self.fcon);
         let body = |(ci, ((((x, v), xn), vn), part)): (
             usize,
             (
@@ -916,6 +1042,9 @@ impl Solver {
             for j in 0..x.len() {
                 let i = i0 + j;
                 let mut f = fext[i];
+                if let Some(fc) = fcon {
+                    add(&mut f, &fc[i]);
+                }
                 for &s in &slots[ptr[i] as usize..ptr[i + 1] as usize] {
                     add(&mut f, &fe[s as usize]);
                 }
@@ -1139,6 +1268,9 @@ impl Solver {
             self.apply_loads();
             let t1 = Instant::now();
             self.element_forces();
+            if !self.projectiles.is_empty() {
+                self.contact_forces();
+            }
             let t2 = Instant::now();
             times.loads += t1 - t0;
             times.forces += t2 - t1;
@@ -1150,20 +1282,46 @@ impl Solver {
                 self.update_nodes::<false>(dt_next)?
             };
             self.e_mass_damp += 0.5 * self.dt_prev * dp;
+            let mut contact_e = 0.0;
+            if snap {
+                // Projectile states at t_n: tip and contact force before their update.
+                cur.proj.clear();
+                for p in &self.projectiles {
+                    cur.proj.push([
+                        p.tip[0], p.tip[1], p.tip[2], 0.0, 0.0, 0.0, p.force[0], p.force[1],
+                        p.force[2],
+                    ]);
+                }
+                if !self.projectiles.is_empty() {
+                    std::mem::swap(&mut self.x, &mut self.xn);
+                    contact_e = self.contact_energy();
+                    std::mem::swap(&mut self.x, &mut self.xn);
+                }
+            }
+            let (ke_proj, v_proj) = if self.projectiles.is_empty() {
+                (0.0, None)
+            } else {
+                self.advance_projectiles(dt_next)
+            };
+            let ke = ke + ke_proj;
             let t3 = Instant::now();
             times.update += t3 - t2;
             if snap {
+                if let Some(vp) = v_proj {
+                    for (row, v) in cur.proj.iter_mut().zip(vp) {
+                        row[3..6].copy_from_slice(&v);
+                    }
+                }
                 // Energies at t_n (positions x^n are in xn; internal energy from them).
                 std::mem::swap(&mut self.x, &mut self.xn);
                 let (ie, damp, fric, hg) = self.internal_energy();
                 std::mem::swap(&mut self.x, &mut self.xn);
-                let total = ke + ie + damp + self.e_mass_damp + fric + hg;
+                let contact = contact_e + self.e_contact_friction;
+                let w_ext = self.w_ext + self.w_prescribed;
+                let total = ke + ie + damp + self.e_mass_damp + fric + hg + contact;
                 let e_init = *e0.get_or_insert(total);
-                let err = total - e_init - self.w_ext;
-                ref_energy = ref_energy
-                    .max(e_init.abs())
-                    .max(self.w_ext.abs())
-                    .max(ke + ie);
+                let err = total - e_init - w_ext;
+                ref_energy = ref_energy.max(e_init.abs()).max(w_ext.abs()).max(ke + ie);
                 let rel = if ref_energy > 0.0 {
                     err.abs() / ref_energy
                 } else {
@@ -1176,8 +1334,8 @@ impl Solver {
                     damping: damp + self.e_mass_damp,
                     friction: fric,
                     hourglass: hg,
-                    contact: 0.0,
-                    external_work: self.w_ext,
+                    contact,
+                    external_work: w_ext,
                     balance_error: err,
                     balance_error_relative: rel,
                 };
@@ -1211,6 +1369,16 @@ impl Solver {
                     } else {
                         1.0
                     };
+                    for (j, p) in self.projectiles.iter().enumerate() {
+                        let row: [f64; 9] = if w >= 1.0 {
+                            cur.proj[j]
+                        } else {
+                            std::array::from_fn(|c| {
+                                prev.proj[j][c] + w * (cur.proj[j][c] - prev.proj[j][c])
+                            })
+                        };
+                        sink.projectile(tk, p.id, &row)?;
+                    }
                     let (src_u, src_v, e) = if w >= 1.0 {
                         (&cur.u, &cur.v, cur.e)
                     } else {

@@ -20,9 +20,15 @@ pub struct MemorySink {
     pub v: Vec<Vec<[f64; 3]>>,
     pub energy_t: Vec<f64>,
     pub energy: Vec<Energies>,
+    /// (t, projectile id, [tip x y z, v x y z, force x y z]).
+    pub projectile: Vec<(f64, i64, [f64; 9])>,
 }
 
 impl Sink for MemorySink {
+    fn projectile(&mut self, t: f64, id: i64, s: &[f64; 9]) -> Result<()> {
+        self.projectile.push((t, id, *s));
+        Ok(())
+    }
     fn history(&mut self, t: f64, nodes: &[usize], u: &[[f64; 3]], v: &[[f64; 3]]) -> Result<()> {
         if self.nodes.is_empty() {
             self.nodes = nodes.to_vec();
@@ -79,6 +85,7 @@ pub struct ParquetSink {
     ids: Vec<i64>,
     energy_t: Vec<f64>,
     energy: Vec<Energies>,
+    projectile: Vec<(f64, i64, [f64; 9])>,
 }
 
 impl ParquetSink {
@@ -90,6 +97,7 @@ impl ParquetSink {
             ids: Vec::new(),
             energy_t: Vec::new(),
             energy: Vec::new(),
+            projectile: Vec::new(),
         })
     }
 
@@ -135,13 +143,42 @@ impl ParquetSink {
         ]);
         let mut ew = AtomicTableWriter::create(&out.join("energy.parquet"), eb.schema(), prov)?;
         ew.write(&eb)?;
+        let mut pw = None;
+        if !self.projectile.is_empty() {
+            let p = &self.projectile;
+            let c = |k: usize| p.iter().map(|r| r.2[k]).collect::<Vec<_>>();
+            let pb = batch(vec![
+                Col::F64("t", p.iter().map(|r| r.0).collect()),
+                Col::I64("projectile_id", p.iter().map(|r| r.1).collect()),
+                Col::F64("x", c(0)),
+                Col::F64("y", c(1)),
+                Col::F64("z", c(2)),
+                Col::F64("vx", c(3)),
+                Col::F64("vy", c(4)),
+                Col::F64("vz", c(5)),
+                Col::F64("fx", c(6)),
+                Col::F64("fy", c(7)),
+                Col::F64("fz", c(8)),
+            ]);
+            let mut w =
+                AtomicTableWriter::create(&out.join("projectile.parquet"), pb.schema(), prov)?;
+            w.write(&pb)?;
+            pw = Some(w);
+        }
         ew.finish()?;
+        if let Some(w) = pw {
+            w.finish()?;
+        }
         self.hist.finish()?;
         Ok(())
     }
 }
 
 impl Sink for ParquetSink {
+    fn projectile(&mut self, t: f64, id: i64, s: &[f64; 9]) -> Result<()> {
+        self.projectile.push((t, id, *s));
+        Ok(())
+    }
     fn history(&mut self, t: f64, nodes: &[usize], u: &[[f64; 3]], v: &[[f64; 3]]) -> Result<()> {
         for (j, &i) in nodes.iter().enumerate() {
             self.cols[0].push(t);

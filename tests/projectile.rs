@@ -1,0 +1,182 @@
+//! Rigid projectile contact.
+//!
+//! Reference: J. C. Smith, F. L. McCrackin, H. F. Schiefer, "Stress-strain relationships
+//! in yarns subjected to rapid impact loading. Part V: Wave propagation in long textile
+//! yarns impacted transversely", Textile Research Journal 28 (1958) 288–302. A yarn
+//! struck transversely at constant velocity V carries a strain ε behind a longitudinal
+//! front at c = √(E/ρ), and a transverse kink at the lab-frame speed
+//! U = c(√(ε(1+ε)) − ε), with V = c√(2ε√(ε(1+ε)) − ε²). For E = 80 GPa,
+//! ρ = 1440 kg/m³, V = 300 m/s: ε = 0.895 %, U = 641.5 m/s (DESIGN.md §8).
+//!
+//! ```text
+//!                   | V = 300 m/s (prescribed)
+//!                 [===]  flat nose, R = 0.25 mm
+//!   pinned o--o--o--o--o--o--o--o pinned      yarn ±0.16 m, 0.1 mm trusses
+//!          <- kink U t ->   <- longitudinal front c t ->
+//! ```
+
+mod common;
+use common::*;
+use weft::model::{ElementKind, Model, PartProps, ProjectileShape, ProjectileSpec};
+use weft::solver::run_in_memory;
+
+const E: f64 = 80e9;
+const RHO: f64 = 1440.0;
+
+fn yarn(half: f64, h: f64, area: f64) -> (Model, usize) {
+    let mut m = Model::default();
+    let n = (2.0 * half / h).round() as usize;
+    for i in 0..=n {
+        m.add_node(i as i64 + 1, [-half + i as f64 * h, 0.0, 0.0]);
+    }
+    let p = m.add_part(
+        1,
+        "yarn",
+        ElementKind::Truss,
+        PartProps {
+            youngs_modulus: Some(E),
+            density: Some(RHO),
+            area: Some(area),
+            tension_only: Some(true),
+            ..Default::default()
+        },
+    );
+    for e in 0..n {
+        m.add_element(e as i64 + 1, p, &[e, e + 1]);
+    }
+    m.constraints.push((0, [true, true, true]));
+    m.constraints.push((n, [true, true, true]));
+    for i in 1..n {
+        m.constraints.push((i, [false, true, false]));
+    }
+    (m, n)
+}
+
+/// Smith's relations: V(ε) and U(ε).
+fn smith_v(eps: f64, c: f64) -> f64 {
+    c * (2.0 * eps * (eps * (1.0 + eps)).sqrt() - eps * eps).sqrt()
+}
+
+#[test]
+fn smith_transverse_impact_strain_and_kink_speed() {
+    let c = (E / RHO).sqrt();
+    let v = 300.0;
+    // Solve V(ε) = 300 m/s by bisection: the oracle, not a fitted number.
+    let (mut lo, mut hi) = (1e-5, 0.1);
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if smith_v(mid, c) < v {
+            lo = mid
+        } else {
+            hi = mid
+        }
+    }
+    let eps = 0.5 * (lo + hi);
+    let u_lab = c * ((eps * (1.0 + eps)).sqrt() - eps);
+    assert!(
+        (eps - 0.00895).abs() < 5e-5 && (u_lab - 641.5).abs() < 0.5,
+        "oracle ε = {eps}, U = {u_lab}"
+    );
+
+    let (half, h) = (0.16, 1e-4);
+    let (mut m, n) = yarn(half, h, 1e-8);
+    m.projectiles.push(ProjectileSpec {
+        id: 1,
+        shape: ProjectileShape::Flat,
+        radius: 0.25e-3,
+        length: 2e-3,
+        mass: 1.0,
+        tip: [0.0, 0.0, 0.0],
+        axis: [0.0, 0.0, -1.0],
+        velocity: [0.0, 0.0, -v],
+        prescribed_velocity: true,
+        contact_stiffness: None,
+        friction: 0.0,
+    });
+    let t_end = 20e-6;
+    m.analysis.end_time = t_end;
+    m.analysis.output_interval = 0.1e-6;
+    let (_s, out, _) = run_in_memory(&m).unwrap();
+    let mid = n / 2;
+    let node = |x: f64| {
+        out.nodes
+            .iter()
+            .position(|&i| i == mid + (x / h).round() as usize)
+            .unwrap()
+    };
+    // Strain between the kink (≈ 13 mm) and the longitudinal front (≈ 149 mm).
+    let last = out.u.len() - 1;
+    let (a, b) = (node(0.04), node(0.10));
+    let strain = (out.u[last][b][0] - out.u[last][a][0]) / 0.06;
+    // Kink arrival at material points X: extrapolate w(X, t) = V(t − t₀) back to w = 0,
+    // then take the spatial position X + u_x at t₀; U_lab = Δx/Δt₀.
+    let kink = |x: f64| -> (f64, f64) {
+        let j = node(x);
+        let w: Vec<f64> = out.series(j, 2).iter().map(|z| -z).collect();
+        let t1 = 0.5 * (x / u_lab + t_end);
+        let (k1, k2) = (out.t.iter().position(|&t| t >= t1).unwrap(), last);
+        let slope = (w[k2] - w[k1]) / (out.t[k2] - out.t[k1]);
+        let t0 = out.t[k1] - w[k1] / slope;
+        let k0 = out.t.iter().position(|&t| t >= t0).unwrap();
+        (t0, x + out.u[k0][j][0])
+    };
+    let (ta, xa) = kink(0.004);
+    let (tb, xb) = kink(0.010);
+    let u = (xb - xa) / (tb - ta);
+    eprintln!(
+        "Smith: strain {:.5} % vs {:.5} %, kink speed {u:.1} m/s vs {u_lab:.1} m/s",
+        100.0 * strain,
+        100.0 * eps
+    );
+    assert!(rel(strain, eps) < 0.01, "strain {strain} vs Smith {eps}");
+    assert!(rel(u, u_lab) < 0.01, "kink speed {u} vs Smith {u_lab}");
+}
+
+#[test]
+fn free_projectile_on_a_pinned_string_conserves_momentum_and_energy() {
+    let (half, h) = (0.05, 2e-4);
+    let (mut m, _n) = yarn(half, h, 2e-8);
+    let (mass, v0) = (2e-6, 150.0); // comparable to the string mass (≈ 3 mg), so the exchange is large
+    m.projectiles.push(ProjectileSpec {
+        id: 1,
+        shape: ProjectileShape::Sphere,
+        radius: 1e-3,
+        length: 0.0,
+        mass,
+        tip: [0.0, 0.0, 1e-4],
+        axis: [0.0, 0.0, -1.0],
+        velocity: [0.0, 0.0, -v0],
+        prescribed_velocity: false,
+        contact_stiffness: None,
+        friction: 0.2,
+    });
+    // Until the longitudinal wave reaches the pinned ends, nothing outside acts.
+    let c = (E / RHO).sqrt();
+    m.analysis.end_time = 0.9 * half / c;
+    m.analysis.output_interval = m.analysis.end_time / 100.0;
+    let (s, out, _) = run_in_memory(&m).unwrap();
+    let p0 = mass * v0;
+    let last = out.t.len() - 1;
+    let pz_nodes: f64 = out
+        .nodes
+        .iter()
+        .enumerate()
+        .map(|(j, &i)| s.mass[i] * out.v[last][j][2])
+        .sum();
+    let pz_proj = mass
+        * out
+            .projectile
+            .iter()
+            .filter(|r| r.0 == out.t[last])
+            .map(|r| r.2[5])
+            .next()
+            .unwrap();
+    let ptot = -(pz_nodes + pz_proj);
+    let e = out.energy.last().unwrap();
+    let ke0 = 0.5 * mass * v0 * v0;
+    eprintln!("momentum {ptot:.6e} vs {p0:.6e}; energy error {:.3e} of {ke0:.3e} J; projectile slowed to {:.1} m/s", e.balance_error, -out.projectile.last().unwrap().2[5]);
+    assert!(pz_nodes.abs() > 0.05 * p0, "the string took up momentum");
+    assert!(rel(ptot, p0) < 0.01, "momentum {ptot} vs {p0}");
+    assert!(e.balance_error.abs() < 0.01 * ke0, "{e:?}");
+    assert!(e.contact > 0.0 || e.internal > 0.0);
+}
