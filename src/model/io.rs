@@ -22,6 +22,7 @@ const ANALYSIS: &str = "end_time, output_interval (+ optional settings)";
 const PROJ: &str =
     "projectile_id, shape, radius, mass, tip_x, tip_y, tip_z, vx, vy, vz (+ optional columns)";
 const SYM: &str = "normal (+ position, tolerance)";
+const TIES: &str = "slave, m1, m2 (+ m3, m4)";
 
 /// Names of the model tables, in the order they are written.
 pub const MODEL_TABLES: &[&str] = &[
@@ -39,6 +40,7 @@ pub const MODEL_TABLES: &[&str] = &[
     "initial_velocities.parquet",
     "projectile.parquet",
     "symmetry.parquet",
+    "ties.parquet",
     "analysis.parquet",
 ];
 
@@ -438,6 +440,54 @@ fn read_model_inner(dir: &Path) -> Result<Model> {
             });
         }
     }
+    if let Some(t) = opt_table(dir, "ties.parquet")? {
+        let sl = t.i64("slave", TIES)?;
+        let n = sl.len();
+        let sl = node_refs(&t, "slave", &sl, &map)?;
+        let m1 = t.i64("m1", TIES)?;
+        let m1 = node_refs(&t, "m1", &m1, &map)?;
+        let m2 = t.i64("m2", TIES)?;
+        let m2 = node_refs(&t, "m2", &m2, &map)?;
+        let opt_nodes = |c: &str| -> Result<Vec<Option<usize>>> {
+            let Some(a) = t.batch.column_by_name(c) else {
+                return Ok(vec![None; n]);
+            };
+            let a = arrow_cast::cast(a, &arrow_schema::DataType::Int64).map_err(|e| {
+                t.value_error(c, 0, format!("cannot read column `{c}` as integers: {e}"))
+            })?;
+            let a = a
+                .as_any()
+                .downcast_ref::<arrow_array::Int64Array>()
+                .expect("int64");
+            (0..n)
+                .map(|row| {
+                    if arrow_array::Array::is_null(a, row) {
+                        Ok(None)
+                    } else {
+                        let id = a.value(row);
+                        map.get(&id).copied().map(Some).ok_or_else(|| {
+                            t.value_error(
+                                c,
+                                row,
+                                format!("node id `{id}` does not exist in nodes.parquet"),
+                            )
+                            .expected("the id of a node in nodes.parquet, or null")
+                        })
+                    }
+                })
+                .collect()
+        };
+        let (m3, m4) = (opt_nodes("m3")?, opt_nodes("m4")?);
+        for row in 0..n {
+            let mut masters = vec![m1[row], m2[row]];
+            masters.extend(m3[row]);
+            masters.extend(m4[row]);
+            m.ties.push(Tie {
+                slave: sl[row],
+                masters,
+            });
+        }
+    }
     if let Some(t) = opt_table(dir, "analysis.parquet")? {
         if t.num_rows() != 1 {
             return Err(
@@ -720,6 +770,46 @@ fn write_tables(m: &Model, dir: &Path, prov: &Provenance) -> Result<()> {
             ]),
             prov,
         )?;
+    }
+    if !m.ties.is_empty() {
+        let ti = &m.ties;
+        let mid = |k: usize| {
+            ti.iter()
+                .map(|x| x.masters.get(k).map(|&i| m.node_id[i]))
+                .collect::<Vec<_>>()
+        };
+        let opt = |name: &'static str, v: Vec<Option<i64>>| {
+            (
+                arrow_schema::Field::new(name, arrow_schema::DataType::Int64, true),
+                Arc::new(arrow_array::Int64Array::from(v)) as arrow_array::ArrayRef,
+            )
+        };
+        let b = batch(vec![
+            Col::I64("slave", ti.iter().map(|x| m.node_id[x.slave]).collect()),
+            Col::I64(
+                "m1",
+                mid(0).into_iter().map(|v| v.unwrap_or_default()).collect(),
+            ),
+            Col::I64(
+                "m2",
+                mid(1).into_iter().map(|v| v.unwrap_or_default()).collect(),
+            ),
+        ]);
+        let mut fields: Vec<arrow_schema::Field> = b
+            .schema()
+            .fields()
+            .iter()
+            .map(|f| f.as_ref().clone())
+            .collect();
+        let mut arrays = b.columns().to_vec();
+        for (f, a) in [opt("m3", mid(2)), opt("m4", mid(3))] {
+            fields.push(f);
+            arrays.push(a);
+        }
+        let b =
+            arrow_array::RecordBatch::try_new(Arc::new(arrow_schema::Schema::new(fields)), arrays)
+                .expect("equal lengths");
+        write_table(&dir.join("ties.parquet"), &b, prov)?;
     }
     if !m.symmetry.is_empty() {
         let s = &m.symmetry;

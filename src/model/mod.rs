@@ -278,6 +278,14 @@ pub struct SymmetryPlane {
     pub tolerance: f64,
 }
 
+/// A tied node (`ties.parquet`): the slave follows the master edge (2 nodes) or face
+/// (3 or 4 nodes) it lies on; its mass and forces go to the masters with the same weights.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Tie {
+    pub slave: usize,
+    pub masters: Vec<usize>,
+}
+
 /// Analysis settings (`analysis.parquet`); command-line flags of `weft-simulate`
 /// override them.
 #[derive(Debug, Clone, PartialEq)]
@@ -338,6 +346,7 @@ pub struct Model {
     pub initial_velocities: Vec<(usize, [f64; 3])>,
     pub projectiles: Vec<ProjectileSpec>,
     pub symmetry: Vec<SymmetryPlane>,
+    pub ties: Vec<Tie>,
     pub analysis: Analysis,
 }
 
@@ -588,6 +597,50 @@ impl Model {
                     n,
                     "a non-zero axis vector (axis_x, axis_y, axis_z)",
                 );
+            }
+        }
+        let mut slave_of = vec![false; self.num_nodes()];
+        for t in &self.ties {
+            slave_of[t.slave] = true;
+        }
+        let mut seen_slave = vec![false; self.num_nodes()];
+        for (row, t) in self.ties.iter().enumerate() {
+            let err = |what: String, exp: &str| {
+                Err(WeftError::input(what)
+                    .in_file("ties.parquet")
+                    .at_row(row)
+                    .expected(exp.to_string()))
+            };
+            let sid = self.node_id[t.slave];
+            if !(2..=4).contains(&t.masters.len()) {
+                return err(
+                    format!("tie of node `{sid}` has {} masters", t.masters.len()),
+                    "2 (an edge), 3 or 4 (a face) master nodes",
+                );
+            }
+            if seen_slave[t.slave] {
+                return err(
+                    format!("node `{sid}` is tied twice"),
+                    "each slave node in one tie",
+                );
+            }
+            seen_slave[t.slave] = true;
+            for (k, &mn) in t.masters.iter().enumerate() {
+                if mn == t.slave || t.masters[..k].contains(&mn) {
+                    return err(
+                        format!("tie of node `{sid}` repeats node `{}`", self.node_id[mn]),
+                        "distinct master nodes, none of them the slave",
+                    );
+                }
+                if slave_of[mn] {
+                    return err(
+                        format!(
+                            "master `{}` of the tie of node `{sid}` is itself tied",
+                            self.node_id[mn]
+                        ),
+                        "masters that are not slaves of other ties (no chains)",
+                    );
+                }
             }
         }
         for (row, s) in self.symmetry.iter().enumerate() {

@@ -375,6 +375,8 @@ pub struct Solver {
     w_prescribed: f64,
     /// Directions normal to the symmetry planes: projectiles cannot move along them.
     proj_fixed: [bool; 3],
+    /// Tied slave nodes: (slave, masters, weights).
+    pub ties: Vec<(usize, Vec<usize>, Vec<f64>)>,
     loads: Vec<Load>,
     loaded_nodes: Vec<usize>,
     fext_prev: Vec<[f64; 3]>,
@@ -406,6 +408,73 @@ fn add(a: &mut [f64; 3], b: &[f64; 3]) {
 
 fn dot(a: &[f64; 3], b: &[f64; 3]) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+/// Weights of a point on a master edge (2 nodes: projection), triangle (barycentric) or
+/// quad (inverse bilinear map), and the distance of the point from the master entity.
+pub fn tie_weights(p: &[f64; 3], m: &[[f64; 3]]) -> (Vec<f64>, f64) {
+    let sub = |a: &[f64; 3], b: &[f64; 3]| [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+    let lerp_err = |w: &[f64]| {
+        let q: [f64; 3] = std::array::from_fn(|d| (0..m.len()).map(|a| w[a] * m[a][d]).sum());
+        let e = sub(p, &q);
+        dot(&e, &e).sqrt()
+    };
+    match m.len() {
+        2 => {
+            let e = sub(&m[1], &m[0]);
+            let t = dot(&sub(p, &m[0]), &e) / dot(&e, &e);
+            let w = vec![1.0 - t, t];
+            let d = lerp_err(&w);
+            (w, d)
+        }
+        3 => {
+            let (e1, e2, r) = (sub(&m[1], &m[0]), sub(&m[2], &m[0]), sub(p, &m[0]));
+            let (a, b, c) = (dot(&e1, &e1), dot(&e1, &e2), dot(&e2, &e2));
+            let (d1, d2) = (dot(&r, &e1), dot(&r, &e2));
+            let det = a * c - b * b;
+            let (u, v) = ((c * d1 - b * d2) / det, (a * d2 - b * d1) / det);
+            let w = vec![1.0 - u - v, u, v];
+            let d = lerp_err(&w);
+            (w, d)
+        }
+        _ => {
+            // Newton on the bilinear map x(ξ, η) = Σ N_a x_a, least squares in 3-D.
+            let (mut xi, mut eta) = (0.0f64, 0.0f64);
+            let sh = |xi: f64, eta: f64| {
+                [
+                    0.25 * (1.0 - xi) * (1.0 - eta),
+                    0.25 * (1.0 + xi) * (1.0 - eta),
+                    0.25 * (1.0 + xi) * (1.0 + eta),
+                    0.25 * (1.0 - xi) * (1.0 + eta),
+                ]
+            };
+            for _ in 0..30 {
+                let n = sh(xi, eta);
+                let x: [f64; 3] = std::array::from_fn(|d| (0..4).map(|a| n[a] * m[a][d]).sum());
+                let dxi: [f64; 3] = std::array::from_fn(|d| {
+                    0.25 * (-(1.0 - eta) * m[0][d] + (1.0 - eta) * m[1][d] + (1.0 + eta) * m[2][d]
+                        - (1.0 + eta) * m[3][d])
+                });
+                let deta: [f64; 3] = std::array::from_fn(|d| {
+                    0.25 * (-(1.0 - xi) * m[0][d] - (1.0 + xi) * m[1][d]
+                        + (1.0 + xi) * m[2][d]
+                        + (1.0 - xi) * m[3][d])
+                });
+                let r = sub(p, &x);
+                let (a, b, c) = (dot(&dxi, &dxi), dot(&dxi, &deta), dot(&deta, &deta));
+                let (g1, g2) = (dot(&r, &dxi), dot(&r, &deta));
+                let det = a * c - b * b;
+                if det.abs() < f64::MIN_POSITIVE {
+                    break;
+                }
+                xi += (c * g1 - b * g2) / det;
+                eta += (a * g2 - b * g1) / det;
+            }
+            let w = sh(xi, eta).to_vec();
+            let d = lerp_err(&w);
+            (w, d)
+        }
+    }
 }
 
 /// Stable step of one node: Δt = (2/ω)(√(1+ξ²) − ξ), ω² = S/m, 2ξω = C/m + α.
@@ -536,6 +605,49 @@ impl Solver {
             fill[n as usize] += 1;
         }
 
+        // Ties: weights from the reference geometry; the slave's mass goes to its masters.
+        let mut ties = Vec::with_capacity(m.ties.len());
+        let mut is_slave = vec![false; nn];
+        for (row, t) in m.ties.iter().enumerate() {
+            let mx: Vec<[f64; 3]> = t.masters.iter().map(|&a| m.coords[a]).collect();
+            let (w, dist) = tie_weights(&m.coords[t.slave], &mx);
+            let size = (1..mx.len())
+                .map(|a| {
+                    let d = [
+                        mx[a][0] - mx[0][0],
+                        mx[a][1] - mx[0][1],
+                        mx[a][2] - mx[0][2],
+                    ];
+                    dot(&d, &d).sqrt()
+                })
+                .fold(0.0, f64::max);
+            let tol = 1e-6 * size;
+            if !(dist <= tol && w.iter().all(|&x| x >= -1e-9 && x <= 1.0 + 1e-9)) {
+                return Err(WeftError::input(format!(
+                    "tied node `{}` is not on its master {} (distance {dist:.3e} m, weights {w:?})",
+                    m.node_id[t.slave],
+                    if mx.len() == 2 { "edge" } else { "face" }
+                ))
+                .in_file("ties.parquet")
+                .at_row(row)
+                .expected(format!(
+                    "the slave on the edge or face of its masters, within {tol:.1e} m"
+                ))
+                .hint(
+                    "order the masters around the face, or tie the node to the entity it lies on",
+                ));
+            }
+            let w: Vec<f64> = w.iter().map(|x| x.clamp(0.0, 1.0)).collect();
+            let sum: f64 = w.iter().sum();
+            let w: Vec<f64> = w.iter().map(|x| x / sum).collect();
+            for (a, &mn) in t.masters.iter().enumerate() {
+                mass[mn] += w[a] * mass[t.slave];
+            }
+            mass[t.slave] = 0.0;
+            is_slave[t.slave] = true;
+            ties.push((t.slave, t.masters.clone(), w));
+        }
+
         // Nodes that can move must have mass.
         let mut loaded = vec![false; nn];
         for l in &m.loads {
@@ -543,7 +655,7 @@ impl Solver {
         }
         for i in 0..nn {
             let attached = slot_ptr[i + 1] > slot_ptr[i];
-            if mass[i] <= 0.0 && fixed[i] != 0b111 && (attached || loaded[i]) {
+            if mass[i] <= 0.0 && fixed[i] != 0b111 && (attached || loaded[i]) && !is_slave[i] {
                 return Err(WeftError::input(format!(
                     "node `{}` has no mass but can move and {}",
                     m.node_id[i],
@@ -627,6 +739,7 @@ impl Solver {
             e_contact_friction: 0.0,
             w_prescribed: 0.0,
             proj_fixed: std::array::from_fn(|d| m.symmetry.iter().any(|sp| sp.normal == d)),
+            ties,
             loads: m.loads.clone(),
             fext_prev: vec![[0.0; 3]; loaded_nodes.len()],
             loaded_nodes,
@@ -702,6 +815,21 @@ impl Solver {
         for i in 0..nn {
             s.k_contact[i] = contact::PENALTY_FACTOR * s.mass[i] / (dt * dt);
         }
+        s.update_slaves(false);
+        for (n, v) in &m.initial_velocities {
+            if let Some((_, ms, _)) = s.ties.iter().find(|t| t.0 == *n) {
+                let vs = s.v[*n];
+                if (0..3).any(|d| (vs[d] - v[d]).abs() > 1e-9 * (1.0 + v[d].abs())) {
+                    return Err(WeftError::input(format!(
+                        "tied node `{}` is given the initial velocity {v:?}, but its masters move with {vs:?}",
+                        m.node_id[*n]
+                    ))
+                    .in_file("initial_velocities.parquet")
+                    .expected(format!("no initial velocity on a slave, or the masters' ({} nodes)", ms.len()))
+                    .hint("give the initial velocity to the master nodes"));
+                }
+            }
+        }
         Ok(s)
     }
 
@@ -746,6 +874,13 @@ impl Solver {
         for (p, k) in self.quad.nodes.iter().zip(&self.quad.k_max) {
             for &n in p {
                 s[n as usize] += k;
+            }
+        }
+        // A slave's stiffness acts on its masters: |u_s|² ≤ Σ w_a |u_a|² (Jensen, w ≥ 0).
+        for (sl, ms, w) in &self.ties {
+            for (a, &mn) in ms.iter().enumerate() {
+                s[mn] += w[a] * s[*sl];
+                c[mn] += w[a] * c[*sl];
             }
         }
         (s, c)
@@ -931,11 +1066,51 @@ impl Solver {
     }
 
     /// Penalty contact of every projectile against every node with mass, at x^n.
-    fn contact_forces(&mut self) {
+    /// Forces beside the elements' and the loads': contact, then the tie transfer of the
+    /// slaves' forces to their masters (so that contact on a slave reaches its masters).
+    fn extra_forces(&mut self) {
         for &i in &self.con_nodes {
             self.fcon[i] = [0.0; 3];
         }
         self.con_nodes.clear();
+        if !self.projectiles.is_empty() {
+            self.contact_forces();
+        }
+        for (sl, ms, w) in &self.ties {
+            let mut f = self.fext[*sl];
+            add(&mut f, &self.fcon[*sl]);
+            for &slot in &self.slots[self.slot_ptr[*sl] as usize..self.slot_ptr[*sl + 1] as usize] {
+                add(&mut f, &self.fe[slot as usize]);
+            }
+            for (a, &mn) in ms.iter().enumerate() {
+                add(&mut self.fcon[mn], &[w[a] * f[0], w[a] * f[1], w[a] * f[2]]);
+                self.con_nodes.push(mn);
+            }
+        }
+    }
+
+    /// Slaves follow their masters: x_s = Σ w_a x_a, v_s = Σ w_a v_a (and v^n when `snap`).
+    fn update_slaves(&mut self, snap: bool) {
+        for (sl, ms, w) in &self.ties {
+            let mut x = [0.0; 3];
+            let mut v = [0.0; 3];
+            let mut vn = [0.0; 3];
+            for (a, &mn) in ms.iter().enumerate() {
+                for d in 0..3 {
+                    x[d] += w[a] * self.x[mn][d];
+                    v[d] += w[a] * self.v[mn][d];
+                    vn[d] += w[a] * self.vn[mn][d];
+                }
+            }
+            self.x[*sl] = x;
+            self.v[*sl] = v;
+            if snap {
+                self.vn[*sl] = vn;
+            }
+        }
+    }
+
+    fn contact_forces(&mut self) {
         let (x, v, mass, kc) = (&self.x, &self.v, &self.mass, &self.k_contact);
         let dt_prev = self.dt_prev;
         for p in self.projectiles.iter_mut() {
@@ -1026,7 +1201,7 @@ impl Solver {
         let (h_prev, h_next) = (0.5 * dt_prev, 0.5 * dt_next);
         let (fe, slots, ptr) = (&self.fe, &self.slots, &self.slot_ptr);
         let (fext, inv_m, mass, fixed) = (&self.fext, &self.inv_m, &self.mass, &self.fixed);
-        let fcon = (!self.projectiles.is_empty()).then_some(&self.fcon);
+        let fcon = (!self.projectiles.is_empty() || !self.ties.is_empty()).then_some(&self.fcon);
         let body = |(ci, ((((x, v), xn), vn), part)): (
             usize,
             (
@@ -1268,8 +1443,8 @@ impl Solver {
             self.apply_loads();
             let t1 = Instant::now();
             self.element_forces();
-            if !self.projectiles.is_empty() {
-                self.contact_forces();
+            if !self.projectiles.is_empty() || !self.ties.is_empty() {
+                self.extra_forces();
             }
             let t2 = Instant::now();
             times.loads += t1 - t0;
@@ -1282,6 +1457,9 @@ impl Solver {
                 self.update_nodes::<false>(dt_next)?
             };
             self.e_mass_damp += 0.5 * self.dt_prev * dp;
+            if !self.ties.is_empty() {
+                self.update_slaves(snap);
+            }
             let mut contact_e = 0.0;
             if snap {
                 // Projectile states at t_n: tip and contact force before their update.

@@ -1,0 +1,190 @@
+//! Tied interfaces between zones of different mesh density.
+//!
+//! Reference: a tied (constrained) interface transmits a wave without changing its speed
+//! (Graff §8.1 for the plate speed √(E/(ρ(1−ν²)))), and because the slave's mass and force
+//! are distributed to the masters with the same weights that interpolate its motion, the
+//! total momentum Σ m v is conserved exactly (Belytschko, Liu, Moran §10.3, constrained
+//! nodes; Hallquist, LS-DYNA Theory Manual, "Tied interfaces").
+//!
+//! ```text
+//!   fine: 300 × 6 quads (h/3)      |  coarse: 100 × 2 quads (h)
+//!   o-o-o-o-o-o-o-o-o-o-o-o-o-o-o-s-M-----M-----M-----M   s: 7 fine interface nodes tied
+//!   |         pulse ->              |                      to the 2 coarse edges (M)
+//!  x=0                          x=0.1                  x=0.2
+//! ```
+
+mod common;
+use common::*;
+use weft::generate::grid::rectangle;
+use weft::model::{ElementKind, Load, Model, PartProps, Tie, TimeLaw};
+use weft::solver::run_in_memory;
+
+const E: f64 = 70e9;
+const NU: f64 = 0.3;
+const RHO: f64 = 2700.0;
+const W: f64 = 2e-3;
+
+/// Two strips joined at x = 0.1; returns the model and (fine, coarse) node offsets.
+fn joined() -> (Model, usize, usize) {
+    let props = PartProps {
+        youngs_modulus_1: Some(E),
+        youngs_modulus_2: Some(E),
+        poisson_ratio_12: Some(NU),
+        shear_modulus_12: Some(E / (2.0 * (1.0 + NU))),
+        thickness: Some(1e-3),
+        density: Some(RHO),
+        ..Default::default()
+    };
+    let mut m = Model::default();
+    let p = m.add_part(1, "sheet", ElementKind::Quad, props);
+    let (fine, fe) = rectangle(300, 6, 0.1, W, ElementKind::Quad);
+    let (coarse, ce) = rectangle(100, 2, 0.1, W, ElementKind::Quad);
+    for (i, x) in fine.iter().enumerate() {
+        m.add_node(i as i64 + 1, *x);
+    }
+    let off = fine.len();
+    for (i, x) in coarse.iter().enumerate() {
+        m.add_node((off + i) as i64 + 1, [x[0] + 0.1, x[1], x[2]]);
+    }
+    let mut id = 1;
+    for e in fe {
+        m.add_element(id, p, &e);
+        id += 1;
+    }
+    for e in ce {
+        let ns: Vec<usize> = e.iter().map(|&n| n + off).collect();
+        m.add_element(id, p, &ns);
+        id += 1;
+    }
+    // Fine interface nodes (column 300, rows 0..=6) tied to the coarse edge (column 0) they lie on.
+    for j in 0..=6 {
+        let slave = j * 301 + 300;
+        let k = (j / 3).min(1);
+        m.ties.push(Tie {
+            slave,
+            masters: vec![off + k * 101, off + (k + 1) * 101],
+        });
+    }
+    for i in 0..m.num_nodes() {
+        m.constraints.push((i, [false, true, true]));
+    }
+    (m, 0, off)
+}
+
+#[test]
+fn a_pulse_keeps_its_speed_across_a_tied_interface_to_a_coarser_mesh() {
+    let (mut m, _, off) = joined();
+    let c = (E / (RHO * (1.0 - NU * NU))).sqrt();
+    let t_f = 0.02 / c;
+    for j in 0..=6 {
+        let w = if j == 0 || j == 6 { 0.5 } else { 1.0 };
+        m.loads.push(Load {
+            id: j as i64 + 1,
+            node: j * 301,
+            force: [20.0 * w, 0.0, 0.0],
+            law: TimeLaw::SinePulse {
+                start: 0.0,
+                duration: t_f,
+            },
+        });
+    }
+    m.analysis.end_time = 0.19 / c + t_f;
+    m.analysis.output_interval = m.analysis.end_time / 3000.0;
+    let (_s, out, _) = run_in_memory(&m).unwrap();
+    let col = |j: usize| out.nodes.iter().position(|&n| n == j).unwrap();
+    let arrival =
+        |j: usize, level: f64| crossing(&out.t, &out.velocity_series(col(j), 0), level).unwrap();
+    let peak = out
+        .velocity_series(col(3 * 301 + 75), 0)
+        .iter()
+        .cloned()
+        .fold(0.0, f64::max);
+    let (fa, fb) = (
+        arrival(3 * 301 + 75, 0.5 * peak),
+        arrival(3 * 301 + 225, 0.5 * peak),
+    );
+    let (ca, cb) = (
+        arrival(off + 101 + 25, 0.5 * peak),
+        arrival(off + 101 + 75, 0.5 * peak),
+    );
+    let (v_fine, v_coarse) = (0.05 / (fb - fa), 0.05 / (cb - ca));
+    let e = out.energy.last().unwrap();
+    let wmax = out
+        .energy
+        .iter()
+        .map(|e| e.external_work)
+        .fold(0.0, f64::max);
+    let worst = out
+        .energy
+        .iter()
+        .map(|e| e.balance_error.abs())
+        .fold(0.0, f64::max);
+    eprintln!(
+        "tied: fine {v_fine:.1} m/s, coarse {v_coarse:.1} m/s, closed form {c:.1} m/s; energy balance {:.2e}; final {e:?}",
+        worst / wmax
+    );
+    assert!(
+        rel(v_fine, c) < 0.01 && rel(v_coarse, c) < 0.01,
+        "{v_fine} / {v_coarse} vs {c}"
+    );
+    assert!(
+        worst < 0.01 * wmax,
+        "energy balance error {worst} J against work {wmax} J"
+    );
+    // The pulse went through: the coarse side carries most of the energy at the end.
+    assert!(e.kinetic + e.internal > 0.9 * wmax);
+}
+
+#[test]
+fn momentum_is_conserved_to_round_off_across_ties() {
+    let (mut m, _, _) = joined();
+    // A velocity patch in the fine zone, away from the interface, nothing else.
+    for j in 0..=6 {
+        for i in 0..60 {
+            m.initial_velocities.push((j * 301 + i, [1.0, 0.0, 0.0]));
+        }
+    }
+    let c = (E / (RHO * (1.0 - NU * NU))).sqrt();
+    m.analysis.end_time = 0.3 / c;
+    m.analysis.output_interval = m.analysis.end_time / 50.0;
+    let (s, out, _) = run_in_memory(&m).unwrap();
+    let p: Vec<f64> = (0..out.t.len())
+        .map(|k| {
+            out.nodes
+                .iter()
+                .enumerate()
+                .map(|(j, &i)| s.mass[i] * out.v[k][j][0])
+                .sum()
+        })
+        .collect();
+    let p0 = p[0];
+    let worst = p.iter().map(|x| (x - p0).abs()).fold(0.0, f64::max);
+    eprintln!("tied momentum: {p0:.15e}, max drift {worst:.3e}");
+    assert!(p0 > 0.0);
+    assert!(worst < 1e-12 * p0, "momentum drifted by {worst} (of {p0})");
+    // The wave crossed into the coarse zone.
+    let last = out.t.len() - 1;
+    let coarse_moving = out
+        .nodes
+        .iter()
+        .enumerate()
+        .filter(|&(j, &i)| s.x0[i][0] > 0.12 && out.v[last][j][0].abs() > 1e-3)
+        .count();
+    assert!(coarse_moving > 0, "no motion reached the coarse zone");
+}
+
+#[test]
+fn a_slave_off_its_master_edge_is_refused() {
+    let (mut m, _, off) = joined();
+    m.ties[0].masters = vec![off + 2 * 101, off + 2 * 101 + 1];
+    let err = weft::solver::Solver::new(&m)
+        .err()
+        .expect("must fail")
+        .to_string();
+    assert!(
+        err.contains("is not on its master edge")
+            && err.contains("ties.parquet")
+            && err.contains("row 0"),
+        "{err}"
+    );
+}
