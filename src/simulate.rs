@@ -27,6 +27,9 @@ pub struct Config {
     pub mass_damping: Option<f64>,
     pub history_sets: Option<Vec<String>>,
     pub max_energy_error: Option<f64>,
+    /// Linear static solve instead of the explicit dynamic run.
+    #[serde(rename = "static")]
+    pub static_solve: bool,
 }
 
 /// What a run reports back to the binary.
@@ -101,6 +104,9 @@ pub fn run(c: &Config, progress: &mut (dyn FnMut(f64) + Send)) -> Result<Report>
     }
     std::fs::create_dir_all(&c.out).map_err(|e| WeftError::io(&c.out, e))?;
     let mut solver = Solver::new(&m)?;
+    if c.static_solve {
+        return run_static(c, &m, &solver, &prov, t_setup);
+    }
     let setup = t_setup.elapsed();
     let mut sink = ParquetSink::create(&c.out, solver.node_id.clone(), &prov)?;
     let mut stats = pool.install(|| solver.run(&mut sink, progress))?;
@@ -123,6 +129,67 @@ pub fn run(c: &Config, progress: &mut (dyn FnMut(f64) + Send)) -> Result<Report>
     Ok(report)
 }
 
+/// The static branch: K u = F, one `history` sample at t = 0, a static summary.
+fn run_static(
+    c: &Config,
+    m: &Model,
+    solver: &Solver,
+    prov: &Provenance,
+    t_setup: Instant,
+) -> Result<Report> {
+    let r = solver.solve_static(m)?;
+    let mut sink = ParquetSink::create(&c.out, solver.node_id.clone(), prov)?;
+    let nodes = &solver.output_nodes;
+    let u: Vec<[f64; 3]> = nodes.iter().map(|&i| r.u[i]).collect();
+    let v = vec![[0.0; 3]; nodes.len()];
+    crate::solver::Sink::history(&mut sink, 0.0, nodes, &u, &v)?;
+    sink.finish_history_only()?;
+    let elements =
+        solver.truss.id.len() + solver.link.id.len() + solver.tri.id.len() + solver.quad.id.len();
+    write_table(
+        &c.out.join("summary.parquet"),
+        &batch(vec![
+            Col::Str("analysis", vec!["static".into()]),
+            Col::I64("dofs", vec![r.dofs as i64]),
+            Col::I64("held_dofs", vec![r.held as i64]),
+            Col::I64("nonzeros", vec![r.nonzeros as i64]),
+            Col::I64("nodes", vec![solver.x0.len() as i64]),
+            Col::I64("elements", vec![elements as i64]),
+            Col::F64("model_mass", vec![solver.physical_mass]),
+            Col::F64(
+                "wall_time_setup",
+                vec![t_setup.elapsed().as_secs_f64() - r.assemble_seconds - r.solve_seconds],
+            ),
+            Col::F64("wall_time_assemble", vec![r.assemble_seconds]),
+            Col::F64("wall_time_solve", vec![r.solve_seconds]),
+        ]),
+        prov,
+    )?;
+    let stats = crate::solver::RunStats {
+        steps: 0,
+        end_time: 0.0,
+        times: Default::default(),
+        threads: 1,
+        max_balance_error_relative: 0.0,
+        final_energies: Default::default(),
+        elements,
+        nodes: solver.x0.len(),
+    };
+    eprintln!(
+        "weft-simulate --static: {} equations ({} held without stiffness), {} non-zeros; assemble {:.3} s, solve {:.3} s",
+        r.dofs, r.held, r.nonzeros, r.assemble_seconds, r.solve_seconds
+    );
+    Ok(Report {
+        stats,
+        dt: 0.0,
+        dt_stable: 0.0,
+        controlling: String::new(),
+        added_mass: 0.0,
+        added_fraction: 0.0,
+        out: c.out.clone(),
+    })
+}
+
 /// `summary.parquet`: one row describing the run. Written last, so its presence means
 /// the run completed.
 pub fn write_summary(out: &Path, r: &Report, s: &Solver, prov: &Provenance) -> Result<()> {
@@ -135,6 +202,7 @@ pub fn write_summary(out: &Path, r: &Report, s: &Solver, prov: &Provenance) -> R
     write_table(
         &out.join("summary.parquet"),
         &batch(vec![
+            Col::Str("analysis", vec!["explicit".into()]),
             Col::I64("steps", vec![st.steps as i64]),
             Col::F64("end_time", vec![st.end_time]),
             Col::F64("dt", vec![r.dt]),

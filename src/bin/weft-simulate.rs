@@ -55,6 +55,10 @@ struct Cli {
     /// Stop when the energy balance error exceeds this fraction [model default 0.1].
     #[arg(long)]
     max_energy_error: Option<f64>,
+    /// Linear static solve (K u = F with the load amplitudes) instead of the explicit run:
+    /// history.parquet gets one sample at t = 0.
+    #[arg(long = "static")]
+    static_solve: bool,
     /// No progress bar.
     #[arg(long, short)]
     quiet: bool,
@@ -84,6 +88,7 @@ fn main_inner() -> anyhow::Result<()> {
         mass_damping: cli.mass_damping,
         history_sets: (!cli.history_sets.is_empty()).then_some(cli.history_sets.clone()),
         max_energy_error: cli.max_energy_error,
+        static_solve: cli.static_solve,
     };
     // Under `weft run`, report progress as `weft-progress <fraction>` lines on stderr.
     let protocol = std::env::var_os("WEFT_PROGRESS").is_some();
@@ -118,6 +123,10 @@ fn main_inner() -> anyhow::Result<()> {
             cli.out.display()
         )
     })?;
+    if cli.static_solve {
+        eprintln!("  wrote {}/{{history,summary}}.parquet", r.out.display());
+        return Ok(());
+    }
     let s = &r.stats;
     eprintln!(
         "weft-simulate: {} steps of dt = {:.4e} s (stable {:.4e} s, controlled by {}), {} nodes, {} elements, {} threads",

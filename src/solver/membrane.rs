@@ -242,6 +242,20 @@ pub fn forces<const N: usize>(
     thickness: f64,
     k_hg: f64,
 ) -> [[f64; 3]; N] {
+    forces_with(x, r, m, thickness, k_hg, NORMAL_RATIO)
+}
+
+/// [`forces`] with a chosen warping ratio r_n (statics uses 0: a linear solve of a flat
+/// membrane has no out-of-plane stiffness to speak of).
+#[inline(always)]
+pub fn forces_with<const N: usize>(
+    x: &[[f64; 3]; N],
+    r: &Reference<N>,
+    m: &Material,
+    thickness: f64,
+    k_hg: f64,
+    normal_ratio: f64,
+) -> [[f64; 3]; N] {
     let (f, e) = kinematics(x, r);
     let s = stress(m, &e);
     let w = r.area * thickness;
@@ -257,10 +271,10 @@ pub fn forces<const N: usize>(
     }
     if N == 4 && k_hg > 0.0 {
         let (q, n) = hourglass_q(x, r);
-        // Warping (normal) part of q with the stiffness k_hg·NORMAL_RATIO.
+        // Warping (normal) part of q with the stiffness k_hg·normal_ratio.
         let qn = dot(&q, &n);
         let kq: [f64; 3] =
-            std::array::from_fn(|c| k_hg * (q[c] - qn * n[c]) + k_hg * NORMAL_RATIO * qn * n[c]);
+            std::array::from_fn(|c| k_hg * (q[c] - qn * n[c]) + k_hg * normal_ratio * qn * n[c]);
         for a in 0..N {
             for c in 0..3 {
                 out[a][c] -= r.gamma[a] * kq[c];
@@ -273,7 +287,7 @@ pub fn forces<const N: usize>(
         let cn = cross(&d1, &d2);
         let cl = dot(&cn, &cn).sqrt();
         if cl > 0.0 {
-            let s = k_hg * (1.0 - NORMAL_RATIO) * qn / cl;
+            let s = k_hg * (1.0 - normal_ratio) * qn / cl;
             let w: [f64; 3] = std::array::from_fn(|c| s * (q[c] - qn * n[c]));
             let (a1, a2) = (cross(&d2, &w), cross(&w, &d1));
             for c in 0..3 {

@@ -33,6 +33,7 @@ pub mod contact;
 pub mod link;
 pub mod membrane;
 pub mod output;
+pub mod statics;
 pub mod truss;
 
 use std::time::{Duration, Instant};

@@ -124,6 +124,13 @@ impl ParquetSink {
         self.hist.write(&b)
     }
 
+    /// Move `history.parquet` into place without an energy table (static solves).
+    pub fn finish_history_only(mut self) -> Result<()> {
+        self.flush()?;
+        self.hist.finish()?;
+        Ok(())
+    }
+
     /// Write the energy table and move both tables into place.
     pub fn finish(mut self, out: &Path, prov: &Provenance) -> Result<()> {
         self.flush()?;

@@ -1,0 +1,290 @@
+//! Linear statics on the same model: K u = F at the reference configuration.
+//!
+//! Each element's stiffness is the central finite difference of its own internal-force
+//! kernel at the reference positions, K_e = −∂f/∂x (so statics and dynamics share one
+//! definition of every element; the kernels are smooth there, and the difference step
+//! 10⁻⁶ × the element size gives K_e to about 10⁻⁹ relative). Tension-only trusses and
+//! no-compression membranes are taken as linear (a linear solve cannot be unilateral);
+//! links contribute their springs, not their dashpots or sliders. Loads are the
+//! amplitudes F of `loads.parquet` (the time laws are ignored). Fixed directions and
+//! symmetry planes remove degrees of freedom; a tied slave's degrees of freedom are
+//! expressed through its masters (u_s = Σ w_a u_a), so K and F are condensed with the
+//! same weights the dynamics use. A degree of freedom without stiffness and without load
+//! (the out-of-plane direction of a flat membrane) is held and counted; one with a load
+//! is an error. The system is solved by sparse Cholesky (nalgebra-sparse), which also
+//! detects mechanisms (a matrix that is not positive definite).
+
+use std::time::Instant;
+
+use nalgebra::DVector;
+use nalgebra_sparse::factorization::CscCholesky;
+use nalgebra_sparse::{CooMatrix, CscMatrix};
+
+use super::{link, membrane, truss, Solver};
+use crate::error::{Result, WeftError};
+use crate::model::Model;
+
+/// What a static solve reports.
+#[derive(Debug, Clone)]
+pub struct StaticReport {
+    /// Displacement of every node [m].
+    pub u: Vec<[f64; 3]>,
+    /// Free degrees of freedom solved for.
+    pub dofs: usize,
+    /// Degrees of freedom without stiffness or load, held at zero.
+    pub held: usize,
+    /// Non-zeros in the factorised matrix.
+    pub nonzeros: usize,
+    pub assemble_seconds: f64,
+    pub solve_seconds: f64,
+}
+
+/// Central-difference stiffness of a force kernel over `N` nodes.
+fn fd_stiffness<const N: usize>(
+    x0: &[[f64; 3]; N],
+    h: f64,
+    f: impl Fn(&[[f64; 3]; N]) -> [[f64; 3]; N],
+) -> Vec<f64> {
+    let n = 3 * N;
+    let mut k = vec![0.0; n * n];
+    for j in 0..n {
+        let (mut xp, mut xm) = (*x0, *x0);
+        xp[j / 3][j % 3] += h;
+        xm[j / 3][j % 3] -= h;
+        let (fp, fm) = (f(&xp), f(&xm));
+        for i in 0..n {
+            k[i * n + j] = -(fp[i / 3][i % 3] - fm[i / 3][i % 3]) / (2.0 * h);
+        }
+    }
+    // Symmetrise: the exact tangent of a hyperelastic element is symmetric.
+    for i in 0..n {
+        for j in 0..i {
+            let a = 0.5 * (k[i * n + j] + k[j * n + i]);
+            k[i * n + j] = a;
+            k[j * n + i] = a;
+        }
+    }
+    k
+}
+
+impl Solver {
+    /// Solve the linear static problem of `m` (the model this solver was built from).
+    pub fn solve_static(&self, m: &Model) -> Result<StaticReport> {
+        let t0 = Instant::now();
+        let nn = self.x0.len();
+        // Degree-of-freedom maps: node direction → [(equation, weight)].
+        let mut eq = vec![[usize::MAX; 3]; nn];
+        let mut neq = 0;
+        let slave: std::collections::HashMap<usize, usize> = self
+            .ties
+            .iter()
+            .enumerate()
+            .map(|(k, t)| (t.0, k))
+            .collect();
+        for i in 0..nn {
+            if slave.contains_key(&i) {
+                continue;
+            }
+            for d in 0..3 {
+                if self.fixed[i] & (1 << d) == 0 {
+                    eq[i][d] = neq;
+                    neq += 1;
+                }
+            }
+        }
+        let map = |i: usize, d: usize| -> Vec<(usize, f64)> {
+            match slave.get(&i) {
+                Some(&k) => {
+                    let (_, ms, w) = &self.ties[k];
+                    ms.iter()
+                        .zip(w)
+                        .filter(|(&a, _)| eq[a][d] != usize::MAX)
+                        .map(|(&a, &wa)| (eq[a][d], wa))
+                        .collect()
+                }
+                None if eq[i][d] != usize::MAX => vec![(eq[i][d], 1.0)],
+                None => vec![],
+            }
+        };
+        let mut trip: Vec<(usize, usize, f64)> = Vec::new();
+        let mut add_element = |nodes: &[usize], ke: &[f64]| {
+            let n = 3 * nodes.len();
+            let maps: Vec<Vec<(usize, f64)>> = (0..n).map(|p| map(nodes[p / 3], p % 3)).collect();
+            for p in 0..n {
+                for q in 0..n {
+                    let v = ke[p * n + q];
+                    if v == 0.0 {
+                        continue;
+                    }
+                    for &(i, wi) in &maps[p] {
+                        for &(j, wj) in &maps[q] {
+                            trip.push((i, j, wi * wj * v));
+                        }
+                    }
+                }
+            }
+        };
+        let x0 = &self.x0;
+        let g = &self.truss;
+        for e in 0..g.id.len() {
+            let [a, b] = g.nodes[e].map(|v| v as usize);
+            let ke = fd_stiffness(&[x0[a], x0[b]], 1e-6 * g.l0[e], |x| {
+                let f2 = truss::force(&x[0], &x[1], g.k[e], g.l0[e], false);
+                [[-f2[0], -f2[1], -f2[2]], f2]
+            });
+            add_element(&[a, b], &ke);
+        }
+        let l = &self.link;
+        for e in 0..l.id.len() {
+            let [a, b] = l.nodes[e].map(|v| v as usize);
+            let ke = fd_stiffness(&[x0[a], x0[b]], 1e-6, |x| {
+                let f2 = link::elastic_force(
+                    &link::rel_disp(&x[0], &x[1], &l.d0[e]),
+                    &l.props[e],
+                    &[0.0; 2],
+                );
+                [[-f2[0], -f2[1], -f2[2]], f2]
+            });
+            add_element(&[a, b], &ke);
+        }
+        fn membranes<const N: usize>(
+            grp: &super::MembraneGroup<N>,
+            x0: &[[f64; 3]],
+            add: &mut dyn FnMut(&[usize], &[f64]),
+        ) {
+            for e in 0..grp.id.len() {
+                let nodes: [usize; N] = grp.nodes[e].map(|v| v as usize);
+                let xe: [[f64; 3]; N] = std::array::from_fn(|a| x0[nodes[a]]);
+                let mut mat = grp.material[e];
+                mat.no_compression = false;
+                let h = 1e-6 * grp.reference[e].area.sqrt();
+                let ke = fd_stiffness(&xe, h, |x| {
+                    membrane::forces_with(
+                        x,
+                        &grp.reference[e],
+                        &mat,
+                        grp.thickness[e],
+                        grp.k_hg[e],
+                        0.0,
+                    )
+                });
+                add(&nodes, &ke);
+            }
+        }
+        membranes(&self.tri, x0, &mut add_element);
+        membranes(&self.quad, x0, &mut add_element);
+        let mut f = vec![0.0; neq];
+        for ld in &m.loads {
+            for d in 0..3 {
+                for (i, w) in map(ld.node, d) {
+                    f[i] += w * ld.force[d];
+                }
+            }
+        }
+        // Hold degrees of freedom without stiffness (and refuse loaded ones).
+        let mut diag = vec![0.0f64; neq];
+        for &(i, j, v) in &trip {
+            if i == j {
+                diag[i] += v;
+            }
+        }
+        let dmax = diag.iter().cloned().fold(0.0, f64::max);
+        let mut keep = vec![usize::MAX; neq];
+        let mut n = 0;
+        let mut held = 0;
+        for i in 0..neq {
+            if diag[i] > 1e-12 * dmax {
+                keep[i] = n;
+                n += 1;
+            } else if f[i] != 0.0 {
+                let (node, d) = (0..nn)
+                    .flat_map(|a| (0..3).map(move |d| (a, d)))
+                    .find(|&(a, d)| eq[a][d] == i)
+                    .unwrap_or((0, 0));
+                return Err(WeftError::input(format!(
+                    "node `{}` is loaded along {} but nothing resists motion in that direction",
+                    self.node_id[node],
+                    ["x", "y", "z"][d]
+                ))
+                .in_file("loads.parquet")
+                .expected("a load only where elements give stiffness")
+                .hint("a flat membrane has no stiffness out of its plane in a linear static solve; fix that direction or load in-plane"));
+            } else {
+                held += 1;
+            }
+        }
+        let mut coo = CooMatrix::new(n, n);
+        for (i, j, v) in trip {
+            let (a, b) = (keep[i], keep[j]);
+            if a != usize::MAX && b != usize::MAX {
+                coo.push(a, b, v);
+            }
+        }
+        let rhs =
+            DVector::from_iterator(n, (0..neq).filter(|&i| keep[i] != usize::MAX).map(|i| f[i]));
+        let csc = CscMatrix::from(&coo);
+        let nonzeros = csc.nnz();
+        let t1 = Instant::now();
+        let chol = CscCholesky::factor(&csc).map_err(|e| {
+            WeftError::input(format!("the stiffness matrix is not positive definite ({e:?}): the model is a mechanism or is not held against rigid motion"))
+                .expected("enough constraints to remove every rigid-body motion, and no mechanism (e.g. a pin-jointed grid in shear)")
+                .hint("add constraints or symmetry planes; use rigid joints (beams) where the structure must carry shear")
+        })?;
+        // A singular matrix can slip through the factorisation with round-off pivots:
+        // a pivot L_ii² far below K_ii means a mechanism.
+        let l = chol.l();
+        let mut worst = (f64::INFINITY, 0usize);
+        for i in 0..n {
+            let kd = csc.get_entry(i, i).map(|e| e.into_value()).unwrap_or(0.0);
+            let lii = l.get_entry(i, i).map(|e| e.into_value()).unwrap_or(0.0);
+            let ratio = lii * lii / kd;
+            if ratio < worst.0 {
+                worst = (ratio, i);
+            }
+        }
+        if worst.0 < 1e-10 {
+            let eq_of = (0..neq).find(|&k| keep[k] == worst.1).unwrap_or(0);
+            let (node, d) = (0..nn)
+                .flat_map(|a| (0..3).map(move |d| (a, d)))
+                .find(|&(a, d)| eq[a][d] == eq_of)
+                .unwrap_or((0, 0));
+            return Err(WeftError::input(format!(
+                "the stiffness matrix is not positive definite (pivot ratio {:.1e} at node `{}`, direction {}): the model is a mechanism or is not held against rigid motion",
+                worst.0,
+                self.node_id[node],
+                ["x", "y", "z"][d]
+            ))
+            .expected("enough constraints to remove every rigid-body motion, and no mechanism (e.g. a pin-jointed grid in shear)")
+            .hint("add constraints or symmetry planes; use rigid joints (beams) where the structure must carry shear"));
+        }
+        let sol = chol.solve(&rhs);
+        let mut full = vec![0.0; neq];
+        for i in 0..neq {
+            if keep[i] != usize::MAX {
+                full[i] = sol[(keep[i], 0)];
+            }
+        }
+        let u: Vec<[f64; 3]> = (0..nn)
+            .map(|i| std::array::from_fn(|d| map(i, d).iter().map(|&(k, w)| w * full[k]).sum()))
+            .collect();
+        if u.iter().flatten().any(|v| !v.is_finite()) {
+            return Err(WeftError::Numerical {
+                what: "the static solution is not finite".into(),
+                step: 0,
+                time: 0.0,
+                hint: Some(
+                    "the stiffness matrix is nearly singular: check constraints and properties"
+                        .into(),
+                ),
+            });
+        }
+        Ok(StaticReport {
+            u,
+            dofs: n,
+            held,
+            nonzeros,
+            assemble_seconds: (t1 - t0).as_secs_f64(),
+            solve_seconds: t1.elapsed().as_secs_f64(),
+        })
+    }
+}
