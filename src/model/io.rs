@@ -33,6 +33,7 @@ pub const MODEL_TABLES: &[&str] = &[
     "elements_point_mass.parquet",
     "elements_tri.parquet",
     "elements_quad.parquet",
+    "elements_beam.parquet",
     "node_sets.parquet",
     "constraints.parquet",
     "loads.parquet",
@@ -124,6 +125,7 @@ fn read_model_inner(dir: &Path) -> Result<Model> {
         f("shear_modulus_12")?,
     );
     let (thick, hg, angle) = (f("thickness")?, f("hourglass")?, f("material_angle")?);
+    let (width, height, nu) = (f("width")?, f("height")?, f("poisson_ratio")?);
     let no_comp = t
         .bool_opt("no_compression")?
         .unwrap_or_else(|| vec![None; ids.len()]);
@@ -169,6 +171,9 @@ fn read_model_inner(dir: &Path) -> Result<Model> {
                 no_compression: no_comp[row],
                 hourglass: hg[row],
                 material_angle: angle[row],
+                width: width[row],
+                height: height[row],
+                poisson_ratio: nu[row],
             },
         };
         validate_part(&part).map_err(|err| err.in_file(&t.path).at_row(row))?;
@@ -603,6 +608,9 @@ fn write_tables(m: &Model, dir: &Path, prov: &Provenance) -> Result<()> {
             ),
             Col::OptF64("hourglass", pc(|q| q.hourglass)),
             Col::OptF64("material_angle", pc(|q| q.material_angle)),
+            Col::OptF64("width", pc(|q| q.width)),
+            Col::OptF64("height", pc(|q| q.height)),
+            Col::OptF64("poisson_ratio", pc(|q| q.poisson_ratio)),
         ]),
         prov,
     )?;
@@ -644,18 +652,34 @@ fn write_tables(m: &Model, dir: &Path, prov: &Provenance) -> Result<()> {
             prov,
         )?;
     }
-    if !m.constraints.is_empty() {
-        let c = &m.constraints;
-        write_table(
-            &dir.join("constraints.parquet"),
-            &batch(vec![
-                Col::I64("node_id", c.iter().map(|x| m.node_id[x.0]).collect()),
-                Col::Bool("fix_x", c.iter().map(|x| x.1[0]).collect()),
-                Col::Bool("fix_y", c.iter().map(|x| x.1[1]).collect()),
-                Col::Bool("fix_z", c.iter().map(|x| x.1[2]).collect()),
-            ]),
-            prov,
-        )?;
+    if !m.constraints.is_empty() || !m.rot_constraints.is_empty() {
+        // One row per node: translations and rotations merged.
+        let mut rows: BTreeMap<usize, [bool; 6]> = BTreeMap::new();
+        for (n, f) in &m.constraints {
+            let r = rows.entry(*n).or_default();
+            for d in 0..3 {
+                r[d] |= f[d];
+            }
+        }
+        for (n, f) in &m.rot_constraints {
+            let r = rows.entry(*n).or_default();
+            for d in 0..3 {
+                r[3 + d] |= f[d];
+            }
+        }
+        let col = |k: usize| rows.values().map(|r| r[k]).collect::<Vec<_>>();
+        let mut cols = vec![
+            Col::I64("node_id", rows.keys().map(|&n| m.node_id[n]).collect()),
+            Col::Bool("fix_x", col(0)),
+            Col::Bool("fix_y", col(1)),
+            Col::Bool("fix_z", col(2)),
+        ];
+        if !m.rot_constraints.is_empty() {
+            cols.push(Col::Bool("fix_rx", col(3)));
+            cols.push(Col::Bool("fix_ry", col(4)));
+            cols.push(Col::Bool("fix_rz", col(5)));
+        }
+        write_table(&dir.join("constraints.parquet"), &batch(cols), prov)?;
     }
     if !m.curves.is_empty() {
         let (mut n, mut t, mut v) = (vec![], vec![], vec![]);

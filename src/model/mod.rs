@@ -28,6 +28,8 @@ pub enum ElementKind {
     Tri,
     /// Four-node one-point membrane quadrilateral with hourglass control.
     Quad,
+    /// Two-node 3-D corotational beam with a rectangular section (rigid joints).
+    Beam,
 }
 
 impl ElementKind {
@@ -43,11 +45,12 @@ impl ElementKind {
             ElementKind::PointMass => "point_mass",
             ElementKind::Tri => "tri",
             ElementKind::Quad => "quad",
+            ElementKind::Beam => "beam",
         }
     }
     pub fn nodes_per_element(self) -> usize {
         match self {
-            ElementKind::Truss | ElementKind::Link => 2,
+            ElementKind::Truss | ElementKind::Link | ElementKind::Beam => 2,
             ElementKind::PointMass => 1,
             ElementKind::Tri => 3,
             ElementKind::Quad => 4,
@@ -97,6 +100,12 @@ pub struct PartProps {
     pub hourglass: Option<f64>,
     /// Angle of material direction 1 from the projected global x, about the normal [rad].
     pub material_angle: Option<f64>,
+    /// Beam section width b (in the plane of the girder) [m].
+    pub width: Option<f64>,
+    /// Beam section height h (out of the plane) [m].
+    pub height: Option<f64>,
+    /// Beam Poisson's ratio for G = E/(2(1+ν)) (null = 0.3).
+    pub poisson_ratio: Option<f64>,
 }
 
 impl PartProps {
@@ -339,6 +348,8 @@ pub struct Model {
     pub node_sets: BTreeMap<String, Vec<usize>>,
     /// Fixed degrees of freedom per constrained node: (node index, [x, y, z] fixed).
     pub constraints: Vec<(usize, [bool; 3])>,
+    /// Fixed rotations about x, y, z (nodes with beams): (node index, [rx, ry, rz]).
+    pub rot_constraints: Vec<(usize, [bool; 3])>,
     pub loads: Vec<Load>,
     /// Tabulated curves by name.
     pub curves: BTreeMap<String, Arc<Curve>>,
@@ -721,6 +732,21 @@ pub fn validate_part(p: &Part) -> Result<()> {
             }
         }
         ElementKind::PointMass => require_pos(p, "mass", q.mass, "in kg")?,
+        ElementKind::Beam => {
+            require_pos(p, "youngs_modulus", q.youngs_modulus, "in Pa")?;
+            require_pos(p, "density", q.density, "in kg/m³")?;
+            require_pos(p, "width", q.width, "in m")?;
+            require_pos(p, "height", q.height, "in m")?;
+            let nu = q.poisson_ratio.unwrap_or(0.3);
+            if !(nu > -1.0 && nu < 0.5) {
+                return Err(WeftError::input(format!(
+                    "part `{}` has poisson_ratio = `{nu}`",
+                    p.name
+                ))
+                .in_column("poisson_ratio")
+                .expected("−1 < ν < 0.5"));
+            }
+        }
         ElementKind::Tri | ElementKind::Quad => {
             require_pos(p, "youngs_modulus_1", q.youngs_modulus_1, "in Pa")?;
             require_pos(p, "youngs_modulus_2", q.youngs_modulus_2, "in Pa")?;

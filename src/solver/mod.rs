@@ -29,6 +29,7 @@
 //! and Δt_i = (2/ω_i)(√(1+ξ_i²) − ξ_i) (Belytschko et al. eq. 6.2.23). The step is
 //! safety × min_i Δt_i; the report names the node and its stiffest element.
 
+pub mod beam;
 pub mod contact;
 pub mod link;
 pub mod membrane;
@@ -210,6 +211,37 @@ impl<const N: usize> MembraneGroup<N> {
     }
 }
 
+/// Beams, struct-of-arrays; their nodes carry rotations.
+#[derive(Debug, Clone, Default)]
+pub struct BeamGroup {
+    pub id: Vec<i64>,
+    pub nodes: Vec<[u32; 2]>,
+    /// Rotation indices of the two nodes.
+    pub rot: Vec<[u32; 2]>,
+    pub props: Vec<beam::BeamProps>,
+    pub slot0: usize,
+}
+
+/// Rotational state of the nodes that carry beams.
+#[derive(Debug, Clone, Default)]
+pub struct Rotations {
+    /// Node index of each rotational node.
+    pub node: Vec<usize>,
+    /// Orientation R (global).
+    pub r: Vec<beam::Mat3>,
+    /// Half-step angular velocity ω^{n−½} (global) [rad/s].
+    pub omega: Vec<[f64; 3]>,
+    /// Lumped rotational inertia J [kg·m²].
+    pub j: Vec<f64>,
+    /// Bit d set when the rotation about axis d is fixed.
+    pub fixed: Vec<u8>,
+    /// Moment slots per rotational node (CSR).
+    ptr: Vec<u32>,
+    slots: Vec<u32>,
+    /// Per-beam end moments, two slots per beam.
+    me: Vec<[f64; 3]>,
+}
+
 /// The stable time step and what controls it.
 #[derive(Debug, Clone)]
 pub struct StableStep {
@@ -363,6 +395,10 @@ pub struct Solver {
     pub link: LinkGroup,
     pub tri: MembraneGroup<3>,
     pub quad: MembraneGroup<4>,
+    pub beam: BeamGroup,
+    pub rot: Rotations,
+    /// Rotational node of each node (u32::MAX: none).
+    pub rot_of: Vec<u32>,
     /// Rigid projectiles.
     pub projectiles: Vec<contact::Projectile>,
     /// Contact forces on nodes, and the nodes that carry one.
@@ -559,11 +595,108 @@ impl Solver {
         }
         let mut tri = MembraneGroup::<3>::build(m, ElementKind::Tri, &mut mass)?;
         let mut quad = MembraneGroup::<4>::build(m, ElementKind::Quad, &mut mass)?;
+        let mut beams = BeamGroup::default();
+        let mut rot = Rotations::default();
+        let mut rot_of = vec![u32::MAX; nn];
+        if let Some(b) = m.block(ElementKind::Beam) {
+            for e in 0..b.len() {
+                let p = &m.parts[b.part[e]].props;
+                let (a, c) = (b.nodes[2 * e], b.nodes[2 * e + 1]);
+                let e0 = beam::reference_frame(&m.coords[a], &m.coords[c]).ok_or_else(|| {
+                    WeftError::input(format!("beam `{}` has zero length", b.id[e]))
+                        .in_file("elements_beam.parquet")
+                        .at_row(e)
+                        .expected("two nodes at distinct positions")
+                })?;
+                let d = [
+                    m.coords[c][0] - m.coords[a][0],
+                    m.coords[c][1] - m.coords[a][1],
+                    m.coords[c][2] - m.coords[a][2],
+                ];
+                let l0 = dot(&d, &d).sqrt();
+                let (em, rho, bw, hh) = (
+                    p.youngs_modulus.unwrap(),
+                    p.density.unwrap(),
+                    p.width.unwrap(),
+                    p.height.unwrap(),
+                );
+                let g = em / (2.0 * (1.0 + p.poisson_ratio.unwrap_or(0.3)));
+                let area = bw * hh;
+                let me = rho * area * l0;
+                // Lumped rotary inertia: each half of the beam as a rigid bar about its end
+                // node's centre of mass, isotropic (J = ½ m (L² + b² + h²)/12).
+                let jn = 0.5 * me * (l0 * l0 + bw * bw + hh * hh) / 12.0;
+                let mut rids = [0u32; 2];
+                for (k, &n) in [a, c].iter().enumerate() {
+                    mass[n] += 0.5 * me;
+                    if rot_of[n] == u32::MAX {
+                        rot_of[n] = rot.node.len() as u32;
+                        rot.node.push(n);
+                        rot.r
+                            .push([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]);
+                        rot.omega.push([0.0; 3]);
+                        rot.j.push(0.0);
+                        rot.fixed.push(0);
+                    }
+                    rids[k] = rot_of[n];
+                    rot.j[rot_of[n] as usize] += jn;
+                }
+                beams.id.push(b.id[e]);
+                beams.nodes.push([a as u32, c as u32]);
+                beams.rot.push(rids);
+                beams.props.push(beam::BeamProps {
+                    l0,
+                    ea: em * area,
+                    gj: g * beam::torsion_constant(bw, hh),
+                    eiy: em * bw * hh.powi(3) / 12.0,
+                    eiz: em * hh * bw.powi(3) / 12.0,
+                    e0,
+                });
+            }
+        }
+        for (n, f) in &m.rot_constraints {
+            if rot_of[*n] != u32::MAX {
+                for d in 0..3 {
+                    if f[d] {
+                        rot.fixed[rot_of[*n] as usize] |= 1 << d;
+                    }
+                }
+            }
+        }
+        // On a symmetry plane with normal d the rotations about the other two axes vanish.
+        for sp in &m.symmetry {
+            for (k, &n) in rot.node.iter().enumerate() {
+                if (m.coords[n][sp.normal] - sp.position).abs() <= sp.tolerance {
+                    for d in 0..3 {
+                        if d != sp.normal {
+                            rot.fixed[k] |= 1 << d;
+                        }
+                    }
+                }
+            }
+        }
+        // Moment slots: two per beam, gathered per rotational node in slot order.
+        let nr = rot.node.len();
+        let mut cnt = vec![0u32; nr + 1];
+        for r in beams.rot.iter().flatten() {
+            cnt[*r as usize + 1] += 1;
+        }
+        for i in 0..nr {
+            cnt[i + 1] += cnt[i];
+        }
+        rot.ptr = cnt.clone();
+        rot.slots = vec![0; 2 * beams.id.len()];
+        for (sl, r) in beams.rot.iter().flatten().enumerate() {
+            rot.slots[cnt[*r as usize] as usize] = sl as u32;
+            cnt[*r as usize] += 1;
+        }
+        rot.me = vec![[0.0; 3]; 2 * beams.id.len()];
         truss.slot0 = 0;
         linkg.slot0 = 2 * truss.id.len();
         tri.slot0 = linkg.slot0 + 2 * linkg.id.len();
         quad.slot0 = tri.slot0 + 3 * tri.id.len();
-        let nslots = quad.slot0 + 4 * quad.id.len();
+        beams.slot0 = quad.slot0 + 4 * quad.id.len();
+        let nslots = beams.slot0 + 2 * beams.id.len();
 
         let mut fixed = vec![0u8; nn];
         for (n, f) in &m.constraints {
@@ -591,6 +724,7 @@ impl Solver {
             .flat_map(|p| [p[0], p[1]])
             .chain(tri.nodes.iter().flatten().copied())
             .chain(quad.nodes.iter().flatten().copied())
+            .chain(beams.nodes.iter().flatten().copied())
             .collect();
         for &n in &slot_nodes {
             count[n as usize + 1] += 1;
@@ -733,6 +867,9 @@ impl Solver {
             ],
             tri,
             quad,
+            beam: beams,
+            rot,
+            rot_of,
             projectiles: m.projectiles.iter().map(contact::Projectile::new).collect(),
             fcon: vec![[0.0; 3]; nn],
             con_nodes: Vec::with_capacity(nn),
@@ -877,6 +1014,29 @@ impl Solver {
                 s[n as usize] += k;
             }
         }
+        // Beams: row sums of M^{-1/2} K M^{-1/2}. A translational row carries the axial and
+        // bending-shear terms and the coupling 12EI/L² to the rotations (scaled by
+        // √(m/J) so that it adds to S/m); a rotational row carries 12EI/(L²√(mJ)) +
+        // (4 + 2)EI/(L J) + 2GJ/(L J). A node's bound is the larger of the two rows.
+        let mut rrow = vec![0.0; self.x.len()];
+        for (e, p) in self.beam.props.iter().enumerate() {
+            let [a, b] = self.beam.nodes[e];
+            let ei = p.eiy.max(p.eiz);
+            let l = p.l0;
+            for (n, o, rk) in [(a, b, self.beam.rot[e][0]), (b, a, self.beam.rot[e][1])] {
+                let (n, o) = (n as usize, o as usize);
+                let (mn, jn) = (self.mass[n].max(f64::MIN_POSITIVE), self.rot.j[rk as usize]);
+                let wo = if self.fixed[o] == 0b111 { 1.0 } else { 2.0 };
+                s[n] +=
+                    wo * p.ea / l + 24.0 * ei / l.powi(3) + 12.0 * ei / (l * l) * (mn / jn).sqrt();
+                rrow[n] += 12.0 * ei / (l * l * (mn * jn).sqrt())
+                    + 6.0 * ei / (l * jn)
+                    + 2.0 * p.gj / (l * jn);
+            }
+        }
+        for n in 0..self.x.len() {
+            s[n] = s[n].max(rrow[n] * self.mass[n]);
+        }
         // A slave's stiffness acts on its masters: |u_s|² ≤ Σ w_a |u_a|² (Jensen, w ≥ 0).
         for (sl, ms, w) in &self.ties {
             for (a, &mn) in ms.iter().enumerate() {
@@ -928,9 +1088,16 @@ impl Solver {
         } else if slot < self.quad.slot0 {
             let e = (slot - self.tri.slot0) / 3;
             (ElementKind::Tri, self.tri.id[e], self.tri.k_max[e])
-        } else {
+        } else if slot < self.beam.slot0 {
             let e = (slot - self.quad.slot0) / 4;
             (ElementKind::Quad, self.quad.id[e], self.quad.k_max[e])
+        } else {
+            let e = (slot - self.beam.slot0) / 2;
+            (
+                ElementKind::Beam,
+                self.beam.id[e],
+                self.beam.props[e].ea / self.beam.props[e].l0,
+            )
         }
     }
 
@@ -1004,7 +1171,48 @@ impl Solver {
     fn element_forces(&mut self) {
         let x = &self.x;
         let v = &self.v;
-        let (fe_rest, fe_quad) = self.fe.split_at_mut(self.quad.slot0);
+        let (fe_all, fe_beam) = self.fe.split_at_mut(self.beam.slot0);
+        {
+            let bg = &self.beam;
+            let rr = &self.rot.r;
+            let body = |(ci, (out, mo)): (usize, (&mut [[f64; 3]], &mut [[f64; 3]]))| {
+                let e0 = ci * CHUNK;
+                for (j, (f, m)) in out
+                    .chunks_exact_mut(2)
+                    .zip(mo.chunks_exact_mut(2))
+                    .enumerate()
+                {
+                    let e = e0 + j;
+                    let [a, b] = bg.nodes[e];
+                    let [ra, rb] = bg.rot[e];
+                    let r = beam::forces(
+                        &x[a as usize],
+                        &x[b as usize],
+                        &rr[ra as usize],
+                        &rr[rb as usize],
+                        &bg.props[e],
+                    );
+                    f[0] = r[0];
+                    f[1] = r[1];
+                    m[0] = r[2];
+                    m[1] = r[3];
+                }
+            };
+            if bg.id.len() <= CHUNK {
+                fe_beam
+                    .chunks_mut(2 * CHUNK)
+                    .zip(self.rot.me.chunks_mut(2 * CHUNK))
+                    .enumerate()
+                    .for_each(body);
+            } else {
+                fe_beam
+                    .par_chunks_mut(2 * CHUNK)
+                    .zip(self.rot.me.par_chunks_mut(2 * CHUNK))
+                    .enumerate()
+                    .for_each(body);
+            }
+        }
+        let (fe_rest, fe_quad) = fe_all.split_at_mut(self.quad.slot0);
         let (fe_rest, fe_tri) = fe_rest.split_at_mut(self.tri.slot0);
         self.tri.forces(x, fe_tri);
         self.quad.forces(x, fe_quad);
@@ -1175,6 +1383,71 @@ impl Solver {
             }
         }
         (ke, Some(vs))
+    }
+
+    /// Advance the rotations of the beam nodes; returns (rotational kinetic energy at t_n,
+    /// mass-damping power α Σ J |ω^n|²). Same scheme as the translations.
+    fn update_rotations(&mut self, dt_next: f64) -> Result<(f64, f64)> {
+        let (alpha, dt_prev) = (self.alpha, self.dt_prev);
+        let c1 = 1.0 / (1.0 + 0.5 * alpha * dt_prev);
+        let c2 = 1.0 - 0.5 * alpha * dt_next;
+        let (mut ke, mut dp) = (0.0, 0.0);
+        let rot = &mut self.rot;
+        for k in 0..rot.node.len() {
+            let mut mom = [0.0; 3];
+            for &sl in &rot.slots[rot.ptr[k] as usize..rot.ptr[k + 1] as usize] {
+                add(&mut mom, &rot.me[sl as usize]);
+            }
+            let ij = 1.0 / rot.j[k];
+            let a: [f64; 3] = std::array::from_fn(|d| {
+                if rot.fixed[k] & (1 << d) != 0 {
+                    0.0
+                } else {
+                    mom[d] * ij
+                }
+            });
+            let w = rot.omega[k];
+            let wn: [f64; 3] = std::array::from_fn(|d| (w[d] + 0.5 * dt_prev * a[d]) * c1);
+            let wnew: [f64; 3] = std::array::from_fn(|d| wn[d] * c2 + 0.5 * dt_next * a[d]);
+            let w2 = dot(&wn, &wn);
+            ke += 0.5 * rot.j[k] * w2;
+            dp += alpha * rot.j[k] * w2;
+            if !(wnew[0] + wnew[1] + wnew[2]).is_finite() {
+                return Err(WeftError::Numerical {
+                    what: format!(
+                        "the rotation of node `{}` became NaN or infinite",
+                        self.node_id[rot.node[k]]
+                    ),
+                    step: self.step,
+                    time: self.t,
+                    hint: Some("check the beam properties near this node".into()),
+                });
+            }
+            rot.omega[k] = wnew;
+            rot.r[k] = beam::rotate(
+                &rot.r[k],
+                &[dt_next * wnew[0], dt_next * wnew[1], dt_next * wnew[2]],
+            );
+        }
+        Ok((ke, dp))
+    }
+
+    /// Strain energy of the beams at the current positions and rotations.
+    fn beam_energy(&self) -> f64 {
+        let (bg, rr, x) = (&self.beam, &self.rot.r, &self.x);
+        (0..bg.id.len())
+            .map(|e| {
+                let [a, b] = bg.nodes[e];
+                let [ra, rb] = bg.rot[e];
+                beam::energy(
+                    &x[a as usize],
+                    &x[b as usize],
+                    &rr[ra as usize],
+                    &rr[rb as usize],
+                    &bg.props[e],
+                )
+            })
+            .sum()
     }
 
     /// Stored penalty energy ½ Σ k g² at the current positions.
@@ -1457,6 +1730,19 @@ impl Solver {
             } else {
                 self.update_nodes::<false>(dt_next)?
             };
+            // Beam strain energy at t_n needs the rotations at t_n: before they advance.
+            let mut beam_e = 0.0;
+            if snap && !self.beam.id.is_empty() {
+                std::mem::swap(&mut self.x, &mut self.xn);
+                beam_e = self.beam_energy();
+                std::mem::swap(&mut self.x, &mut self.xn);
+            }
+            let (ke_rot, dp_rot) = if self.rot.node.is_empty() {
+                (0.0, 0.0)
+            } else {
+                self.update_rotations(dt_next)?
+            };
+            let (ke, dp) = (ke + ke_rot, dp + dp_rot);
             self.e_mass_damp += 0.5 * self.dt_prev * dp;
             if !self.ties.is_empty() {
                 self.update_slaves(snap);
@@ -1494,6 +1780,7 @@ impl Solver {
                 // Energies at t_n (positions x^n are in xn; internal energy from them).
                 std::mem::swap(&mut self.x, &mut self.xn);
                 let (ie, damp, fric, hg) = self.internal_energy();
+                let ie = ie + beam_e;
                 std::mem::swap(&mut self.x, &mut self.xn);
                 let contact = contact_e + self.e_contact_friction;
                 let w_ext = self.w_ext + self.w_prescribed;

@@ -20,7 +20,7 @@ use nalgebra::DVector;
 use nalgebra_sparse::factorization::CscCholesky;
 use nalgebra_sparse::{CooMatrix, CscMatrix};
 
-use super::{link, membrane, truss, Solver};
+use super::{beam, link, membrane, truss, Solver};
 use crate::error::{Result, WeftError};
 use crate::model::Model;
 
@@ -92,6 +92,23 @@ impl Solver {
                 }
             }
         }
+        // Rotations of beam nodes, after the translations.
+        let mut eqr = vec![[usize::MAX; 3]; self.rot.node.len()];
+        for (k, e) in eqr.iter_mut().enumerate() {
+            for d in 0..3 {
+                if self.rot.fixed[k] & (1 << d) == 0 {
+                    e[d] = neq;
+                    neq += 1;
+                }
+            }
+        }
+        let rmap = |k: usize, d: usize| -> Vec<(usize, f64)> {
+            if eqr[k][d] == usize::MAX {
+                vec![]
+            } else {
+                vec![(eqr[k][d], 1.0)]
+            }
+        };
         let map = |i: usize, d: usize| -> Vec<(usize, f64)> {
             match slave.get(&i) {
                 Some(&k) => {
@@ -107,9 +124,8 @@ impl Solver {
             }
         };
         let mut trip: Vec<(usize, usize, f64)> = Vec::new();
-        let mut add_element = |nodes: &[usize], ke: &[f64]| {
-            let n = 3 * nodes.len();
-            let maps: Vec<Vec<(usize, f64)>> = (0..n).map(|p| map(nodes[p / 3], p % 3)).collect();
+        let mut add_maps = |maps: &[Vec<(usize, f64)>], ke: &[f64]| {
+            let n = maps.len();
             for p in 0..n {
                 for q in 0..n {
                     let v = ke[p * n + q];
@@ -124,6 +140,12 @@ impl Solver {
                 }
             }
         };
+        let tmaps = |nodes: &[usize]| -> Vec<Vec<(usize, f64)>> {
+            (0..3 * nodes.len())
+                .map(|p| map(nodes[p / 3], p % 3))
+                .collect()
+        };
+        let mut add_element = |nodes: &[usize], ke: &[f64]| add_maps(&tmaps(nodes), ke);
         let x0 = &self.x0;
         let g = &self.truss;
         for e in 0..g.id.len() {
@@ -173,6 +195,28 @@ impl Solver {
         }
         membranes(&self.tri, x0, &mut add_element);
         membranes(&self.quad, x0, &mut add_element);
+        let bg = &self.beam;
+        for e in 0..bg.id.len() {
+            let [a, b] = bg.nodes[e].map(|v| v as usize);
+            let [ra, rb] = bg.rot[e].map(|v| v as usize);
+            let eye = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+            // Unknowns [x₁, x₂, φ₁, φ₂]; φ a rotation increment of the node.
+            let ke = fd_stiffness(
+                &[x0[a], x0[b], [0.0; 3], [0.0; 3]],
+                1e-6 * bg.props[e].l0,
+                |u| {
+                    let (r1, r2) = (beam::rotate(&eye, &u[2]), beam::rotate(&eye, &u[3]));
+                    beam::forces(&u[0], &u[1], &r1, &r2, &bg.props[e])
+                },
+            );
+            let mut maps = tmaps(&[a, b]);
+            for k in [ra, rb] {
+                for d in 0..3 {
+                    maps.push(rmap(k, d));
+                }
+            }
+            add_maps(&maps, &ke);
+        }
         let mut f = vec![0.0; neq];
         for ld in &m.loads {
             for d in 0..3 {
