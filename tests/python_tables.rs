@@ -4,6 +4,7 @@
 //! Runs `tests/read_tables.py`. Where pandas or polars are not installed the test says
 //! so and passes, unless `WEFT_REQUIRE_PYTHON=1` (set by `.ci/run`, which installs them).
 
+mod common;
 use std::process::Command;
 
 #[test]
@@ -50,4 +51,60 @@ fn tables_open_in_pandas_and_polars() {
     let se = String::from_utf8_lossy(&o.stderr);
     assert!(o.status.success(), "read_tables.py failed:\n{so}\n{se}");
     eprintln!("{so}");
+}
+
+#[test]
+fn a_model_with_every_feature_opens_in_pandas_and_polars() {
+    let probe = Command::new("python3")
+        .args(["-c", "import pandas, polars, pyarrow"])
+        .output();
+    if !probe.map(|o| o.status.success()).unwrap_or(false) {
+        assert!(
+            std::env::var("WEFT_REQUIRE_PYTHON").as_deref() != Ok("1"),
+            "python3 with pandas, polars and pyarrow is required"
+        );
+        eprintln!("SKIP: python3 with pandas, polars and pyarrow not found");
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let model = dir.path().join("composite");
+    let out = dir.path().join("out");
+    let prov = weft::table::Provenance::new("test composite", serde_json::json!({}));
+    weft::model::io::write_model(&common::composite(), &model, &prov).unwrap();
+    let st = Command::new(env!("CARGO_BIN_EXE_weft-simulate"))
+        .arg("--model")
+        .arg(&model)
+        .arg("--out")
+        .arg(&out)
+        .arg("--quiet")
+        .status()
+        .unwrap();
+    assert!(st.success());
+    for t in [
+        "elements_quad.parquet",
+        "elements_tri.parquet",
+        "elements_beam.parquet",
+        "ties.parquet",
+        "symmetry.parquet",
+        "projectile.parquet",
+    ] {
+        assert!(model.join(t).exists(), "{t}");
+    }
+    assert!(out.join("projectile.parquet").exists());
+    let o = Command::new("python3")
+        .arg(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/read_tables.py"))
+        .arg(env!("CARGO_BIN_EXE_weft-simulate"))
+        .arg(&model)
+        .arg(&out)
+        .arg(dir.path())
+        .arg("open-only")
+        .output()
+        .unwrap();
+    assert!(
+        o.status.success(),
+        "read_tables.py failed:\n{}\n{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    );
+    eprintln!("{}", String::from_utf8_lossy(&o.stdout));
 }

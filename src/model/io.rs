@@ -277,6 +277,16 @@ fn read_model_inner(dir: &Path) -> Result<Model> {
         m.constraints = (0..idx.len())
             .map(|i| (idx[i], [fx[i], fy[i], fz[i]]))
             .collect();
+        let r = |c: &str| -> Result<Vec<bool>> {
+            Ok(t.bool_opt(c)?
+                .map(|v| v.into_iter().map(|b| b.unwrap_or(false)).collect())
+                .unwrap_or_else(|| vec![false; idx.len()]))
+        };
+        let (rx, ry, rz) = (r("fix_rx")?, r("fix_ry")?, r("fix_rz")?);
+        m.rot_constraints = (0..idx.len())
+            .filter(|&i| rx[i] || ry[i] || rz[i])
+            .map(|i| (idx[i], [rx[i], ry[i], rz[i]]))
+            .collect();
     }
     if let Some(t) = opt_table(dir, "curves.parquet")? {
         let names = t.str("curve", CURVES)?;

@@ -33,10 +33,13 @@ pub enum ElementKind {
 }
 
 impl ElementKind {
-    pub const ALL: [ElementKind; 3] = [
+    pub const ALL: [ElementKind; 6] = [
         ElementKind::Truss,
         ElementKind::Link,
         ElementKind::PointMass,
+        ElementKind::Tri,
+        ElementKind::Quad,
+        ElementKind::Beam,
     ];
     pub fn name(self) -> &'static str {
         match self {
@@ -115,7 +118,7 @@ impl PartProps {
     }
 }
 
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct Part {
     pub id: i64,
     pub name: String,
@@ -125,7 +128,7 @@ pub struct Part {
 
 /// Elements of one kind, struct-of-arrays; `nodes` holds `nodes_per_element` node
 /// indices per element.
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone, Default, PartialEq)]
 pub struct ElementBlock {
     pub id: Vec<i64>,
     /// Index into [`Model::parts`].
@@ -212,7 +215,7 @@ impl TimeLaw {
 }
 
 /// A nodal force F·g(t).
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct Load {
     pub id: i64,
     pub node: usize,
@@ -336,7 +339,7 @@ impl Default for Analysis {
     }
 }
 
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone, Default, PartialEq)]
 pub struct Model {
     pub node_id: Vec<i64>,
     /// Initial coordinates [m].

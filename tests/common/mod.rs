@@ -67,3 +67,214 @@ pub fn crossings(t: &[f64], y: &[f64], level: f64) -> Vec<f64> {
         .map(|i| t[i - 1] + (level - y[i - 1]) / (y[i] - y[i - 1]) * (t[i] - t[i - 1]))
         .collect()
 }
+
+/// A small model with every feature the tables carry: trusses, links (slider and
+/// dashpots), point masses, quads and triangles tied together, beams with rotation
+/// constraints, a symmetry plane, a projectile, a tabulated and a pulse load.
+pub fn composite() -> weft::model::Model {
+    use weft::model::*;
+    let mut m = Model::default();
+    let mut id = 0i64;
+    let mut node = |m: &mut Model, x: [f64; 3]| {
+        id += 1;
+        m.add_node(id, x)
+    };
+    // Quad patch 4 × 4 on [0, 0.02]², triangle patch 2 × 2 on [0.02, 0.04] × [0, 0.02].
+    let mut q = vec![];
+    for j in 0..=4 {
+        for i in 0..=4 {
+            q.push(node(&mut m, [0.005 * i as f64, 0.005 * j as f64, 0.0]));
+        }
+    }
+    let mut t = vec![];
+    for j in 0..=2 {
+        for i in 0..=2 {
+            t.push(node(&mut m, [0.02 + 0.01 * i as f64, 0.01 * j as f64, 0.0]));
+        }
+    }
+    let mem = |e1: f64| PartProps {
+        youngs_modulus_1: Some(e1),
+        youngs_modulus_2: Some(0.5 * e1),
+        poisson_ratio_12: Some(0.2),
+        shear_modulus_12: Some(0.1 * e1),
+        thickness: Some(2e-4),
+        density: Some(1440.0),
+        material_angle: Some(0.2),
+        ..Default::default()
+    };
+    let pq = m.add_part(
+        1,
+        "fine",
+        ElementKind::Quad,
+        PartProps {
+            hourglass: Some(0.05),
+            ..mem(3e10)
+        },
+    );
+    let pt = m.add_part(
+        2,
+        "coarse",
+        ElementKind::Tri,
+        PartProps {
+            no_compression: Some(true),
+            ..mem(2e10)
+        },
+    );
+    let mut eid = 0i64;
+    for j in 0..4 {
+        for i in 0..4 {
+            eid += 1;
+            m.add_element(
+                eid,
+                pq,
+                &[
+                    q[j * 5 + i],
+                    q[j * 5 + i + 1],
+                    q[(j + 1) * 5 + i + 1],
+                    q[(j + 1) * 5 + i],
+                ],
+            );
+        }
+    }
+    for j in 0..2 {
+        for i in 0..2 {
+            let (a, b, c, d) = (
+                t[j * 3 + i],
+                t[j * 3 + i + 1],
+                t[(j + 1) * 3 + i + 1],
+                t[(j + 1) * 3 + i],
+            );
+            eid += 1;
+            m.add_element(eid, pt, &[a, b, c]);
+            eid += 1;
+            m.add_element(eid, pt, &[a, c, d]);
+        }
+    }
+    // The quad patch's right edge (x = 0.02) is tied to the triangle patch's left edge.
+    for j in 0..=4 {
+        let k = (j / 2).min(1);
+        m.ties.push(Tie {
+            slave: q[j * 5 + 4],
+            masters: vec![t[k * 3], t[(k + 1) * 3]],
+        });
+    }
+    // Beams along x from the triangle patch's right edge, with a point mass at the end,
+    // a truss and a link with slider and dashpots to a fixed anchor.
+    let pb = m.add_part(
+        3,
+        "rods",
+        ElementKind::Beam,
+        PartProps {
+            youngs_modulus: Some(1.5e11),
+            density: Some(7800.0),
+            width: Some(5e-4),
+            height: Some(3e-4),
+            poisson_ratio: Some(0.0),
+            ..Default::default()
+        },
+    );
+    let mut prev = t[2];
+    let mut b_nodes = vec![];
+    for k in 1..=4 {
+        let n = node(&mut m, [0.04 + 0.005 * k as f64, 0.0, 0.0]);
+        eid += 1;
+        m.add_element(eid, pb, &[prev, n]);
+        b_nodes.push(n);
+        prev = n;
+    }
+    let tip = prev;
+    let ptr = m.add_part(
+        4,
+        "yarn",
+        ElementKind::Truss,
+        PartProps {
+            youngs_modulus: Some(8e10),
+            density: Some(1440.0),
+            area: Some(1e-7),
+            tension_only: Some(true),
+            ..Default::default()
+        },
+    );
+    let far = node(&mut m, [0.07, 0.0, 0.0]);
+    eid += 1;
+    m.add_element(eid, ptr, &[tip, far]);
+    let pm = m.add_part(
+        5,
+        "bead",
+        ElementKind::PointMass,
+        PartProps {
+            mass: Some(1e-4),
+            ..Default::default()
+        },
+    );
+    eid += 1;
+    m.add_element(eid, pm, &[far]);
+    let anchor = node(&mut m, [0.07, 0.0, 0.0]);
+    let pl = m.add_part(
+        6,
+        "crossing",
+        ElementKind::Link,
+        PartProps {
+            kx: Some(1e4),
+            ky: Some(1e4),
+            kz: Some(5e4),
+            cx: Some(0.01),
+            cy: Some(0.01),
+            cz: Some(0.02),
+            slip_force: Some(0.01),
+            ..Default::default()
+        },
+    );
+    eid += 1;
+    m.add_element(eid, pl, &[far, anchor]);
+    m.constraints.push((anchor, [true, true, true]));
+    for j in 0..=4 {
+        m.constraints.push((q[j * 5], [true, true, true]));
+    }
+    m.rot_constraints.push((b_nodes[1], [true, false, false]));
+    m.symmetry.push(SymmetryPlane {
+        normal: 1,
+        position: 0.0,
+        tolerance: 1e-9,
+    });
+    m.projectiles.push(ProjectileSpec {
+        id: 1,
+        shape: ProjectileShape::Round,
+        radius: 2e-3,
+        length: 8e-3,
+        mass: 1e-3,
+        tip: [0.01, 0.01, 1e-4],
+        axis: [0.0, 0.0, -1.0],
+        velocity: [0.0, 0.0, -50.0],
+        prescribed_velocity: false,
+        contact_stiffness: None,
+        friction: 0.1,
+    });
+    let curve = std::sync::Arc::new(Curve {
+        t: vec![0.0, 5e-6, 2e-5],
+        value: vec![0.0, 1.0, 0.3],
+    });
+    m.curves.insert("ramp_hold".into(), curve.clone());
+    m.loads.push(Load {
+        id: 1,
+        node: far,
+        force: [2.0, 0.0, 0.5],
+        law: TimeLaw::Tabulated {
+            name: "ramp_hold".into(),
+            curve,
+        },
+    });
+    m.loads.push(Load {
+        id: 2,
+        node: t[8],
+        force: [0.0, 0.0, -1.0],
+        law: TimeLaw::SinePulse {
+            start: 1e-6,
+            duration: 5e-6,
+        },
+    });
+    m.node_sets.insert("beam".into(), b_nodes);
+    m.analysis.end_time = 3e-5;
+    m.analysis.output_interval = 1e-6;
+    m
+}
