@@ -273,13 +273,13 @@ fn unknown_element_table() {
         |m| {
             std::fs::copy(
                 m.join("elements_truss.parquet"),
-                m.join("elements_beam.parquet"),
+                m.join("elements_shell.parquet"),
             )
             .map(|_| ())
             .unwrap()
         },
         &[],
-        &["elements_beam.parquet", "unknown element table"],
+        &["elements_shell.parquet", "unknown element table"],
     );
 }
 

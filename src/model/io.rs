@@ -403,6 +403,9 @@ fn read_model_inner(dir: &Path) -> Result<Model> {
         let presc = t
             .bool_opt("prescribed_velocity")?
             .unwrap_or_else(|| vec![None; n]);
+        let seg = t
+            .bool_opt("segment_contact")?
+            .unwrap_or_else(|| vec![None; n]);
         for row in 0..n {
             let sh = ProjectileShape::parse(&shape[row]).ok_or_else(|| {
                 t.value_error(
@@ -428,6 +431,7 @@ fn read_model_inner(dir: &Path) -> Result<Model> {
                 prescribed_velocity: presc[row].unwrap_or(false),
                 contact_stiffness: k[row],
                 friction: mu[row].unwrap_or(0.0),
+                segment_contact: seg[row].unwrap_or(true),
             });
         }
     }
@@ -801,6 +805,10 @@ fn write_tables(m: &Model, dir: &Path, prov: &Provenance) -> Result<()> {
                     p.iter().map(|x| x.contact_stiffness).collect(),
                 ),
                 Col::F64("friction", c(|x| x.friction)),
+                Col::Bool(
+                    "segment_contact",
+                    p.iter().map(|x| x.segment_contact).collect(),
+                ),
             ]),
             prov,
         )?;

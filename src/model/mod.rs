@@ -276,6 +276,10 @@ pub struct ProjectileSpec {
     pub contact_stiffness: Option<f64>,
     /// Coulomb friction coefficient μ.
     pub friction: f64,
+    /// Also contact the membrane faces (sample points at face centroids and edge
+    /// midpoints), so that a projectile smaller than an element cannot pass between
+    /// nodes. Default true.
+    pub segment_contact: bool,
 }
 
 /// A symmetry plane (`symmetry.parquet`): nodes on it keep their displacement normal to

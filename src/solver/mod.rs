@@ -94,6 +94,8 @@ pub struct MembraneGroup<const N: usize> {
     pub k_hg: Vec<f64>,
     /// Largest eigenvalue of the element stiffness [N/m] (stable step).
     pub k_max: Vec<f64>,
+    /// Element mass ρ s A₀ [kg].
+    pub mass: Vec<f64>,
     pub slot0: usize,
 }
 
@@ -107,6 +109,7 @@ impl<const N: usize> MembraneGroup<N> {
             thickness: vec![],
             k_hg: vec![],
             k_max: vec![],
+            mass: vec![],
             slot0: 0,
         };
         let Some(b) = m.block(kind) else { return Ok(g) };
@@ -152,6 +155,7 @@ impl<const N: usize> MembraneGroup<N> {
                 mass[n] += me / N as f64;
             }
             g.k_max.push(membrane::max_stiffness(&r, &mat, s, k_hg));
+            g.mass.push(me);
             g.id.push(b.id[e]);
             g.nodes.push(std::array::from_fn(|a| ns[a] as u32));
             g.reference.push(r);
@@ -401,6 +405,12 @@ pub struct Solver {
     pub rot_of: Vec<u32>,
     /// Rigid projectiles.
     pub projectiles: Vec<contact::Projectile>,
+    /// Contact sample points on the membrane faces (centroids, edge midpoints), for
+    /// flat noses.
+    samples: Vec<contact::SamplePoint>,
+    /// Face triangles (quads split along both diagonals) with their masses, for
+    /// spherical noses.
+    face_tris: Vec<([u32; 3], f64)>,
     /// Contact forces on nodes, and the nodes that carry one.
     fcon: Vec<[f64; 3]>,
     con_nodes: Vec<usize>,
@@ -595,6 +605,65 @@ impl Solver {
         }
         let mut tri = MembraneGroup::<3>::build(m, ElementKind::Tri, &mut mass)?;
         let mut quad = MembraneGroup::<4>::build(m, ElementKind::Quad, &mut mass)?;
+        // Contact sample points on the faces, each with a tributary mass for its penalty:
+        // half the face's mass at its centroid, the other half shared among its edges (an
+        // edge collects from every face it bounds), so the penalty of a face does not
+        // depend on what lies beyond it (a symmetry plane, a free edge).
+        let samples = {
+            let mut v = Vec::new();
+            let mut edge_at: std::collections::BTreeMap<(u32, u32), usize> = Default::default();
+            let faces = tri
+                .nodes
+                .iter()
+                .map(|f| f.to_vec())
+                .zip(tri.mass.iter())
+                .chain(quad.nodes.iter().map(|f| f.to_vec()).zip(quad.mass.iter()));
+            for (f, &mf) in faces {
+                let n = f.len();
+                let mut nodes = [0u32; 4];
+                nodes[..n].copy_from_slice(&f);
+                let mut w = [0.0; 4];
+                for x in w.iter_mut().take(n) {
+                    *x = 1.0 / n as f64;
+                }
+                v.push(contact::SamplePoint {
+                    nodes,
+                    w,
+                    n,
+                    mass: 0.5 * mf,
+                });
+                for a in 0..n {
+                    let (p, q) = (f[a], f[(a + 1) % n]);
+                    let k = *edge_at.entry((p.min(q), p.max(q))).or_insert_with(|| {
+                        v.push(contact::SamplePoint {
+                            nodes: [p, q, 0, 0],
+                            w: [0.5, 0.5, 0.0, 0.0],
+                            n: 2,
+                            mass: 0.0,
+                        });
+                        v.len() - 1
+                    });
+                    v[k].mass += 0.5 * mf / n as f64;
+                }
+            }
+            v
+        };
+        let face_tris: Vec<([u32; 3], f64)> = tri
+            .nodes
+            .iter()
+            .zip(&tri.mass)
+            .map(|(f, &m)| (*f, m))
+            .chain(quad.nodes.iter().zip(&quad.mass).flat_map(|(f, &m)| {
+                // Both diagonals, so that the split has no handedness (a mirrored mesh,
+                // e.g. across a symmetry plane, gets the mirrored contact).
+                [
+                    ([f[0], f[1], f[2]], 0.25 * m),
+                    ([f[0], f[2], f[3]], 0.25 * m),
+                    ([f[1], f[2], f[3]], 0.25 * m),
+                    ([f[1], f[3], f[0]], 0.25 * m),
+                ]
+            }))
+            .collect();
         let mut beams = BeamGroup::default();
         let mut rot = Rotations::default();
         let mut rot_of = vec![u32::MAX; nn];
@@ -871,6 +940,8 @@ impl Solver {
             rot,
             rot_of,
             projectiles: m.projectiles.iter().map(contact::Projectile::new).collect(),
+            samples,
+            face_tris,
             fcon: vec![[0.0; 3]; nn],
             con_nodes: Vec::with_capacity(nn),
             k_contact: vec![0.0; nn],
@@ -1322,6 +1393,7 @@ impl Solver {
     fn contact_forces(&mut self) {
         let (x, v, mass, kc) = (&self.x, &self.v, &self.mass, &self.k_contact);
         let dt_prev = self.dt_prev;
+        let dt2 = self.stable.dt * self.stable.dt;
         for p in self.projectiles.iter_mut() {
             let mut ftot = [0.0; 3];
             for i in 0..x.len() {
@@ -1349,6 +1421,94 @@ impl Solver {
                 add(&mut self.fcon[i], &f);
                 ftot = [ftot[0] - f[0], ftot[1] - f[1], ftot[2] - f[2]];
                 self.con_nodes.push(i);
+            }
+            if p.segments && p.nose_centre().is_some() {
+                // Exact: the sphere against the closest point of every face triangle.
+                let c = p.nose_centre().expect("spherical nose");
+                for (tri_n, mt) in &self.face_tris {
+                    let xs = tri_n.map(|n| x[n as usize]);
+                    let w = contact::closest_on_triangle(&c, &xs[0], &xs[1], &xs[2]);
+                    let q: [f64; 3] = std::array::from_fn(|d| {
+                        w[0] * xs[0][d] + w[1] * xs[1][d] + w[2] * xs[2][d]
+                    });
+                    let dq = [q[0] - c[0], q[1] - c[1], q[2] - c[2]];
+                    let dist = dot(&dq, &dq).sqrt();
+                    if dist >= p.radius || dist == 0.0 {
+                        continue;
+                    }
+                    // A round nose's hemisphere only: the cylinder behind it is left to node contact.
+                    if p.shape == crate::model::ProjectileShape::Round && dot(&dq, &p.axis) < 0.0 {
+                        continue;
+                    }
+                    let n = [dq[0] / dist, dq[1] / dist, dq[2] / dist];
+                    let kp = p
+                        .stiffness
+                        .unwrap_or(contact::PENALTY_FACTOR * mt / (3.0 * dt2));
+                    let fnorm = kp * (p.radius - dist);
+                    let mut f = [n[0] * fnorm, n[1] * fnorm, n[2] * fnorm];
+                    if p.friction > 0.0 {
+                        let vq: [f64; 3] = std::array::from_fn(|d| {
+                            (0..3).map(|a| w[a] * v[tri_n[a] as usize][d]).sum()
+                        });
+                        let vr = [vq[0] - p.v[0], vq[1] - p.v[1], vq[2] - p.v[2]];
+                        let vn = dot(&vr, &n);
+                        let vt = [vr[0] - vn * n[0], vr[1] - vn * n[1], vr[2] - vn * n[2]];
+                        let vtm = dot(&vt, &vt).sqrt();
+                        if vtm > 0.0 {
+                            let ft = p.friction * fnorm * (vtm / contact::V_REG).min(1.0);
+                            for d in 0..3 {
+                                f[d] -= ft * vt[d] / vtm;
+                            }
+                            self.e_contact_friction += ft * vtm * dt_prev;
+                        }
+                    }
+                    for a in 0..3 {
+                        let i = tri_n[a] as usize;
+                        add(&mut self.fcon[i], &[w[a] * f[0], w[a] * f[1], w[a] * f[2]]);
+                        self.con_nodes.push(i);
+                    }
+                    ftot = [ftot[0] - f[0], ftot[1] - f[1], ftot[2] - f[2]];
+                }
+            } else if p.segments {
+                for sp in &self.samples {
+                    let nodes = &sp.nodes[..sp.n];
+                    let pos: [f64; 3] = std::array::from_fn(|d| {
+                        (0..sp.n).map(|a| sp.w[a] * x[nodes[a] as usize][d]).sum()
+                    });
+                    let Some((g, n)) = p.penetration(&pos) else {
+                        continue;
+                    };
+                    let kp = contact::SEGMENT_FACTOR
+                        * p.stiffness
+                            .unwrap_or(contact::PENALTY_FACTOR * sp.mass / dt2);
+                    let fnorm = kp * g;
+                    let mut f = [n[0] * fnorm, n[1] * fnorm, n[2] * fnorm];
+                    if p.friction > 0.0 {
+                        let vp: [f64; 3] = std::array::from_fn(|d| {
+                            (0..sp.n).map(|a| sp.w[a] * v[nodes[a] as usize][d]).sum()
+                        });
+                        let vr = [vp[0] - p.v[0], vp[1] - p.v[1], vp[2] - p.v[2]];
+                        let vn = dot(&vr, &n);
+                        let vt = [vr[0] - vn * n[0], vr[1] - vn * n[1], vr[2] - vn * n[2]];
+                        let vtm = dot(&vt, &vt).sqrt();
+                        if vtm > 0.0 {
+                            let ft = p.friction * fnorm * (vtm / contact::V_REG).min(1.0);
+                            for d in 0..3 {
+                                f[d] -= ft * vt[d] / vtm;
+                            }
+                            self.e_contact_friction += ft * vtm * dt_prev;
+                        }
+                    }
+                    for a in 0..sp.n {
+                        let i = nodes[a] as usize;
+                        add(
+                            &mut self.fcon[i],
+                            &[sp.w[a] * f[0], sp.w[a] * f[1], sp.w[a] * f[2]],
+                        );
+                        self.con_nodes.push(i);
+                    }
+                    ftot = [ftot[0] - f[0], ftot[1] - f[1], ftot[2] - f[2]];
+                }
             }
             p.force = ftot;
         }
@@ -1453,6 +1613,45 @@ impl Solver {
     /// Stored penalty energy ½ Σ k g² at the current positions.
     fn contact_energy(&self) -> f64 {
         let mut e = 0.0;
+        for p in self.projectiles.iter().filter(|p| p.segments) {
+            if let Some(c) = p.nose_centre() {
+                let dt2 = self.stable.dt * self.stable.dt;
+                for (tri_n, mt) in &self.face_tris {
+                    let xs = tri_n.map(|n| self.x[n as usize]);
+                    let w = contact::closest_on_triangle(&c, &xs[0], &xs[1], &xs[2]);
+                    let dq: [f64; 3] = std::array::from_fn(|d| {
+                        w[0] * xs[0][d] + w[1] * xs[1][d] + w[2] * xs[2][d] - c[d]
+                    });
+                    let dist = dot(&dq, &dq).sqrt();
+                    if dist >= p.radius || dist == 0.0 {
+                        continue;
+                    }
+                    if p.shape == crate::model::ProjectileShape::Round && dot(&dq, &p.axis) < 0.0 {
+                        continue;
+                    }
+                    let kp = p
+                        .stiffness
+                        .unwrap_or(contact::PENALTY_FACTOR * mt / (3.0 * dt2));
+                    e += 0.5 * kp * (p.radius - dist).powi(2);
+                }
+                continue;
+            }
+            for sp in &self.samples {
+                let nodes = &sp.nodes[..sp.n];
+                let pos: [f64; 3] = std::array::from_fn(|d| {
+                    (0..sp.n)
+                        .map(|a| sp.w[a] * self.x[nodes[a] as usize][d])
+                        .sum()
+                });
+                if let Some((g, _)) = p.penetration(&pos) {
+                    let dt2 = self.stable.dt * self.stable.dt;
+                    let kp = contact::SEGMENT_FACTOR
+                        * p.stiffness
+                            .unwrap_or(contact::PENALTY_FACTOR * sp.mass / dt2);
+                    e += 0.5 * kp * g * g;
+                }
+            }
+        }
         for p in &self.projectiles {
             for i in 0..self.x.len() {
                 if self.mass[i] <= 0.0 {

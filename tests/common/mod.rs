@@ -249,6 +249,7 @@ pub fn composite() -> weft::model::Model {
         prescribed_velocity: false,
         contact_stiffness: None,
         friction: 0.1,
+        segment_contact: true,
     });
     let curve = std::sync::Arc::new(Curve {
         t: vec![0.0, 5e-6, 2e-5],
