@@ -2082,7 +2082,8 @@ impl Solver {
             elements: self.truss.id.len()
                 + self.link.id.len()
                 + self.tri.id.len()
-                + self.quad.id.len(),
+                + self.quad.id.len()
+                + self.beam.id.len(),
             nodes: self.x.len(),
         })
     }

@@ -1,0 +1,350 @@
+//! The paper's §4 models on a square L × L: a girder of rods and a membrane on the same
+//! nodes, clamped along x = 0, loaded along x = L.
+//!
+//! Load cases (total force F spread over the loaded edge's nodes, half at the two
+//! corners, so that the traction is uniform): `tension` (along +x), `shear` (along +y),
+//! `transverse` (along +z at the centre node, an impact-like pulse). Time law: the pulse
+//! F·sin(πt/T_F) on [0, T_F] with T_F = T/2 and T = L√(ρ/E) (the time a longitudinal
+//! wave needs to cross the square; `period` sets T, so that two models compared sample by
+//! sample share it); a static solve uses the amplitude F.
+//!
+//! Node sets: `reference` (every node), `axis_x` (y = 0, ordered by x), `diagonal`
+//! (x = y, ordered by x), `loaded_edge` (x = L, ordered by y).
+
+use serde::Serialize;
+
+use crate::error::{Result, WeftError};
+use crate::generate::grid::rectangle;
+use crate::model::{Analysis, ElementKind, Load, Model, PartProps, TimeLaw};
+
+/// Where the square is loaded.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum LoadCase {
+    Tension,
+    Shear,
+    Transverse,
+}
+
+/// Steps per load pulse: the stable step of these coarse models would sample the paper's
+/// pulse (T_F = T/2 spans N/2 cells) with about five steps, too few for the response and
+/// for the energy account (the trapezoidal work is then off by ~(π/5)²/12 ≈ 3 %).
+pub const STEPS_PER_PULSE: f64 = 40.0;
+
+/// Choose a time step that resolves the pulse when the stable step does not.
+fn resolve_pulse(m: &mut Model) -> Result<()> {
+    let t_f = m.loads.iter().find_map(|l| match l.law {
+        TimeLaw::SinePulse { duration, .. } => Some(duration),
+        _ => None,
+    });
+    if let Some(t_f) = t_f {
+        let stable = crate::solver::Solver::new(m)?.stable;
+        let dt = t_f / STEPS_PER_PULSE;
+        if dt < stable.dt {
+            m.analysis.time_step = Some(dt);
+        }
+    }
+    Ok(())
+}
+
+/// Common parameters of the square models.
+#[derive(Debug, Clone, Serialize)]
+pub struct Square {
+    /// Side L [m].
+    pub length: f64,
+    /// Cells (rods or elements) per side N.
+    pub cells: usize,
+    pub load_case: LoadCase,
+    /// Total force F [N].
+    pub force: f64,
+    /// The time scale T [s] (pulse T_F = T/2, default end time T); `None`: L√(ρ/E) of the
+    /// model's own material. Give a girder and its membrane the same T to compare them.
+    pub period: Option<f64>,
+    /// End time [s]; `None`: T = L√(ρ/E).
+    pub end_time: Option<f64>,
+    /// Output interval [s]; `None`: end time / 100.
+    pub output_interval: Option<f64>,
+}
+
+fn positive(name: &str, v: f64, unit: &str) -> Result<()> {
+    if v > 0.0 && v.is_finite() {
+        Ok(())
+    } else {
+        Err(WeftError::input(format!("--{name} = `{v}`")).expected(format!("a value > 0 {unit}")))
+    }
+}
+
+/// Nodes of the (cells+1)² grid, clamps, loads, sets and analysis shared by both models.
+/// `rotations` clamps the rotations at x = 0 too (beams).
+fn frame(m: &mut Model, sq: &Square, e: f64, rho: f64, rotations: bool) -> Result<()> {
+    positive("length", sq.length, "in m")?;
+    if sq.cells == 0 {
+        return Err(WeftError::input("--cells = `0`").expected("at least 1 cell per side"));
+    }
+    if !sq.force.is_finite() {
+        return Err(
+            WeftError::input(format!("--force = `{}`", sq.force)).expected("a finite force in N")
+        );
+    }
+    let n = sq.cells;
+    let id = |i: usize, j: usize| j * (n + 1) + i;
+    for j in 0..=n {
+        m.constraints.push((id(0, j), [true, true, true]));
+        if rotations {
+            m.rot_constraints.push((id(0, j), [true, true, true]));
+        }
+    }
+    let t = sq.period.unwrap_or(sq.length * (rho / e).sqrt());
+    positive("period", t, "in s")?;
+    let law = TimeLaw::SinePulse {
+        start: 0.0,
+        duration: 0.5 * t,
+    };
+    match sq.load_case {
+        LoadCase::Tension | LoadCase::Shear => {
+            let d = if sq.load_case == LoadCase::Tension {
+                0
+            } else {
+                1
+            };
+            for j in 0..=n {
+                let w = if j == 0 || j == n { 0.5 } else { 1.0 } / n as f64;
+                let mut f = [0.0; 3];
+                f[d] = sq.force * w;
+                m.loads.push(Load {
+                    id: j as i64 + 1,
+                    node: id(n, j),
+                    force: f,
+                    law: law.clone(),
+                });
+            }
+        }
+        LoadCase::Transverse => {
+            m.loads.push(Load {
+                id: 1,
+                node: id(n / 2, n / 2),
+                force: [0.0, 0.0, sq.force],
+                law,
+            });
+        }
+    }
+    m.node_sets
+        .insert("reference".into(), (0..(n + 1) * (n + 1)).collect());
+    m.node_sets
+        .insert("axis_x".into(), (0..=n).map(|i| id(i, 0)).collect());
+    m.node_sets
+        .insert("diagonal".into(), (0..=n).map(|i| id(i, i)).collect());
+    m.node_sets
+        .insert("loaded_edge".into(), (0..=n).map(|j| id(n, j)).collect());
+    let end = sq.end_time.unwrap_or(t);
+    m.analysis = Analysis {
+        end_time: end,
+        output_interval: sq.output_interval.unwrap_or(end / 100.0),
+        ..Default::default()
+    };
+    Ok(())
+}
+
+/// `girder`: rods along x and y between the nodes of an N × N grid.
+#[derive(Debug, Clone, Serialize)]
+pub struct GirderParams {
+    pub square: Square,
+    pub youngs_modulus: f64,
+    pub density: f64,
+    /// Rod width b (in plane) [m]; `None`: L/(10N).
+    pub rod_width: Option<f64>,
+    /// Rod thickness h (out of plane) [m]; `None`: equal to b.
+    pub rod_thickness: Option<f64>,
+    /// Rigid joints (beams) or pinned joints (trusses).
+    pub rigid: bool,
+    /// Rods along the boundary with the full section instead of half the height.
+    pub full_edge_rods: bool,
+}
+
+impl GirderParams {
+    pub fn b(&self) -> f64 {
+        self.rod_width
+            .unwrap_or(self.square.length / (10.0 * self.square.cells as f64))
+    }
+    pub fn h(&self) -> f64 {
+        self.rod_thickness.unwrap_or(self.b())
+    }
+}
+
+/// Build the girder; returns the model and warnings for the user.
+///
+/// Each rod is a prism of b × h between joint centres; the b × b crossings would be
+/// counted twice, so the rods carry the density ρ(1 − b/(2a)), which gives the lattice's
+/// areal density ρ·b·h·(2 − b/a)/a exactly (DESIGN.md §8). Rods on the boundary have
+/// half the height (half a cell each), unless `full_edge_rods`.
+pub fn girder(p: &GirderParams) -> Result<(Model, Vec<String>)> {
+    positive("youngs-modulus", p.youngs_modulus, "in Pa")?;
+    positive("density", p.density, "in kg/m³")?;
+    let (b, h) = (p.b(), p.h());
+    positive("rod-width", b, "in m")?;
+    positive("rod-thickness", h, "in m")?;
+    let (n, l) = (p.square.cells, p.square.length);
+    if n == 0 {
+        return Err(WeftError::input("--cells = `0`").expected("at least 1 cell per side"));
+    }
+    let a = l / n as f64;
+    if b >= a {
+        return Err(WeftError::input(format!(
+            "--rod-width = `{b}` m is not smaller than the cell size a = L/N = {a} m"
+        ))
+        .expected("b < a"));
+    }
+    let mut warnings = vec![];
+    let (lo, hi) = (l / (20.0 * n as f64), l / (8.0 * n as f64));
+    if b < lo * (1.0 - 1e-12) || b > hi * (1.0 + 1e-12) {
+        warnings.push(format!(
+            "rod width b = {b:.4e} m lies outside the paper's range L/(20N) … L/(8N) = {lo:.4e} … {hi:.4e} m (its eq. 3); the reduced membrane closed forms assume slender rods"
+        ));
+    }
+    let mut m = Model::default();
+    let (nodes, _) = rectangle(n, n, l, l, ElementKind::Quad);
+    for (i, x) in nodes.iter().enumerate() {
+        m.add_node(i as i64 + 1, *x);
+    }
+    let kind = if p.rigid {
+        ElementKind::Beam
+    } else {
+        ElementKind::Truss
+    };
+    let rho = p.density * (1.0 - b / (2.0 * a));
+    let props = |h: f64| {
+        if p.rigid {
+            PartProps {
+                youngs_modulus: Some(p.youngs_modulus),
+                density: Some(rho),
+                width: Some(b),
+                height: Some(h),
+                poisson_ratio: Some(0.0),
+                ..Default::default()
+            }
+        } else {
+            PartProps {
+                youngs_modulus: Some(p.youngs_modulus),
+                density: Some(rho),
+                area: Some(b * h),
+                ..Default::default()
+            }
+        }
+    };
+    let part = m.add_part(1, "rods", kind, props(h));
+    // Rods on the boundary stand for half a cell of the lattice: half the height halves
+    // their axial and in-plane bending stiffness and their mass, so that the girder of
+    // side L matches the lattice (and its equivalent membrane of side L) exactly.
+    let edge = if p.full_edge_rods {
+        part
+    } else {
+        m.add_part(2, "edge_rods", kind, props(0.5 * h))
+    };
+    let id = |i: usize, j: usize| j * (n + 1) + i;
+    let mut eid = 1;
+    for j in 0..=n {
+        for i in 0..=n {
+            if i < n {
+                m.add_element(
+                    eid,
+                    if j == 0 || j == n { edge } else { part },
+                    &[id(i, j), id(i + 1, j)],
+                );
+                eid += 1;
+            }
+            if j < n {
+                m.add_element(
+                    eid,
+                    if i == 0 || i == n { edge } else { part },
+                    &[id(i, j), id(i, j + 1)],
+                );
+                eid += 1;
+            }
+        }
+    }
+    frame(&mut m, &p.square, p.youngs_modulus, p.density, p.rigid)?;
+    // A plane girder under in-plane loads: hold the out-of-plane motion (pinned joints have
+    // no stiffness there at all).
+    if p.square.load_case != LoadCase::Transverse {
+        for i in 0..m.num_nodes() {
+            m.constraints.push((i, [false, false, true]));
+            if p.rigid {
+                m.rot_constraints.push((i, [true, true, false]));
+            }
+        }
+    }
+    m.validate()?;
+    resolve_pulse(&mut m)?;
+    Ok((m, warnings))
+}
+
+/// `membrane`: the same square meshed with quads, orthotropic with E₁ = E₂ = E.
+#[derive(Debug, Clone, Serialize)]
+pub struct MembraneParams {
+    pub square: Square,
+    pub youngs_modulus: f64,
+    pub poisson_ratio: f64,
+    pub shear_modulus: f64,
+    pub thickness: f64,
+    pub density: f64,
+}
+
+impl MembraneParams {
+    /// The closed-form equivalent of a rigid-jointed girder with b = h = a/10 (DESIGN.md
+    /// §8): s = b²/a, ρ = ρ_g(2 − b/a), G = E(b/a)²/2, with E = 1.5·10¹¹ Pa,
+    /// ρ_g = 7800 kg/m³, L = 0.1 m, N = 10.
+    pub fn paper_default(square: Square) -> MembraneParams {
+        let a = square.length / square.cells as f64;
+        let r = 0.1;
+        MembraneParams {
+            youngs_modulus: 1.5e11,
+            poisson_ratio: 0.0,
+            shear_modulus: 1.5e11 * r * r / 2.0,
+            thickness: (r * a) * (r * a) / a,
+            density: 7800.0 * (2.0 - r),
+            square,
+        }
+    }
+}
+
+pub fn membrane(p: &MembraneParams) -> Result<Model> {
+    positive("youngs-modulus", p.youngs_modulus, "in Pa")?;
+    positive("shear-modulus", p.shear_modulus, "in Pa")?;
+    positive("thickness", p.thickness, "in m")?;
+    positive("density", p.density, "in kg/m³")?;
+    let (n, l) = (p.square.cells, p.square.length);
+    if n == 0 {
+        return Err(WeftError::input("--cells = `0`").expected("at least 1 cell per side"));
+    }
+    let mut m = Model::default();
+    let (nodes, elems) = rectangle(n, n, l, l, ElementKind::Quad);
+    for (i, x) in nodes.iter().enumerate() {
+        m.add_node(i as i64 + 1, *x);
+    }
+    let part = m.add_part(
+        1,
+        "membrane",
+        ElementKind::Quad,
+        PartProps {
+            youngs_modulus_1: Some(p.youngs_modulus),
+            youngs_modulus_2: Some(p.youngs_modulus),
+            poisson_ratio_12: Some(p.poisson_ratio),
+            shear_modulus_12: Some(p.shear_modulus),
+            thickness: Some(p.thickness),
+            density: Some(p.density),
+            ..Default::default()
+        },
+    );
+    for (e, ns) in elems.iter().enumerate() {
+        m.add_element(e as i64 + 1, part, ns);
+    }
+    frame(&mut m, &p.square, p.youngs_modulus, p.density, false)?;
+    if p.square.load_case != LoadCase::Transverse {
+        for i in 0..m.num_nodes() {
+            m.constraints.push((i, [false, false, true]));
+        }
+    }
+    m.validate()?;
+    resolve_pulse(&mut m)?;
+    Ok(m)
+}
