@@ -177,3 +177,195 @@ fn a_girder_converges_to_its_closed_form_membrane() {
     );
     assert!(errs[2] < 0.015, "N = 40: {}", errs[2]);
 }
+
+use weft::generate::zones::{
+    combined, woven_reduced, Centre, CombinedParams, MembraneProps, WovenParams,
+};
+use weft::model::{ElementKind, Model};
+
+fn cp(centre: Centre, quarter: bool) -> CombinedParams {
+    let (a, b) = (0.02 / 8.0, 0.02 / 80.0);
+    CombinedParams {
+        centre,
+        centre_length: 0.02,
+        centre_cells: 8,
+        length: 0.06,
+        coarsening: 2,
+        growth: 1.3,
+        quarter,
+        youngs_modulus: 1.5e11,
+        density: 7800.0,
+        rod_width: b,
+        membrane: MembraneProps {
+            youngs_modulus: 1.5e11,
+            poisson_ratio: 0.0,
+            shear_modulus: 1.5e11 * (b / a).powi(2) / 2.0,
+            thickness: b * b / a,
+            density: 7800.0 * (2.0 - b / a),
+        },
+        force: 10.0,
+        pulse: 0.02 * (7800.0f64 / 1.5e11).sqrt(),
+        end_time: 2.0 * 0.03 * (7800.0f64 / 1.5e11).sqrt(),
+        output_interval: 1e-7,
+    }
+}
+
+/// Every node strictly inside an edge of a coarse quad is a tie slave.
+fn no_hanging_nodes(m: &Model) {
+    let slaves: std::collections::HashSet<usize> = m.ties.iter().map(|t| t.slave).collect();
+    let b = m.block(ElementKind::Quad).unwrap();
+    let coarse: Vec<usize> = (0..b.len())
+        .filter(|&e| m.parts[b.part[e]].name == "coarse_membrane")
+        .collect();
+    for e in coarse {
+        let ns = &b.nodes[4 * e..4 * e + 4];
+        for k in 0..4 {
+            let (p, q) = (m.coords[ns[k]], m.coords[ns[(k + 1) % 4]]);
+            for (i, x) in m.coords.iter().enumerate() {
+                if ns.contains(&i) {
+                    continue;
+                }
+                let t = ((x[0] - p[0]) * (q[0] - p[0]) + (x[1] - p[1]) * (q[1] - p[1]))
+                    / ((q[0] - p[0]).powi(2) + (q[1] - p[1]).powi(2));
+                let d = ((p[0] + t * (q[0] - p[0]) - x[0]).powi(2)
+                    + (p[1] + t * (q[1] - p[1]) - x[1]).powi(2)
+                    + (x[2] - p[2]).powi(2))
+                .sqrt();
+                if t > 1e-9 && t < 1.0 - 1e-9 && d < 1e-12 {
+                    assert!(
+                        slaves.contains(&i),
+                        "node {} hangs on a coarse edge without a tie",
+                        m.node_id[i]
+                    );
+                }
+            }
+        }
+    }
+}
+
+fn sets_on_lines(m: &Model) {
+    for name in ["reference", "axis_x", "diagonal", "interface"] {
+        assert!(!m.node_sets[name].is_empty(), "set {name} is empty");
+    }
+    let x = &m.coords;
+    for w in m.node_sets["axis_x"].windows(2) {
+        assert!(x[w[0]][1].abs() < 1e-12 && x[w[1]][0] > x[w[0]][0]);
+    }
+    for w in m.node_sets["diagonal"].windows(2) {
+        assert!((x[w[1]][0] - x[w[1]][1]).abs() < 1e-12 && x[w[1]][0] > x[w[0]][0]);
+    }
+    let slaves: std::collections::HashSet<usize> = m.ties.iter().map(|t| t.slave).collect();
+    assert!(m.node_sets["interface"].iter().all(|n| slaves.contains(n)));
+}
+
+#[test]
+fn combined_models_are_tied_without_hanging_nodes_and_weigh_what_they_should() {
+    for centre in [Centre::Girder, Centre::Membrane] {
+        for quarter in [true, false] {
+            let p = cp(centre, quarter);
+            let m = combined(&p).unwrap();
+            no_hanging_nodes(&m);
+            sets_on_lines(&m);
+            let mass: f64 = weft::solver::Solver::new(&m).unwrap().physical_mass;
+            let (c, half) = (0.01, 0.03);
+            let area_out = if quarter {
+                half * half - c * c
+            } else {
+                4.0 * (half * half - c * c)
+            };
+            let area_in = if quarter { c * c } else { 4.0 * c * c };
+            let a = 0.02 / 8.0;
+            let b = p.rod_width;
+            let areal_in = match centre {
+                Centre::Girder => 7800.0 * b * b * (2.0 - b / a) / a,
+                Centre::Membrane => p.membrane.density * p.membrane.thickness,
+            };
+            let exact = p.membrane.density * p.membrane.thickness * area_out + areal_in * area_in;
+            assert!(
+                rel(mass, exact) < 1e-9,
+                "{centre:?} quarter={quarter}: {mass} vs {exact}"
+            );
+        }
+    }
+}
+
+#[test]
+fn a_quarter_combined_model_matches_the_full_one() {
+    let (q, f) = (
+        combined(&cp(Centre::Girder, true)).unwrap(),
+        combined(&cp(Centre::Girder, false)).unwrap(),
+    );
+    let (sq_, oq, _) = run_in_memory(&q).unwrap();
+    let (sf, of, _) = run_in_memory(&f).unwrap();
+    let find = |s: &Solver, x: f64, y: f64| {
+        s.x0.iter()
+            .position(|p| (p[0] - x).abs() < 1e-12 && (p[1] - y).abs() < 1e-12)
+            .unwrap()
+    };
+    let (mut worst, mut peak) = (0.0f64, 0.0f64);
+    for (x, y) in [(0.0, 0.0), (0.005, 0.0025), (0.0075, 0.0075), (0.01, 0.005)] {
+        let (jq, jf) = (find(&sq_, x, y), find(&sf, x, y));
+        for k in 0..oq.t.len() {
+            worst = worst.max((oq.u[k][jq][2] - of.u[k][jf][2]).abs());
+            peak = peak.max(of.u[k][jf][2].abs());
+        }
+    }
+    eprintln!("combined quarter vs full: {worst:.3e} m of {peak:.3e} m");
+    assert!(peak > 0.0 && worst < 1e-9 * peak, "{worst} of {peak}");
+}
+
+#[test]
+fn the_reduced_woven_model() {
+    let p = WovenParams::paper();
+    let m = woven_reduced(&p).unwrap();
+    no_hanging_nodes(&m);
+    sets_on_lines(&m);
+    let n = p.yarns / 2;
+    assert_eq!(m.block(ElementKind::Link).unwrap().len(), (n + 1) * (n + 1));
+    assert_eq!(m.block(ElementKind::Truss).unwrap().len(), 2 * n * (n + 1));
+    // Mass: yarns ρA × length (the yarns on the symmetry planes with half the area) and
+    // the membrane ρ s × its area.
+    let c = n as f64 * p.spacing;
+    let yarn = p.yarn_density * p.yarn_area * 2.0 * c * (n as f64 + 0.5);
+    let mem = p.membrane.density * p.membrane.thickness * (0.05f64.powi(2) - c * c);
+    let s = Solver::new(&m).unwrap();
+    assert!(
+        rel(s.physical_mass, yarn + mem) < 1e-9,
+        "{} vs {}",
+        s.physical_mass,
+        yarn + mem
+    );
+    // It runs stably, in seconds, and the patch takes up the projectile.
+    let t = std::time::Instant::now();
+    let (_s, out, st) = run_in_memory(&m).unwrap();
+    let e = out.energy.last().unwrap();
+    let v = out.projectile.last().unwrap().2[5];
+    let ke0 = 0.5 * 0.25 * p.projectile_mass * p.projectile_velocity.powi(2);
+    eprintln!("woven-reduced: {} steps in {:.2} s, projectile {v:.1} m/s, energy error {:.2e} of {ke0:.1} J", st.steps, t.elapsed().as_secs_f64(), e.balance_error);
+    assert!(
+        v > -0.999 * p.projectile_velocity,
+        "the patch did not slow the projectile"
+    );
+    assert!(e.balance_error.abs() < 0.01 * ke0, "{e:?}");
+    assert!(t.elapsed().as_secs_f64() < 20.0);
+}
+
+#[test]
+fn combined_models_run_stably_at_their_defaults() {
+    for centre in [Centre::Girder, Centre::Membrane] {
+        let m = combined(&cp(centre, true)).unwrap();
+        let (_s, out, _) = run_in_memory(&m).unwrap();
+        let wmax = out
+            .energy
+            .iter()
+            .map(|e| e.external_work.abs())
+            .fold(0.0, f64::max);
+        let worst = out
+            .energy
+            .iter()
+            .map(|e| e.balance_error.abs())
+            .fold(0.0, f64::max);
+        eprintln!("combined {centre:?}: energy balance {:.2e}", worst / wmax);
+        assert!(worst < 0.01 * wmax, "{centre:?}: {worst} of {wmax}");
+    }
+}

@@ -108,3 +108,51 @@ fn a_model_with_every_feature_opens_in_pandas_and_polars() {
     );
     eprintln!("{}", String::from_utf8_lossy(&o.stdout));
 }
+
+#[test]
+fn a_generated_woven_model_opens_in_pandas_and_polars() {
+    let probe = Command::new("python3")
+        .args(["-c", "import pandas, polars, pyarrow"])
+        .output();
+    if !probe.map(|o| o.status.success()).unwrap_or(false) {
+        assert!(
+            std::env::var("WEFT_REQUIRE_PYTHON").as_deref() != Ok("1"),
+            "python3 with pandas, polars and pyarrow is required"
+        );
+        eprintln!("SKIP: python3 with pandas, polars and pyarrow not found");
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let (model, out) = (dir.path().join("woven"), dir.path().join("out"));
+    let st = Command::new(env!("CARGO_BIN_EXE_weft-weave"))
+        .args(["woven-reduced", "--end-time", "5e-6", "--out"])
+        .arg(&model)
+        .status()
+        .unwrap();
+    assert!(st.success());
+    let st = Command::new(env!("CARGO_BIN_EXE_weft-simulate"))
+        .arg("--model")
+        .arg(&model)
+        .arg("--out")
+        .arg(&out)
+        .arg("--quiet")
+        .status()
+        .unwrap();
+    assert!(st.success());
+    let o = Command::new("python3")
+        .arg(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/read_tables.py"))
+        .arg(env!("CARGO_BIN_EXE_weft-simulate"))
+        .arg(&model)
+        .arg(&out)
+        .arg(dir.path())
+        .arg("open-only")
+        .output()
+        .unwrap();
+    assert!(
+        o.status.success(),
+        "read_tables.py failed:\n{}\n{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    );
+    eprintln!("{}", String::from_utf8_lossy(&o.stdout));
+}

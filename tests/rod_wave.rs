@@ -128,3 +128,70 @@ fn chain_stable_step_is_element_length_over_wave_speed() {
     assert!(rel(s.stable.dt, 0.9 * h / p.wave_speed()) < 1e-9);
     assert_eq!(s.stable.element.unwrap().0, weft::model::ElementKind::Truss);
 }
+
+#[test]
+fn pretensioned_string_carries_transverse_waves_at_sqrt_t_over_mu() {
+    // A string of trusses pre-strained by ε₀ between fixed ends carries T = E·A·ε₀;
+    // transverse waves travel at √(T/μ) = √(E ε₀/ρ) (the string equation; e.g. Graff
+    // §1.1). E = 80 GPa, ρ = 1440 kg/m³, ε₀ = 1 %: 745.4 m/s.
+    use weft::model::{ElementKind, Load, Model, PartProps, TimeLaw};
+    let (e, rho, eps0, l, n) = (80e9, 1440.0, 0.01, 0.2, 400usize);
+    let mut m = Model::default();
+    for i in 0..=n {
+        m.add_node(i as i64 + 1, [l * i as f64 / n as f64, 0.0, 0.0]);
+    }
+    let p = m.add_part(
+        1,
+        "yarn",
+        ElementKind::Truss,
+        PartProps {
+            youngs_modulus: Some(e),
+            density: Some(rho),
+            area: Some(1e-8),
+            prestrain: Some(eps0),
+            ..Default::default()
+        },
+    );
+    for k in 0..n {
+        m.add_element(k as i64 + 1, p, &[k, k + 1]);
+    }
+    m.constraints.push((0, [true, true, true]));
+    m.constraints.push((n, [true, true, true]));
+    for i in 1..n {
+        m.constraints.push((i, [true, true, false]));
+    }
+    let c = (e * eps0 / rho).sqrt();
+    let t_f = 0.02 / c;
+    m.loads.push(Load {
+        id: 1,
+        node: 1,
+        force: [0.0, 0.0, 0.01],
+        law: TimeLaw::SinePulse {
+            start: 0.0,
+            duration: t_f,
+        },
+    });
+    m.analysis.end_time = 0.15 / c;
+    m.analysis.output_interval = m.analysis.end_time / 1500.0;
+    let (s, out, _) = run_in_memory(&m).unwrap();
+    // The initial axial force is E·A·ε₀.
+    let n0 =
+        weft::solver::truss::axial_force(&s.x0[0], &s.x0[1], s.truss.k[0], s.truss.l0[0], false);
+    assert!(rel(n0, e * 1e-8 * eps0) < 1e-12, "{n0}");
+    let j = |x: f64| {
+        out.nodes
+            .iter()
+            .position(|&i| i == (x / l * n as f64).round() as usize)
+            .unwrap()
+    };
+    let wa = out.velocity_series(j(0.04), 2);
+    let wb = out.velocity_series(j(0.12), 2);
+    let peak = wa.iter().cloned().fold(0.0, f64::max);
+    let (ta, tb) = (
+        crossing(&out.t, &wa, 0.5 * peak).unwrap(),
+        crossing(&out.t, &wb, 0.5 * peak).unwrap(),
+    );
+    let v = 0.08 / (tb - ta);
+    eprintln!("pretensioned string: {v:.1} m/s vs √(Eε₀/ρ) = {c:.1} m/s");
+    assert!(rel(v, c) < 0.01, "{v} vs {c}");
+}

@@ -8,7 +8,11 @@ use clap::{Parser, Subcommand};
 
 use weft::generate::rod::{build, RodParams};
 use weft::generate::square::{girder, membrane, GirderParams, LoadCase, MembraneParams, Square};
+use weft::generate::zones::{
+    combined, woven_reduced, Centre, CombinedParams, MembraneProps, WovenParams,
+};
 use weft::model::io::write_model;
+use weft::model::ProjectileShape;
 use weft::table::Provenance;
 
 #[derive(Parser)]
@@ -36,6 +40,146 @@ enum Model {
     /// clamped at x = 0 and loaded at x = L. Defaults: the closed-form equivalent of the
     /// default girder (s = b²/a, ρ = ρ_g(2 − b/a), G = E(b/a)²/2 with b/a = 0.1).
     Membrane(MembraneArgs),
+    /// A dense centre zone (rigid girder or fine membrane) inside a coarse membrane whose
+    /// elements grow with distance from the centre, joined by tied interfaces; pinned outer
+    /// edge; a transverse force pulse at the centre.
+    Combined(CombinedArgs),
+    /// The reduced woven model (the paper's §5): warp and weft trusses joined at every
+    /// crossing by a link (springs, dashpots, optional friction slider), inside a graded
+    /// equivalent membrane tied to the yarn ends, hit by a rigid projectile.
+    WovenReduced(WovenArgs),
+}
+
+#[derive(clap::Args)]
+struct CombinedArgs {
+    /// Output model folder.
+    #[arg(long)]
+    out: PathBuf,
+    /// Dense centre zone: girder or membrane.
+    #[arg(long, value_enum, default_value_t = Centre::Girder)]
+    centre: Centre,
+    /// Side of the centre zone L_m [m].
+    #[arg(long, default_value_t = 0.02)]
+    centre_length: f64,
+    /// Cells across the centre zone (even).
+    #[arg(long, default_value_t = 20)]
+    centre_cells: usize,
+    /// Side of the whole model L [m].
+    #[arg(long, default_value_t = 0.1)]
+    length: f64,
+    /// Coarse cell size at the centre zone, in centre cells (divides centre-cells/2).
+    #[arg(long, default_value_t = 2)]
+    coarsening: usize,
+    /// Growth ratio of the coarse cells away from the centre.
+    #[arg(long, default_value_t = 1.25)]
+    growth: f64,
+    /// Full model instead of the quarter with symmetry planes x = 0, y = 0.
+    #[arg(long)]
+    full: bool,
+    /// Girder Young's modulus E [Pa] (also the membrane's).
+    #[arg(long, default_value_t = 1.5e11)]
+    youngs_modulus: f64,
+    /// Girder density ρ [kg/m³].
+    #[arg(long, default_value_t = 7800.0)]
+    density: f64,
+    /// Girder rod width = thickness b [m] [default: cell size / 10].
+    #[arg(long)]
+    rod_width: Option<f64>,
+    /// Membrane shear modulus G [Pa] [default: E(b/a)²/2].
+    #[arg(long)]
+    shear_modulus: Option<f64>,
+    /// Membrane thickness s [m] [default: b²/a].
+    #[arg(long)]
+    thickness: Option<f64>,
+    /// Membrane density [kg/m³] [default: ρ(2 − b/a)].
+    #[arg(long)]
+    membrane_density: Option<f64>,
+    /// Transverse force at the centre [N] (the full model's; a quarter carries F/4).
+    #[arg(long, default_value_t = 100.0)]
+    force: f64,
+    /// Pulse duration T_F [s] [default: L_m·√(ρ/E)].
+    #[arg(long)]
+    pulse: Option<f64>,
+    /// Simulated time [s] [default: L/2·√(ρ/E)·4].
+    #[arg(long)]
+    end_time: Option<f64>,
+    /// Output interval [s] [default: end time / 100].
+    #[arg(long)]
+    output_interval: Option<f64>,
+}
+
+#[derive(clap::Args)]
+struct WovenArgs {
+    /// Output model folder.
+    #[arg(long)]
+    out: PathBuf,
+    /// Yarns per side of the full patch (even).
+    #[arg(long, default_value_t = 20)]
+    yarns: usize,
+    /// Yarn spacing p [m].
+    #[arg(long, default_value_t = 1e-3)]
+    spacing: f64,
+    /// Yarn Young's modulus [Pa] (aramid).
+    #[arg(long, default_value_t = 80e9)]
+    yarn_modulus: f64,
+    /// Yarn density [kg/m³].
+    #[arg(long, default_value_t = 1440.0)]
+    yarn_density: f64,
+    /// Yarn cross-section area [m²] (190 g/m² fabric at 1 mm spacing).
+    #[arg(long, default_value_t = 6.6e-8)]
+    yarn_area: f64,
+    /// Let yarns carry compression too.
+    #[arg(long)]
+    compressible_yarns: bool,
+    /// Yarn pretension as an initial strain ε₀ (the yarns start with E·A·ε₀; the membrane
+    /// around is not pre-stressed, so relax the model first, e.g. with --mass-damping).
+    #[arg(long, default_value_t = 0.0)]
+    pretension_strain: f64,
+    /// Crimp: z offset of warp and weft at the crossings, ± [m].
+    #[arg(long, default_value_t = 0.0)]
+    crimp: f64,
+    /// Link stiffness k_x = k_y [N/m] (the paper's fitted 3.8661·10³ N/mm).
+    #[arg(long, default_value_t = 3.8661e6)]
+    k_xy: f64,
+    /// Link stiffness k_z [N/m] (the paper's fitted 5.2448·10⁶ N/mm).
+    #[arg(long, default_value_t = 5.2448e9)]
+    k_z: f64,
+    /// Link dashpots c_x = c_y [N·s/m].
+    #[arg(long, default_value_t = 0.0)]
+    c_xy: f64,
+    /// Link dashpot c_z [N·s/m].
+    #[arg(long, default_value_t = 0.0)]
+    c_z: f64,
+    /// Link friction slider: tangential slip force [N] [default: none].
+    #[arg(long)]
+    slip_force: Option<f64>,
+    /// Side of the whole model [m].
+    #[arg(long, default_value_t = 0.1)]
+    length: f64,
+    /// Growth ratio of the membrane cells away from the patch.
+    #[arg(long, default_value_t = 1.25)]
+    growth: f64,
+    /// Full model instead of the quarter.
+    #[arg(long)]
+    full: bool,
+    /// Projectile nose: flat, round or sphere.
+    #[arg(long, value_enum, default_value_t = ProjectileShape::Flat)]
+    projectile_shape: ProjectileShape,
+    /// Projectile radius [m] (9 mm calibre).
+    #[arg(long, default_value_t = 4.5e-3)]
+    projectile_radius: f64,
+    /// Projectile mass [kg] (a quarter model carries a quarter).
+    #[arg(long, default_value_t = 8e-3)]
+    projectile_mass: f64,
+    /// Impact velocity [m/s].
+    #[arg(long, default_value_t = 400.0)]
+    projectile_velocity: f64,
+    /// Simulated time [s].
+    #[arg(long, default_value_t = 5e-5)]
+    end_time: f64,
+    /// Output interval [s].
+    #[arg(long, default_value_t = 1e-6)]
+    output_interval: f64,
 }
 
 #[derive(clap::Args)]
@@ -105,8 +249,8 @@ struct GirderArgs {
     /// Joints: rigid (beams, shear stiffness E·h·b³/(2a³)) or pinned (trusses, none).
     #[arg(long, value_enum, default_value_t = Joints::Rigid)]
     joints: Joints,
-    /// Give the boundary rods the full section [default: half the height, as half a cell
-    /// of the lattice, so that the girder matches its equivalent membrane of side L].
+    /// Give the boundary rods full properties [default: half the modulus and density, as
+    /// half a cell of the lattice, so that the girder matches its equivalent membrane of side L].
     #[arg(long)]
     full_edge_rods: bool,
 }
@@ -210,6 +354,89 @@ fn run() -> anyhow::Result<()> {
                 p.b(),
                 p.h(),
                 a.square.out.display()
+            );
+        }
+        Model::Combined(a) => {
+            let cell = a.centre_length / a.centre_cells.max(1) as f64;
+            let b = a.rod_width.unwrap_or(cell / 10.0);
+            let c = a.length * 0.5 * (a.density / a.youngs_modulus).sqrt();
+            let end = a.end_time.unwrap_or(4.0 * c);
+            let p = CombinedParams {
+                centre: a.centre,
+                centre_length: a.centre_length,
+                centre_cells: a.centre_cells,
+                length: a.length,
+                coarsening: a.coarsening,
+                growth: a.growth,
+                quarter: !a.full,
+                youngs_modulus: a.youngs_modulus,
+                density: a.density,
+                rod_width: b,
+                membrane: MembraneProps {
+                    youngs_modulus: a.youngs_modulus,
+                    poisson_ratio: 0.0,
+                    shear_modulus: a
+                        .shear_modulus
+                        .unwrap_or(a.youngs_modulus * (b / cell).powi(2) / 2.0),
+                    thickness: a.thickness.unwrap_or(b * b / cell),
+                    density: a.membrane_density.unwrap_or(a.density * (2.0 - b / cell)),
+                },
+                force: a.force,
+                pulse: a
+                    .pulse
+                    .unwrap_or(a.centre_length * (a.density / a.youngs_modulus).sqrt()),
+                end_time: end,
+                output_interval: a.output_interval.unwrap_or(end / 100.0),
+            };
+            let m = combined(&p).context("cannot build the combined model")?;
+            let prov = Provenance::new("weave combined", serde_json::to_value(&p)?);
+            write_model(&m, &a.out, &prov)
+                .with_context(|| format!("cannot write model `{}`", a.out.display()))?;
+            eprintln!(
+                "weft-weave combined: {} nodes, {} elements, {} ties -> {}",
+                m.num_nodes(),
+                m.num_elements(),
+                m.ties.len(),
+                a.out.display()
+            );
+        }
+        Model::WovenReduced(a) => {
+            let d = WovenParams::paper();
+            let p = WovenParams {
+                yarns: a.yarns,
+                spacing: a.spacing,
+                yarn_modulus: a.yarn_modulus,
+                yarn_density: a.yarn_density,
+                yarn_area: a.yarn_area,
+                tension_only: !a.compressible_yarns,
+                pretension_strain: a.pretension_strain,
+                crimp: a.crimp,
+                k_xy: a.k_xy,
+                k_z: a.k_z,
+                c_xy: a.c_xy,
+                c_z: a.c_z,
+                slip_force: a.slip_force,
+                length: a.length,
+                growth: a.growth,
+                quarter: !a.full,
+                projectile_shape: a.projectile_shape,
+                projectile_radius: a.projectile_radius,
+                projectile_mass: a.projectile_mass,
+                projectile_velocity: a.projectile_velocity,
+                end_time: a.end_time,
+                output_interval: a.output_interval,
+                ..d
+            };
+            let m = woven_reduced(&p).context("cannot build the reduced woven model")?;
+            let prov = Provenance::new("weave woven-reduced", serde_json::to_value(&p)?);
+            write_model(&m, &a.out, &prov)
+                .with_context(|| format!("cannot write model `{}`", a.out.display()))?;
+            eprintln!(
+                "weft-weave woven-reduced: {} nodes, {} elements, {} ties -> {}",
+                m.num_nodes(),
+                m.num_elements(),
+                m.ties.len(),
+                a.out.display()
             );
         }
         Model::Membrane(a) => {

@@ -4,3 +4,4 @@
 pub mod grid;
 pub mod rod;
 pub mod square;
+pub mod zones;

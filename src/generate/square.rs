@@ -32,7 +32,7 @@ pub enum LoadCase {
 pub const STEPS_PER_PULSE: f64 = 40.0;
 
 /// Choose a time step that resolves the pulse when the stable step does not.
-fn resolve_pulse(m: &mut Model) -> Result<()> {
+pub(crate) fn resolve_pulse(m: &mut Model) -> Result<()> {
     let t_f = m.loads.iter().find_map(|l| match l.law {
         TimeLaw::SinePulse { duration, .. } => Some(duration),
         _ => None,
@@ -157,7 +157,7 @@ pub struct GirderParams {
     pub rod_thickness: Option<f64>,
     /// Rigid joints (beams) or pinned joints (trusses).
     pub rigid: bool,
-    /// Rods along the boundary with the full section instead of half the height.
+    /// Rods along the boundary with full properties instead of half the modulus and density.
     pub full_edge_rods: bool,
 }
 
@@ -175,8 +175,8 @@ impl GirderParams {
 ///
 /// Each rod is a prism of b × h between joint centres; the b × b crossings would be
 /// counted twice, so the rods carry the density ρ(1 − b/(2a)), which gives the lattice's
-/// areal density ρ·b·h·(2 − b/a)/a exactly (DESIGN.md §8). Rods on the boundary have
-/// half the height (half a cell each), unless `full_edge_rods`.
+/// areal density ρ·b·h·(2 − b/a)/a exactly (DESIGN.md §8). Rods on the boundary stand for
+/// half a cell: half the modulus and half the density, unless `full_edge_rods`.
 pub fn girder(p: &GirderParams) -> Result<(Model, Vec<String>)> {
     positive("youngs-modulus", p.youngs_modulus, "in Pa")?;
     positive("density", p.density, "in kg/m³")?;
@@ -212,11 +212,11 @@ pub fn girder(p: &GirderParams) -> Result<(Model, Vec<String>)> {
         ElementKind::Truss
     };
     let rho = p.density * (1.0 - b / (2.0 * a));
-    let props = |h: f64| {
+    let props = |f: f64| {
         if p.rigid {
             PartProps {
-                youngs_modulus: Some(p.youngs_modulus),
-                density: Some(rho),
+                youngs_modulus: Some(f * p.youngs_modulus),
+                density: Some(f * rho),
                 width: Some(b),
                 height: Some(h),
                 poisson_ratio: Some(0.0),
@@ -224,21 +224,21 @@ pub fn girder(p: &GirderParams) -> Result<(Model, Vec<String>)> {
             }
         } else {
             PartProps {
-                youngs_modulus: Some(p.youngs_modulus),
-                density: Some(rho),
+                youngs_modulus: Some(f * p.youngs_modulus),
+                density: Some(f * rho),
                 area: Some(b * h),
                 ..Default::default()
             }
         }
     };
-    let part = m.add_part(1, "rods", kind, props(h));
-    // Rods on the boundary stand for half a cell of the lattice: half the height halves
-    // their axial and in-plane bending stiffness and their mass, so that the girder of
-    // side L matches the lattice (and its equivalent membrane of side L) exactly.
+    let part = m.add_part(1, "rods", kind, props(1.0));
+    // Rods on the boundary stand for half a cell of the lattice: half the modulus and half
+    // the density at the full section halve every stiffness and the mass, so that the
+    // girder of side L matches the lattice (and its equivalent membrane of side L).
     let edge = if p.full_edge_rods {
         part
     } else {
-        m.add_part(2, "edge_rods", kind, props(0.5 * h))
+        m.add_part(2, "edge_rods", kind, props(0.5))
     };
     let id = |i: usize, j: usize| j * (n + 1) + i;
     let mut eid = 1;

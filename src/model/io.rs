@@ -126,6 +126,7 @@ fn read_model_inner(dir: &Path) -> Result<Model> {
     );
     let (thick, hg, angle) = (f("thickness")?, f("hourglass")?, f("material_angle")?);
     let (width, height, nu) = (f("width")?, f("height")?, f("poisson_ratio")?);
+    let prestrain = f("prestrain")?;
     let no_comp = t
         .bool_opt("no_compression")?
         .unwrap_or_else(|| vec![None; ids.len()]);
@@ -174,6 +175,7 @@ fn read_model_inner(dir: &Path) -> Result<Model> {
                 width: width[row],
                 height: height[row],
                 poisson_ratio: nu[row],
+                prestrain: prestrain[row],
             },
         };
         validate_part(&part).map_err(|err| err.in_file(&t.path).at_row(row))?;
@@ -625,6 +627,7 @@ fn write_tables(m: &Model, dir: &Path, prov: &Provenance) -> Result<()> {
             Col::OptF64("width", pc(|q| q.width)),
             Col::OptF64("height", pc(|q| q.height)),
             Col::OptF64("poisson_ratio", pc(|q| q.poisson_ratio)),
+            Col::OptF64("prestrain", pc(|q| q.prestrain)),
         ]),
         prov,
     )?;

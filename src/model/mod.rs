@@ -76,6 +76,9 @@ pub struct PartProps {
     pub area: Option<f64>,
     /// Truss carries no compression when true.
     pub tension_only: Option<bool>,
+    /// Truss initial strain ε₀ (pretension): the reference length is the geometric length
+    /// over (1 + ε₀), so the truss starts with the force E·A·ε₀. Null = 0.
+    pub prestrain: Option<f64>,
     /// Link spring stiffnesses along global x, y, z [N/m].
     pub kx: Option<f64>,
     pub ky: Option<f64>,
@@ -225,7 +228,8 @@ pub struct Load {
 }
 
 /// Shape of a rigid projectile's nose.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
 pub enum ProjectileShape {
     Sphere,
     /// Flat-nosed cylinder.
@@ -718,6 +722,16 @@ pub fn validate_part(p: &Part) -> Result<()> {
             require_pos(p, "youngs_modulus", q.youngs_modulus, "in Pa")?;
             require_pos(p, "density", q.density, "in kg/m³")?;
             require_pos(p, "area", q.area, "in m²")?;
+            if let Some(e0) = q.prestrain {
+                if !(e0 > -0.5 && e0 < 0.5) {
+                    return Err(WeftError::input(format!(
+                        "part `{}` has prestrain = `{e0}`",
+                        p.name
+                    ))
+                    .in_column("prestrain")
+                    .expected("a small strain, −0.5 < ε₀ < 0.5"));
+                }
+            }
         }
         ElementKind::Link => {
             for (c, v) in [("kx", q.kx), ("ky", q.ky), ("kz", q.kz)] {

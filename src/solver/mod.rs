@@ -573,8 +573,10 @@ impl Solver {
                 mass[c] += 0.5 * me;
                 truss.id.push(b.id[e]);
                 truss.nodes.push([a as u32, c as u32]);
-                truss.k.push(e_mod * area / l0);
-                truss.l0.push(l0);
+                // Pretension: the unstressed length is shorter than the geometric one.
+                let lref = l0 / (1.0 + p.prestrain.unwrap_or(0.0));
+                truss.k.push(e_mod * area / lref);
+                truss.l0.push(lref);
                 truss.tension_only.push(p.tension_only.unwrap_or(false));
             }
         }

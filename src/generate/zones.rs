@@ -1,0 +1,719 @@
+//! Coupled zones: a dense centre (a girder, a fine membrane, or the reduced woven patch)
+//! inside a coarse membrane whose elements grow with distance from the centre, joined by
+//! tied interfaces (the paper's §3–§5 models).
+//!
+//! The coarse membrane is a tensor-product grid of lines: uniform at spacing h_c across
+//! the centre, then growing by the ratio r out to the outer boundary, with the centre
+//! square [−c, c]² left as a hole. Every node of the dense zone on the hole's boundary is
+//! tied to the coarse edge it lies on, so no node hangs without a tie. With quarter
+//! symmetry the model is [0, ·]² with symmetry planes x = 0 and y = 0.
+
+use serde::Serialize;
+
+use crate::error::{Result, WeftError};
+use crate::model::{
+    Analysis, ElementKind, Load, Model, PartProps, ProjectileShape, ProjectileSpec, SymmetryPlane,
+    Tie, TimeLaw,
+};
+
+/// Line positions ≥ 0: uniform h_c up to `c`, then growing by `ratio` to `outer`.
+pub fn graded_lines(c: f64, hc: f64, outer: f64, ratio: f64) -> Result<Vec<f64>> {
+    let n = (c / hc).round() as usize;
+    if n == 0 || ((n as f64) * hc - c).abs() > 1e-9 * c {
+        return Err(WeftError::input(format!(
+            "the centre half-size {c} m is not a multiple of the coarse spacing {hc} m"
+        ))
+        .expected("a coarse spacing that divides the centre zone"));
+    }
+    if !(outer > c) {
+        return Err(WeftError::input(format!(
+            "outer half-size {outer} m is not larger than the centre half-size {c} m"
+        ))
+        .expected("outer > centre"));
+    }
+    let mut v: Vec<f64> = (0..=n).map(|k| k as f64 * hc).collect();
+    let (mut x, mut h) = (c, hc);
+    while x + h * ratio < outer - 0.5 * h * ratio {
+        h *= ratio;
+        x += h;
+        v.push(x);
+    }
+    // The last cell ends on the boundary.
+    if (outer - x) > 1e-12 {
+        v.push(outer);
+    }
+    Ok(v)
+}
+
+/// Membrane properties for the coarse zone.
+#[derive(Debug, Clone, Serialize)]
+pub struct MembraneProps {
+    pub youngs_modulus: f64,
+    pub poisson_ratio: f64,
+    pub shear_modulus: f64,
+    pub thickness: f64,
+    pub density: f64,
+}
+
+impl MembraneProps {
+    fn part(&self) -> PartProps {
+        PartProps {
+            youngs_modulus_1: Some(self.youngs_modulus),
+            youngs_modulus_2: Some(self.youngs_modulus),
+            poisson_ratio_12: Some(self.poisson_ratio),
+            shear_modulus_12: Some(self.shear_modulus),
+            thickness: Some(self.thickness),
+            density: Some(self.density),
+            ..Default::default()
+        }
+    }
+}
+
+/// The coarse graded membrane with a hole; returns, for each side of the hole
+/// (x = c, y = c, and for a full model x = −c, y = −c), its boundary nodes ordered along it.
+struct Coarse {
+    /// (fixed coordinate axis, value, nodes ordered by the other coordinate)
+    hole_sides: Vec<(usize, f64, Vec<usize>)>,
+    /// Outer boundary nodes.
+    outer: Vec<usize>,
+}
+
+fn coarse_membrane(
+    m: &mut Model,
+    pos: &[f64],
+    quarter: bool,
+    c: f64,
+    props: &MembraneProps,
+    first_id: i64,
+) -> Coarse {
+    let lines: Vec<f64> = if quarter {
+        pos.to_vec()
+    } else {
+        pos.iter()
+            .rev()
+            .map(|x| -x)
+            .chain(pos[1..].iter().cloned())
+            .collect()
+    };
+    let k = lines.len();
+    let inside = |x: f64| x.abs() < c - 1e-12;
+    let mut used = vec![false; k * k];
+    let mut cells = vec![];
+    for j in 0..k - 1 {
+        for i in 0..k - 1 {
+            let (xm, ym) = (
+                0.5 * (lines[i] + lines[i + 1]),
+                0.5 * (lines[j] + lines[j + 1]),
+            );
+            if inside(xm) && inside(ym) {
+                continue;
+            }
+            cells.push((i, j));
+            for (a, b) in [(i, j), (i + 1, j), (i + 1, j + 1), (i, j + 1)] {
+                used[b * k + a] = true;
+            }
+        }
+    }
+    let mut idx = vec![usize::MAX; k * k];
+    let mut nid = first_id;
+    for j in 0..k {
+        for i in 0..k {
+            if used[j * k + i] {
+                idx[j * k + i] = m.add_node(nid, [lines[i], lines[j], 0.0]);
+                nid += 1;
+            }
+        }
+    }
+    let part = m.add_part(90, "coarse_membrane", ElementKind::Quad, props.part());
+    let mut eid = 1_000_000i64;
+    for (i, j) in cells {
+        m.add_element(
+            eid,
+            part,
+            &[
+                idx[j * k + i],
+                idx[j * k + i + 1],
+                idx[(j + 1) * k + i + 1],
+                idx[(j + 1) * k + i],
+            ],
+        );
+        eid += 1;
+    }
+    let near = |a: f64, b: f64| (a - b).abs() < 1e-9 * c.max(1e-12);
+    let mut hole_sides = vec![];
+    let sides: Vec<(usize, f64)> = if quarter {
+        vec![(0, c), (1, c)]
+    } else {
+        vec![(0, c), (1, c), (0, -c), (1, -c)]
+    };
+    for (axis, v) in sides {
+        let mut ns: Vec<usize> = (0..k * k)
+            .filter(|&q| idx[q] != usize::MAX)
+            .map(|q| idx[q])
+            .filter(|&n| {
+                near(m.coords[n][axis], v)
+                    && m.coords[n][1 - axis].abs() <= c + 1e-12
+                    && (!quarter || m.coords[n][1 - axis] >= -1e-12)
+            })
+            .collect();
+        ns.sort_by(|&a, &b| m.coords[a][1 - axis].total_cmp(&m.coords[b][1 - axis]));
+        hole_sides.push((axis, v, ns));
+    }
+    let lo = lines[0];
+    let hi = lines[k - 1];
+    let outer = (0..k * k)
+        .filter(|&q| idx[q] != usize::MAX)
+        .map(|q| idx[q])
+        .filter(|&n| {
+            let x = m.coords[n];
+            (!quarter && (near(x[0], lo) || near(x[1], lo))) || near(x[0], hi) || near(x[1], hi)
+        })
+        .collect();
+    Coarse { hole_sides, outer }
+}
+
+/// Tie every listed fine node lying on a hole side to the coarse edge it lies on.
+fn tie_to_hole(m: &mut Model, coarse: &Coarse, fine: &[usize]) -> Result<Vec<usize>> {
+    let mut tied = vec![];
+    for &f in fine {
+        let x = m.coords[f];
+        let mut done = false;
+        for (axis, v, ns) in &coarse.hole_sides {
+            if (x[*axis] - v).abs() > 1e-9 * v.abs().max(1e-12) {
+                continue;
+            }
+            let s = x[1 - axis];
+            let k = ns.windows(2).position(|w| {
+                m.coords[w[0]][1 - axis] <= s + 1e-12 && s <= m.coords[w[1]][1 - axis] + 1e-12
+            });
+            if let Some(k) = k {
+                m.ties.push(Tie {
+                    slave: f,
+                    masters: vec![ns[k], ns[k + 1]],
+                });
+                tied.push(f);
+                done = true;
+                break;
+            }
+        }
+        if !done {
+            return Err(WeftError::input(format!(
+                "node `{}` at {:?} is on no side of the coarse zone's hole",
+                m.node_id[f], x
+            ))
+            .expected("the dense zone's boundary on the coarse grid's hole"));
+        }
+    }
+    Ok(tied)
+}
+
+/// Order nodes along y = 0 by x, then x = y by x.
+fn line_sets(m: &mut Model, candidates: &[usize], name: &str, on: impl Fn(&[f64; 3]) -> bool) {
+    let mut v: Vec<usize> = candidates
+        .iter()
+        .copied()
+        .filter(|&n| on(&m.coords[n]))
+        .collect();
+    v.sort_by(|&a, &b| m.coords[a][0].total_cmp(&m.coords[b][0]));
+    v.dedup_by(|a, b| (m.coords[*a][0] - m.coords[*b][0]).abs() < 1e-12);
+    m.node_sets.insert(name.into(), v);
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum Centre {
+    /// A rigid-jointed girder.
+    Girder,
+    /// A fine membrane.
+    Membrane,
+}
+
+/// `combined`: a dense centre zone (girder or fine membrane) in a graded coarse membrane.
+#[derive(Debug, Clone, Serialize)]
+pub struct CombinedParams {
+    pub centre: Centre,
+    /// Side of the dense centre zone L_m [m].
+    pub centre_length: f64,
+    /// Cells across the centre zone (even).
+    pub centre_cells: usize,
+    /// Side of the whole model L [m].
+    pub length: f64,
+    /// Coarse cell size at the centre, in centre cells.
+    pub coarsening: usize,
+    /// Growth ratio of the coarse cells.
+    pub growth: f64,
+    pub quarter: bool,
+    /// Girder: E, ρ, b = h (rods) [Pa, kg/m³, m].
+    pub youngs_modulus: f64,
+    pub density: f64,
+    pub rod_width: f64,
+    /// The coarse membrane (and the fine one).
+    pub membrane: MembraneProps,
+    /// Transverse force at the centre [N], pulse T_F [s], end time [s], output [s].
+    pub force: f64,
+    pub pulse: f64,
+    pub end_time: f64,
+    pub output_interval: f64,
+}
+
+pub fn combined(p: &CombinedParams) -> Result<Model> {
+    if p.centre_cells == 0 || p.centre_cells % 2 != 0 {
+        return Err(
+            WeftError::input(format!("--centre-cells = `{}`", p.centre_cells))
+                .expected("an even number of cells > 0 (a node at the centre)"),
+        );
+    }
+    if p.coarsening == 0 || (p.centre_cells / 2) % p.coarsening != 0 {
+        return Err(
+            WeftError::input(format!("--coarsening = `{}`", p.coarsening)).expected(format!(
+                "a divisor of centre-cells/2 = {}",
+                p.centre_cells / 2
+            )),
+        );
+    }
+    let a = p.centre_length / p.centre_cells as f64;
+    let c = 0.5 * p.centre_length;
+    let pos = graded_lines(c, a * p.coarsening as f64, 0.5 * p.length, p.growth)?;
+    let mut m = Model::default();
+    // Dense zone: nodes on the centre grid (ids from 1), quarter or full.
+    let (lo, n) = if p.quarter {
+        (0usize, p.centre_cells / 2)
+    } else {
+        (0, p.centre_cells)
+    };
+    let x0 = if p.quarter { 0.0 } else { -c };
+    let mut fine = vec![];
+    for j in lo..=n {
+        for i in lo..=n {
+            fine.push(m.add_node(
+                (fine.len() + 1) as i64,
+                [x0 + i as f64 * a, x0 + j as f64 * a, 0.0],
+            ));
+        }
+    }
+    let w = n + 1;
+    let id = |i: usize, j: usize| fine[j * w + i];
+    match p.centre {
+        Centre::Girder => {
+            let rod = |f: f64| PartProps {
+                youngs_modulus: Some(f * p.youngs_modulus),
+                density: Some(f * p.density * (1.0 - p.rod_width / (2.0 * a))),
+                width: Some(p.rod_width),
+                height: Some(p.rod_width),
+                poisson_ratio: Some(0.0),
+                ..Default::default()
+            };
+            let part = m.add_part(1, "rods", ElementKind::Beam, rod(1.0));
+            // Rods on the hole boundary (half a cell; the membrane carries the other half)
+            // and on a symmetry plane (half belongs to the neighbouring quarter) carry half
+            // of everything: half the modulus and half the density at the full section
+            // halve every stiffness (axial, both bendings, torsion) and the mass alike.
+            let half = m.add_part(2, "half_rods", ElementKind::Beam, rod(0.5));
+            let on_line = |k: usize| k == n || (p.quarter && k == 0) || (!p.quarter && k == 0);
+            let mut eid = 1;
+            for j in 0..=n {
+                for i in 0..=n {
+                    if i < n {
+                        m.add_element(
+                            eid,
+                            if on_line(j) { half } else { part },
+                            &[id(i, j), id(i + 1, j)],
+                        );
+                        eid += 1;
+                    }
+                    if j < n {
+                        m.add_element(
+                            eid,
+                            if on_line(i) { half } else { part },
+                            &[id(i, j), id(i, j + 1)],
+                        );
+                        eid += 1;
+                    }
+                }
+            }
+        }
+        Centre::Membrane => {
+            let part = m.add_part(1, "fine_membrane", ElementKind::Quad, p.membrane.part());
+            let mut eid = 1;
+            for j in 0..n {
+                for i in 0..n {
+                    m.add_element(
+                        eid,
+                        part,
+                        &[id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)],
+                    );
+                    eid += 1;
+                }
+            }
+        }
+    }
+    let coarse = coarse_membrane(&mut m, &pos, p.quarter, c, &p.membrane, 100_000);
+    let boundary: Vec<usize> = fine
+        .iter()
+        .copied()
+        .filter(|&f| {
+            let x = m.coords[f];
+            (x[0].abs() - c).abs() < 1e-12 || (x[1].abs() - c).abs() < 1e-12
+        })
+        .collect();
+    let tied = tie_to_hole(&mut m, &coarse, &boundary)?;
+    for &o in &coarse.outer {
+        m.constraints.push((o, [true, true, true]));
+    }
+    if p.quarter {
+        m.symmetry.push(SymmetryPlane {
+            normal: 0,
+            position: 0.0,
+            tolerance: 1e-9 * p.length,
+        });
+        m.symmetry.push(SymmetryPlane {
+            normal: 1,
+            position: 0.0,
+            tolerance: 1e-9 * p.length,
+        });
+    }
+    let centre = *fine
+        .iter()
+        .find(|&&f| m.coords[f][0].abs() < 1e-12 && m.coords[f][1].abs() < 1e-12)
+        .expect("a centre node");
+    let share = if p.quarter { 0.25 } else { 1.0 };
+    m.loads.push(Load {
+        id: 1,
+        node: centre,
+        force: [0.0, 0.0, share * p.force],
+        law: TimeLaw::SinePulse {
+            start: 0.0,
+            duration: p.pulse,
+        },
+    });
+    let all: Vec<usize> = (0..m.num_nodes()).collect();
+    m.node_sets.insert("reference".into(), fine.clone());
+    m.node_sets.insert("interface".into(), tied);
+    // Along y = 0 and x = y: the dense zone's nodes, then the coarse ones beyond it.
+    let fine_set: std::collections::HashSet<usize> = fine.iter().copied().collect();
+    let keep = |n: usize, x: &[f64; 3]| {
+        fine_set.contains(&n) || x[0].abs() > c + 1e-12 || x[1].abs() > c + 1e-12
+    };
+    let cand: Vec<usize> = all
+        .iter()
+        .copied()
+        .filter(|&n| keep(n, &m.coords[n]))
+        .collect();
+    line_sets(&mut m, &cand, "axis_x", |x| {
+        x[1].abs() < 1e-12 && x[0] >= -1e-12
+    });
+    line_sets(&mut m, &cand, "diagonal", |x| {
+        (x[0] - x[1]).abs() < 1e-12 && x[0] >= -1e-12
+    });
+    m.analysis = Analysis {
+        end_time: p.end_time,
+        output_interval: p.output_interval,
+        ..Default::default()
+    };
+    m.validate()?;
+    crate::generate::square::resolve_pulse(&mut m)?;
+    Ok(m)
+}
+
+/// `woven-reduced`: the reduced woven model of the paper's §5.
+#[derive(Debug, Clone, Serialize)]
+pub struct WovenParams {
+    /// Yarns per side of the full patch (even).
+    pub yarns: usize,
+    /// Yarn spacing p [m].
+    pub spacing: f64,
+    /// Yarn: E [Pa], ρ [kg/m³], cross-section area [m²], tension only.
+    pub yarn_modulus: f64,
+    pub yarn_density: f64,
+    pub yarn_area: f64,
+    pub tension_only: bool,
+    /// Initial yarn strain (pretension) ε₀.
+    pub pretension_strain: f64,
+    /// Crimp: z offset ± of warp and weft nodes at the crossings [m].
+    pub crimp: f64,
+    /// Links: k_x = k_y, k_z [N/m], c_x, c_y, c_z [N·s/m], slip force [N] (None: none).
+    pub k_xy: f64,
+    pub k_z: f64,
+    pub c_xy: f64,
+    pub c_z: f64,
+    pub slip_force: Option<f64>,
+    /// Whole model side [m], coarse membrane growth ratio, quarter symmetry.
+    pub length: f64,
+    pub growth: f64,
+    pub quarter: bool,
+    pub membrane: MembraneProps,
+    /// Projectile: flat-nosed by default.
+    pub projectile_shape: ProjectileShape,
+    pub projectile_radius: f64,
+    pub projectile_mass: f64,
+    pub projectile_velocity: f64,
+    pub end_time: f64,
+    pub output_interval: f64,
+}
+
+impl WovenParams {
+    /// The paper's §5 model (DESIGN.md §1, §9): aramid yarns 1 mm apart (E = 80 GPa,
+    /// ρ = 1440 kg/m³, 190 g/m² together: A = 6.6·10⁻⁸ m² per yarn), links at the fitted
+    /// k_x = k_y = 3.8661·10⁶ N/m, k_z = 5.2448·10⁹ N/m (the paper's N/mm values, its
+    /// exponents corrected), a 9 mm, 8 g flat-nosed projectile at 400 m/s; the equivalent
+    /// membrane from the paper's §3 ratios: areal density 0.8 of the patch's, E = 0.3 E_yarn,
+    /// G = 0.0042 E, thickness 2A/p.
+    pub fn paper() -> WovenParams {
+        let (p, a) = (1e-3, 6.6e-8);
+        let s = 2.0 * a / p;
+        let areal = 2.0 * 1440.0 * a / p;
+        let e_m = 0.3 * 80e9;
+        WovenParams {
+            yarns: 20,
+            spacing: p,
+            yarn_modulus: 80e9,
+            yarn_density: 1440.0,
+            yarn_area: a,
+            tension_only: true,
+            pretension_strain: 0.0,
+            crimp: 0.0,
+            k_xy: 3.8661e6,
+            k_z: 5.2448e9,
+            c_xy: 0.0,
+            c_z: 0.0,
+            slip_force: None,
+            length: 0.1,
+            growth: 1.25,
+            quarter: true,
+            membrane: MembraneProps {
+                youngs_modulus: e_m,
+                poisson_ratio: 0.0,
+                shear_modulus: 0.0042 * e_m,
+                thickness: s,
+                density: 0.8 * areal / s,
+            },
+            projectile_shape: ProjectileShape::Flat,
+            projectile_radius: 4.5e-3,
+            projectile_mass: 8e-3,
+            projectile_velocity: 400.0,
+            end_time: 5e-5,
+            output_interval: 1e-6,
+        }
+    }
+}
+
+pub fn woven_reduced(p: &WovenParams) -> Result<Model> {
+    if p.yarns < 2 || p.yarns % 2 != 0 {
+        return Err(WeftError::input(format!("--yarns = `{}`", p.yarns))
+            .expected("an even number ≥ 2 (a crossing at the centre)"));
+    }
+    for (n, v) in [
+        ("spacing", p.spacing),
+        ("yarn-modulus", p.yarn_modulus),
+        ("yarn-density", p.yarn_density),
+        ("yarn-area", p.yarn_area),
+        ("k-z", p.k_z),
+        ("k-xy", p.k_xy),
+    ] {
+        if !(v > 0.0 && v.is_finite()) {
+            return Err(WeftError::input(format!("--{n} = `{v}`")).expected("a value > 0"));
+        }
+    }
+    let c = 0.5 * p.yarns as f64 * p.spacing;
+    let pos = graded_lines(c, p.spacing, 0.5 * p.length, p.growth)?;
+    let mut m = Model::default();
+    let (n, x0) = if p.quarter {
+        (p.yarns / 2, 0.0)
+    } else {
+        (p.yarns, -c)
+    };
+    let w = n + 1;
+    let mut warp = vec![];
+    let mut weft = vec![];
+    for j in 0..=n {
+        for i in 0..=n {
+            let (x, y) = (x0 + i as f64 * p.spacing, x0 + j as f64 * p.spacing);
+            let boundary = (x.abs() - c).abs() < 1e-12 || (y.abs() - c).abs() < 1e-12;
+            // Plain weave: the warp passes over and under alternately; flat on the boundary.
+            let z = if boundary {
+                0.0
+            } else if (i + j) % 2 == 0 {
+                p.crimp
+            } else {
+                -p.crimp
+            };
+            warp.push(m.add_node((2 * (j * w + i) + 1) as i64, [x, y, z]));
+            weft.push(m.add_node((2 * (j * w + i) + 2) as i64, [x, y, -z]));
+        }
+    }
+    let yarn = m.add_part(
+        1,
+        "yarns",
+        ElementKind::Truss,
+        PartProps {
+            youngs_modulus: Some(p.yarn_modulus),
+            density: Some(p.yarn_density),
+            area: Some(p.yarn_area),
+            tension_only: Some(p.tension_only),
+            prestrain: (p.pretension_strain != 0.0).then_some(p.pretension_strain),
+            ..Default::default()
+        },
+    );
+    let link = m.add_part(
+        2,
+        "crossings",
+        ElementKind::Link,
+        PartProps {
+            kx: Some(p.k_xy),
+            ky: Some(p.k_xy),
+            kz: Some(p.k_z),
+            cx: Some(p.c_xy),
+            cy: Some(p.c_xy),
+            cz: Some(p.c_z),
+            slip_force: p.slip_force,
+            ..Default::default()
+        },
+    );
+    // In a quarter model, what lies on a symmetry plane is shared with the neighbouring
+    // quarter: the yarns along x = 0 or y = 0 get half the area, the links on one plane
+    // half, the centre link a quarter of their stiffness, damping and slip force.
+    let scaled = |f: f64, base: &PartProps| PartProps {
+        kx: base.kx.map(|v| v * f),
+        ky: base.ky.map(|v| v * f),
+        kz: base.kz.map(|v| v * f),
+        cx: base.cx.map(|v| v * f),
+        cy: base.cy.map(|v| v * f),
+        cz: base.cz.map(|v| v * f),
+        slip_force: base.slip_force.map(|v| v * f),
+        ..base.clone()
+    };
+    let (half_yarn, half_link, quarter_link) = if p.quarter {
+        let yp = m.parts[yarn].props.clone();
+        let lp = m.parts[link].props.clone();
+        (
+            m.add_part(
+                3,
+                "yarns_on_symmetry",
+                ElementKind::Truss,
+                PartProps {
+                    area: Some(0.5 * p.yarn_area),
+                    ..yp
+                },
+            ),
+            m.add_part(
+                4,
+                "crossings_on_symmetry",
+                ElementKind::Link,
+                scaled(0.5, &lp),
+            ),
+            m.add_part(5, "centre_crossing", ElementKind::Link, scaled(0.25, &lp)),
+        )
+    } else {
+        (yarn, link, link)
+    };
+    let mut eid = 1;
+    for j in 0..=n {
+        for i in 0..=n {
+            let k = j * w + i;
+            if i < n {
+                m.add_element(
+                    eid,
+                    if p.quarter && j == 0 { half_yarn } else { yarn },
+                    &[warp[k], warp[k + 1]],
+                );
+                eid += 1;
+            }
+            if j < n {
+                m.add_element(
+                    eid,
+                    if p.quarter && i == 0 { half_yarn } else { yarn },
+                    &[weft[k], weft[k + w]],
+                );
+                eid += 1;
+            }
+            let lk = match (p.quarter && i == 0, p.quarter && j == 0) {
+                (true, true) => quarter_link,
+                (true, false) | (false, true) => half_link,
+                _ => link,
+            };
+            m.add_element(eid, lk, &[warp[k], weft[k]]);
+            eid += 1;
+        }
+    }
+    let coarse = coarse_membrane(&mut m, &pos, p.quarter, c, &p.membrane, 1_000_000);
+    // Warp ends on the sides x = ±c, weft ends on y = ±c; both yarns at the corners.
+    let ends: Vec<usize> = (0..warp.len())
+        .flat_map(|k| {
+            let x = m.coords[warp[k]];
+            let mut v = vec![];
+            if (x[0].abs() - c).abs() < 1e-12 {
+                v.push(warp[k]);
+            }
+            if (x[1].abs() - c).abs() < 1e-12 {
+                v.push(weft[k]);
+            }
+            v
+        })
+        .collect();
+    let tied = tie_to_hole(&mut m, &coarse, &ends)?;
+    // Yarn nodes on the boundary lines that are not yarn ends would have no mass path if
+    // untied: every boundary node of both yarns is tied.
+    let others: Vec<usize> = (0..warp.len())
+        .flat_map(|k| [warp[k], weft[k]])
+        .filter(|n| !tied.contains(n))
+        .filter(|&n| {
+            let x = m.coords[n];
+            (x[0].abs() - c).abs() < 1e-12 || (x[1].abs() - c).abs() < 1e-12
+        })
+        .collect();
+    let mut tied2 = tie_to_hole(&mut m, &coarse, &others)?;
+    let mut interface = tied;
+    interface.append(&mut tied2);
+    for &o in &coarse.outer {
+        m.constraints.push((o, [true, true, true]));
+    }
+    if p.quarter {
+        m.symmetry.push(SymmetryPlane {
+            normal: 0,
+            position: 0.0,
+            tolerance: 1e-9 * p.length,
+        });
+        m.symmetry.push(SymmetryPlane {
+            normal: 1,
+            position: 0.0,
+            tolerance: 1e-9 * p.length,
+        });
+    }
+    let share = if p.quarter { 0.25 } else { 1.0 };
+    m.projectiles.push(ProjectileSpec {
+        id: 1,
+        shape: p.projectile_shape,
+        radius: p.projectile_radius,
+        length: 2.0 * p.projectile_radius,
+        mass: share * p.projectile_mass,
+        tip: [0.0, 0.0, p.crimp + 1e-5],
+        axis: [0.0, 0.0, -1.0],
+        velocity: [0.0, 0.0, -p.projectile_velocity],
+        prescribed_velocity: false,
+        contact_stiffness: None,
+        friction: 0.0,
+        segment_contact: true,
+    });
+    m.node_sets.insert("reference".into(), warp.clone());
+    m.node_sets.insert("interface".into(), interface);
+    let warp_set: std::collections::HashSet<usize> = warp.iter().copied().collect();
+    let keep = |n: usize, x: &[f64; 3]| {
+        warp_set.contains(&n) || x[0].abs() > c + 1e-12 || x[1].abs() > c + 1e-12
+    };
+    let cand: Vec<usize> = (0..m.num_nodes())
+        .filter(|&n| keep(n, &m.coords[n]))
+        .collect();
+    line_sets(&mut m, &cand, "axis_x", |x| {
+        x[1].abs() < 1e-12 && x[0] >= -1e-12
+    });
+    line_sets(&mut m, &cand, "diagonal", |x| {
+        (x[0] - x[1]).abs() < 1e-12 && x[0] >= -1e-12
+    });
+    m.analysis = Analysis {
+        end_time: p.end_time,
+        output_interval: p.output_interval,
+        ..Default::default()
+    };
+    m.validate()?;
+    Ok(m)
+}
