@@ -369,3 +369,58 @@ fn combined_models_run_stably_at_their_defaults() {
         assert!(worst < 0.01 * wmax, "{centre:?}: {worst} of {wmax}");
     }
 }
+
+#[test]
+fn every_generator_at_its_cli_defaults_simulates_stably_through_the_binaries() {
+    use std::process::Command;
+    let dir = tempfile::tempdir().unwrap();
+    for model in ["rod", "girder", "membrane", "combined", "woven-reduced"] {
+        let (m, o) = (
+            dir.path().join(model),
+            dir.path().join(format!("{model}-out")),
+        );
+        let st = Command::new(env!("CARGO_BIN_EXE_weft-weave"))
+            .arg(model)
+            .arg("--out")
+            .arg(&m)
+            .output()
+            .unwrap();
+        assert!(
+            st.status.success(),
+            "{model}: {}",
+            String::from_utf8_lossy(&st.stderr)
+        );
+        let t = std::time::Instant::now();
+        let st = Command::new(env!("CARGO_BIN_EXE_weft-simulate"))
+            .arg("--model")
+            .arg(&m)
+            .arg("--out")
+            .arg(&o)
+            .arg("-q")
+            .output()
+            .unwrap();
+        assert!(
+            st.status.success(),
+            "{model}: {}",
+            String::from_utf8_lossy(&st.stderr)
+        );
+        let secs = t.elapsed().as_secs_f64();
+        let e = weft::table::Table::read(&o.join("energy.parquet")).unwrap();
+        let err = e.f64("balance_error", "").unwrap();
+        let (ke, ie, w) = (
+            e.f64("kinetic", "").unwrap(),
+            e.f64("internal", "").unwrap(),
+            e.f64("external_work", "").unwrap(),
+        );
+        let scale = (0..ke.len())
+            .map(|k| w[k].abs().max(ke[0] + ie[0]).max(ke[k] + ie[k]))
+            .fold(0.0, f64::max);
+        let worst = err.iter().map(|x| x.abs()).fold(0.0, f64::max);
+        eprintln!("{model}: {secs:.2} s, energy balance {:.2e}", worst / scale);
+        assert!(
+            scale > 0.0 && worst < 0.01 * scale,
+            "{model}: {worst} of {scale}"
+        );
+        assert!(secs < 30.0, "{model}: {secs} s");
+    }
+}
