@@ -319,6 +319,17 @@ struct RodArgs {
     tension_only: bool,
 }
 
+/// Write a model folder with its provenance (the stage and its parameters).
+fn save<P: serde::Serialize>(
+    m: &weft::model::Model,
+    out: &std::path::Path,
+    stage: &str,
+    p: &P,
+) -> anyhow::Result<()> {
+    let prov = Provenance::new(stage, serde_json::to_value(p)?);
+    write_model(m, out, &prov).with_context(|| format!("cannot write model `{}`", out.display()))
+}
+
 fn main() -> ExitCode {
     match run() {
         Ok(()) => ExitCode::SUCCESS,
@@ -346,9 +357,7 @@ fn run() -> anyhow::Result<()> {
             for w in warnings {
                 eprintln!("warning: {w}");
             }
-            let prov = Provenance::new("weave girder", serde_json::to_value(&p)?);
-            write_model(&m, &a.square.out, &prov)
-                .with_context(|| format!("cannot write model `{}`", a.square.out.display()))?;
+            save(&m, &a.square.out, "weave girder", &p)?;
             eprintln!(
                 "weft-weave girder: {} nodes, {} {} rods, b = {:.3e} m, h = {:.3e} m -> {}",
                 m.num_nodes(),
@@ -392,9 +401,7 @@ fn run() -> anyhow::Result<()> {
                 output_interval: a.output_interval.unwrap_or(end / 100.0),
             };
             let m = combined(&p).context("cannot build the combined model")?;
-            let prov = Provenance::new("weave combined", serde_json::to_value(&p)?);
-            write_model(&m, &a.out, &prov)
-                .with_context(|| format!("cannot write model `{}`", a.out.display()))?;
+            save(&m, &a.out, "weave combined", &p)?;
             eprintln!(
                 "weft-weave combined: {} nodes, {} elements, {} ties -> {}",
                 m.num_nodes(),
@@ -431,9 +438,7 @@ fn run() -> anyhow::Result<()> {
                 ..d
             };
             let m = woven_reduced(&p).context("cannot build the reduced woven model")?;
-            let prov = Provenance::new("weave woven-reduced", serde_json::to_value(&p)?);
-            write_model(&m, &a.out, &prov)
-                .with_context(|| format!("cannot write model `{}`", a.out.display()))?;
+            save(&m, &a.out, "weave woven-reduced", &p)?;
             eprintln!(
                 "weft-weave woven-reduced: {} nodes, {} elements, {} ties -> {}",
                 m.num_nodes(),
@@ -453,9 +458,7 @@ fn run() -> anyhow::Result<()> {
                 ..d
             };
             let m = membrane(&p).context("cannot build the membrane")?;
-            let prov = Provenance::new("weave membrane", serde_json::to_value(&p)?);
-            write_model(&m, &a.square.out, &prov)
-                .with_context(|| format!("cannot write model `{}`", a.square.out.display()))?;
+            save(&m, &a.square.out, "weave membrane", &p)?;
             eprintln!(
                 "weft-weave membrane: {} nodes, {} quads, s = {:.3e} m, ρ = {:.1} kg/m³, G = {:.3e} Pa -> {}",
                 m.num_nodes(),
@@ -481,9 +484,7 @@ fn run() -> anyhow::Result<()> {
                 tension_only: a.tension_only,
             };
             let m = build(&p).context("cannot build the rod model")?;
-            let prov = Provenance::new("weave rod", serde_json::to_value(&p)?);
-            write_model(&m, &a.out, &prov)
-                .with_context(|| format!("cannot write model `{}`", a.out.display()))?;
+            save(&m, &a.out, "weave rod", &p)?;
             eprintln!(
                 "weft-weave rod: {} nodes, {} trusses, c = {:.1} m/s, T_F = {:.3e} s -> {}",
                 m.num_nodes(),

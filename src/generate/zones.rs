@@ -207,16 +207,27 @@ fn tie_to_hole(m: &mut Model, coarse: &Coarse, fine: &[usize]) -> Result<Vec<usi
     Ok(tied)
 }
 
-/// Order nodes along y = 0 by x, then x = y by x.
-fn line_sets(m: &mut Model, candidates: &[usize], name: &str, on: impl Fn(&[f64; 3]) -> bool) {
-    let mut v: Vec<usize> = candidates
-        .iter()
-        .copied()
-        .filter(|&n| on(&m.coords[n]))
+/// `axis_x` (y = 0) and `diagonal` (x = y), ordered by x: the dense zone's nodes inside
+/// the centre square of half-size c, the coarse zone's beyond it (where both have a node
+/// on the hole boundary, the dense zone's).
+fn centre_line_sets(m: &mut Model, dense: &[usize], c: f64) {
+    let dense_set: std::collections::HashSet<usize> = dense.iter().copied().collect();
+    let cand: Vec<usize> = (0..m.num_nodes())
+        .filter(|&n| {
+            let x = m.coords[n];
+            dense_set.contains(&n) || x[0].abs() > c + 1e-12 || x[1].abs() > c + 1e-12
+        })
         .collect();
-    v.sort_by(|&a, &b| m.coords[a][0].total_cmp(&m.coords[b][0]));
-    v.dedup_by(|a, b| (m.coords[*a][0] - m.coords[*b][0]).abs() < 1e-12);
-    m.node_sets.insert(name.into(), v);
+    let mut set = |name: &str, on: &dyn Fn(&[f64; 3]) -> bool| {
+        let mut v: Vec<usize> = cand.iter().copied().filter(|&n| on(&m.coords[n])).collect();
+        v.sort_by(|&a, &b| m.coords[a][0].total_cmp(&m.coords[b][0]));
+        v.dedup_by(|a, b| (m.coords[*a][0] - m.coords[*b][0]).abs() < 1e-12);
+        m.node_sets.insert(name.into(), v);
+    };
+    set("axis_x", &|x| x[1].abs() < 1e-12 && x[0] >= -1e-12);
+    set("diagonal", &|x| {
+        (x[0] - x[1]).abs() < 1e-12 && x[0] >= -1e-12
+    });
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, clap::ValueEnum)]
@@ -386,25 +397,9 @@ pub fn combined(p: &CombinedParams) -> Result<Model> {
             duration: p.pulse,
         },
     });
-    let all: Vec<usize> = (0..m.num_nodes()).collect();
     m.node_sets.insert("reference".into(), fine.clone());
     m.node_sets.insert("interface".into(), tied);
-    // Along y = 0 and x = y: the dense zone's nodes, then the coarse ones beyond it.
-    let fine_set: std::collections::HashSet<usize> = fine.iter().copied().collect();
-    let keep = |n: usize, x: &[f64; 3]| {
-        fine_set.contains(&n) || x[0].abs() > c + 1e-12 || x[1].abs() > c + 1e-12
-    };
-    let cand: Vec<usize> = all
-        .iter()
-        .copied()
-        .filter(|&n| keep(n, &m.coords[n]))
-        .collect();
-    line_sets(&mut m, &cand, "axis_x", |x| {
-        x[1].abs() < 1e-12 && x[0] >= -1e-12
-    });
-    line_sets(&mut m, &cand, "diagonal", |x| {
-        (x[0] - x[1]).abs() < 1e-12 && x[0] >= -1e-12
-    });
+    centre_line_sets(&mut m, &fine, c);
     m.analysis = Analysis {
         end_time: p.end_time,
         output_interval: p.output_interval,
@@ -696,19 +691,7 @@ pub fn woven_reduced(p: &WovenParams) -> Result<Model> {
     });
     m.node_sets.insert("reference".into(), warp.clone());
     m.node_sets.insert("interface".into(), interface);
-    let warp_set: std::collections::HashSet<usize> = warp.iter().copied().collect();
-    let keep = |n: usize, x: &[f64; 3]| {
-        warp_set.contains(&n) || x[0].abs() > c + 1e-12 || x[1].abs() > c + 1e-12
-    };
-    let cand: Vec<usize> = (0..m.num_nodes())
-        .filter(|&n| keep(n, &m.coords[n]))
-        .collect();
-    line_sets(&mut m, &cand, "axis_x", |x| {
-        x[1].abs() < 1e-12 && x[0] >= -1e-12
-    });
-    line_sets(&mut m, &cand, "diagonal", |x| {
-        (x[0] - x[1]).abs() < 1e-12 && x[0] >= -1e-12
-    });
+    centre_line_sets(&mut m, &warp, c);
     m.analysis = Analysis {
         end_time: p.end_time,
         output_interval: p.output_interval,

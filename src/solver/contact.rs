@@ -147,6 +147,24 @@ impl Projectile {
     }
 }
 
+/// Regularised Coulomb friction at a contact point with normal `n` and normal force
+/// `fnorm`, for the point's velocity `vr` relative to the projectile: the force on the
+/// point, −μ f_n t̂ min(1, |v_t|/v_reg), and the power it dissipates (≥ 0).
+#[inline]
+pub fn friction(n: &[f64; 3], fnorm: f64, vr: &[f64; 3], mu: f64) -> ([f64; 3], f64) {
+    let vn = vr[0] * n[0] + vr[1] * n[1] + vr[2] * n[2];
+    let vt = [vr[0] - vn * n[0], vr[1] - vn * n[1], vr[2] - vn * n[2]];
+    let vtm = (vt[0] * vt[0] + vt[1] * vt[1] + vt[2] * vt[2]).sqrt();
+    if vtm == 0.0 {
+        return ([0.0; 3], 0.0);
+    }
+    let ft = mu * fnorm * (vtm / V_REG).min(1.0);
+    (
+        [-ft * vt[0] / vtm, -ft * vt[1] / vtm, -ft * vt[2] / vtm],
+        ft * vtm,
+    )
+}
+
 /// Closest point of the triangle (a, b, c) to p, as barycentric weights (w_a, w_b, w_c)
 /// (Ericson, *Real-Time Collision Detection*, §5.1.5).
 pub fn closest_on_triangle(p: &[f64; 3], a: &[f64; 3], b: &[f64; 3], c: &[f64; 3]) -> [f64; 3] {

@@ -1409,16 +1409,9 @@ impl Solver {
                 let mut f = [n[0] * fnorm, n[1] * fnorm, n[2] * fnorm];
                 if p.friction > 0.0 {
                     let vr = [v[i][0] - p.v[0], v[i][1] - p.v[1], v[i][2] - p.v[2]];
-                    let vn = dot(&vr, &n);
-                    let vt = [vr[0] - vn * n[0], vr[1] - vn * n[1], vr[2] - vn * n[2]];
-                    let vtm = dot(&vt, &vt).sqrt();
-                    if vtm > 0.0 {
-                        let ft = p.friction * fnorm * (vtm / contact::V_REG).min(1.0);
-                        for d in 0..3 {
-                            f[d] -= ft * vt[d] / vtm;
-                        }
-                        self.e_contact_friction += ft * vtm * dt_prev;
-                    }
+                    let (ft, power) = contact::friction(&n, fnorm, &vr, p.friction);
+                    f = [f[0] + ft[0], f[1] + ft[1], f[2] + ft[2]];
+                    self.e_contact_friction += power * dt_prev;
                 }
                 add(&mut self.fcon[i], &f);
                 ftot = [ftot[0] - f[0], ftot[1] - f[1], ftot[2] - f[2]];
@@ -1453,16 +1446,9 @@ impl Solver {
                             (0..3).map(|a| w[a] * v[tri_n[a] as usize][d]).sum()
                         });
                         let vr = [vq[0] - p.v[0], vq[1] - p.v[1], vq[2] - p.v[2]];
-                        let vn = dot(&vr, &n);
-                        let vt = [vr[0] - vn * n[0], vr[1] - vn * n[1], vr[2] - vn * n[2]];
-                        let vtm = dot(&vt, &vt).sqrt();
-                        if vtm > 0.0 {
-                            let ft = p.friction * fnorm * (vtm / contact::V_REG).min(1.0);
-                            for d in 0..3 {
-                                f[d] -= ft * vt[d] / vtm;
-                            }
-                            self.e_contact_friction += ft * vtm * dt_prev;
-                        }
+                        let (ft, power) = contact::friction(&n, fnorm, &vr, p.friction);
+                        f = [f[0] + ft[0], f[1] + ft[1], f[2] + ft[2]];
+                        self.e_contact_friction += power * dt_prev;
                     }
                     for a in 0..3 {
                         let i = tri_n[a] as usize;
@@ -1490,16 +1476,9 @@ impl Solver {
                             (0..sp.n).map(|a| sp.w[a] * v[nodes[a] as usize][d]).sum()
                         });
                         let vr = [vp[0] - p.v[0], vp[1] - p.v[1], vp[2] - p.v[2]];
-                        let vn = dot(&vr, &n);
-                        let vt = [vr[0] - vn * n[0], vr[1] - vn * n[1], vr[2] - vn * n[2]];
-                        let vtm = dot(&vt, &vt).sqrt();
-                        if vtm > 0.0 {
-                            let ft = p.friction * fnorm * (vtm / contact::V_REG).min(1.0);
-                            for d in 0..3 {
-                                f[d] -= ft * vt[d] / vtm;
-                            }
-                            self.e_contact_friction += ft * vtm * dt_prev;
-                        }
+                        let (ft, power) = contact::friction(&n, fnorm, &vr, p.friction);
+                        f = [f[0] + ft[0], f[1] + ft[1], f[2] + ft[2]];
+                        self.e_contact_friction += power * dt_prev;
                     }
                     for a in 0..sp.n {
                         let i = nodes[a] as usize;
