@@ -6,6 +6,7 @@
 //! `weft-simulate`), [`generate`] (canonical models behind `weft-weave`), [`table`]
 //! (validated Parquet I/O with provenance), [`error`] (typed errors).
 
+pub mod analysis;
 pub mod error;
 pub mod generate;
 pub mod model;

@@ -1,0 +1,354 @@
+//! Measure-and-match analyses on `history.parquet`: wave speeds along a line of nodes
+//! (the paper's §3) and the displacement mismatch T between two models (its eq. 2).
+
+use std::collections::HashMap;
+use std::path::Path;
+
+use crate::error::{Result, WeftError};
+use crate::model::io::read_model;
+use crate::table::Table;
+
+/// Time series of the nodes of one node set, read from a history table.
+#[derive(Debug, Clone)]
+pub struct Series {
+    pub t: Vec<f64>,
+    pub node_id: Vec<i64>,
+    /// Initial positions of the nodes [m].
+    pub x0: Vec<[f64; 3]>,
+    /// `values[k][j][c]`: component c (ux, uy, uz, vx, vy, vz) of node j at sample k.
+    pub values: Vec<Vec<[f64; 6]>>,
+}
+
+/// Component names of `history.parquet`, in `Series::values` order.
+pub const COMPONENTS: [&str; 6] = ["ux", "uy", "uz", "vx", "vy", "vz"];
+
+/// Parse a list like `ux,uy` into component indices.
+pub fn components(list: &str) -> Result<Vec<usize>> {
+    list.split(',')
+        .map(|c| {
+            let c = c.trim();
+            COMPONENTS.iter().position(|n| *n == c).ok_or_else(|| {
+                WeftError::input(format!("unknown component `{c}`"))
+                    .expected("some of ux, uy, uz, vx, vy, vz, comma-separated")
+            })
+        })
+        .collect()
+}
+
+/// Read the nodes of `set` (in set order) from a model folder and its history table.
+pub fn read_series(model: &Path, history: &Path, set: &str) -> Result<Series> {
+    let m = read_model(model)?;
+    let nodes = m.node_sets.get(set).ok_or_else(|| {
+        WeftError::input(format!(
+            "model `{}` has no node set `{set}`",
+            model.display()
+        ))
+        .expected(format!(
+            "one of {}",
+            m.node_sets
+                .keys()
+                .map(|k| format!("`{k}`"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        ))
+    })?;
+    let h = Table::read(history)?;
+    const COLS: &str = "t, node_id, ux, uy, uz, vx, vy, vz";
+    let t = h.f64("t", COLS)?;
+    let ids = h.i64("node_id", COLS)?;
+    let cols: Vec<Vec<f64>> = COMPONENTS
+        .iter()
+        .map(|c| h.f64(c, COLS))
+        .collect::<Result<_>>()?;
+    let want: HashMap<i64, usize> = nodes
+        .iter()
+        .enumerate()
+        .map(|(j, &i)| (m.node_id[i], j))
+        .collect();
+    let mut times: Vec<f64> = vec![];
+    let mut values: Vec<Vec<[f64; 6]>> = vec![];
+    let mut seen = vec![0usize; nodes.len()];
+    for r in 0..t.len() {
+        if times.last() != Some(&t[r]) {
+            if let Some(&last) = times.last() {
+                if t[r] < last {
+                    return Err(h
+                        .value_error("t", r, format!("time `{}` after `{last}`", t[r]))
+                        .expected("rows ordered by time, as weft-simulate writes them"));
+                }
+            }
+            times.push(t[r]);
+            values.push(vec![[f64::NAN; 6]; nodes.len()]);
+        }
+        if let Some(&j) = want.get(&ids[r]) {
+            let k = times.len() - 1;
+            values[k][j] = std::array::from_fn(|c| cols[c][r]);
+            seen[j] += 1;
+        }
+    }
+    if let Some(j) = (0..nodes.len()).find(|&j| seen[j] != times.len()) {
+        return Err(WeftError::input(format!(
+            "node `{}` of set `{set}` has {} of {} samples in the history",
+            m.node_id[nodes[j]],
+            seen[j],
+            times.len()
+        ))
+        .in_file(history)
+        .expected("every node of the set at every output time")
+        .hint("write the history of this set: weft-simulate --history-set NAME (or all nodes)"));
+    }
+    Ok(Series {
+        t: times,
+        node_id: nodes.iter().map(|&i| m.node_id[i]).collect(),
+        x0: nodes.iter().map(|&i| m.coords[i]).collect(),
+        values,
+    })
+}
+
+/// First time |y| reaches `level`, linearly interpolated; `None` if never.
+pub fn arrival(t: &[f64], y: &[f64], level: f64) -> Option<f64> {
+    if y.first().is_some_and(|v| v.abs() >= level) {
+        return Some(t[0]);
+    }
+    (1..y.len()).find(|&k| y[k].abs() >= level).map(|k| {
+        let (a, b) = (y[k - 1].abs(), y[k].abs());
+        t[k - 1] + (level - a) / (b - a) * (t[k] - t[k - 1])
+    })
+}
+
+/// Wave speeds along an ordered line of nodes.
+#[derive(Debug, Clone)]
+pub struct WaveSpeeds {
+    pub node_id: Vec<i64>,
+    /// Distance along the line from its first node [m].
+    pub position: Vec<f64>,
+    pub arrival: Vec<Option<f64>>,
+    /// Speed over the segment from the previous node to this one [m/s].
+    pub segment_speed: Vec<Option<f64>>,
+    /// Mean of the node's two neighbouring segments (one at the ends) [m/s].
+    pub node_speed: Vec<Option<f64>>,
+}
+
+/// Level: absolute, or a fraction of each node's peak |value|.
+#[derive(Debug, Clone, Copy)]
+pub enum Level {
+    Absolute(f64),
+    Relative(f64),
+}
+
+/// Arrival times of a level along the line and the speeds between nodes (the paper's §3:
+/// v = Δx/(t₂ − t₁), a node's speed the mean of its two segments). The speed is signed:
+/// positive when the wave runs in the set's order.
+pub fn wave_speeds(s: &Series, component: usize, level: Level) -> WaveSpeeds {
+    let n = s.node_id.len();
+    let mut position = vec![0.0; n];
+    for j in 1..n {
+        let d: f64 = (0..3)
+            .map(|c| (s.x0[j][c] - s.x0[j - 1][c]).powi(2))
+            .sum::<f64>()
+            .sqrt();
+        position[j] = position[j - 1] + d;
+    }
+    let arrival: Vec<Option<f64>> = (0..n)
+        .map(|j| {
+            let y: Vec<f64> = s.values.iter().map(|v| v[j][component]).collect();
+            let lv = match level {
+                Level::Absolute(a) => a,
+                Level::Relative(f) => f * y.iter().map(|v| v.abs()).fold(0.0, f64::max),
+            };
+            if lv <= 0.0 {
+                None
+            } else {
+                arrival(&s.t, &y, lv)
+            }
+        })
+        .collect();
+    let segment_speed: Vec<Option<f64>> = (0..n)
+        .map(|j| {
+            if j == 0 {
+                return None;
+            }
+            match (arrival[j - 1], arrival[j]) {
+                (Some(a), Some(b)) if b != a => Some((position[j] - position[j - 1]) / (b - a)),
+                _ => None,
+            }
+        })
+        .collect();
+    let node_speed = (0..n)
+        .map(|j| {
+            let s: Vec<f64> = [
+                segment_speed[j],
+                segment_speed.get(j + 1).copied().flatten(),
+            ]
+            .into_iter()
+            .flatten()
+            .collect();
+            (!s.is_empty()).then(|| s.iter().sum::<f64>() / s.len() as f64)
+        })
+        .collect();
+    WaveSpeeds {
+        node_id: s.node_id.clone(),
+        position,
+        arrival,
+        segment_speed,
+        node_speed,
+    }
+}
+
+/// The mismatch between a candidate (p, the reduced model) and a reference (q).
+#[derive(Debug, Clone)]
+pub struct Mismatch {
+    /// T = ∫Σ‖p − q‖² dt / ∫Σ(‖p‖² + ‖q‖²) dt (without the integrals in static mode).
+    pub t_value: f64,
+    /// Per reference node: (reference id, candidate id, peak ‖p − q‖ / peak ‖q‖).
+    pub per_node: Vec<(i64, i64, f64)>,
+    pub max_peak_relative_error: f64,
+    pub samples: usize,
+}
+
+/// For each reference node, the candidate node nearest to it (within `tol` metres).
+pub fn match_nodes(reference: &Series, candidate: &Series, tol: f64) -> Result<Vec<usize>> {
+    let mut used = HashMap::new();
+    let mut out = Vec::with_capacity(reference.node_id.len());
+    for (j, x) in reference.x0.iter().enumerate() {
+        let (k, d) = candidate
+            .x0
+            .iter()
+            .enumerate()
+            .map(|(k, y)| {
+                (
+                    k,
+                    ((x[0] - y[0]).powi(2) + (x[1] - y[1]).powi(2) + (x[2] - y[2]).powi(2)).sqrt(),
+                )
+            })
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+            .ok_or_else(|| WeftError::input("the candidate node set is empty"))?;
+        if d > tol {
+            return Err(WeftError::input(format!(
+                "reference node `{}` at {:?} has no candidate node within {tol:e} m (nearest: `{}` at {d:.3e} m)",
+                reference.node_id[j], x, candidate.node_id[k]
+            ))
+            .expected("a candidate node at every reference position")
+            .hint("compare node sets on the same positions, or raise --tolerance"));
+        }
+        if let Some(prev) = used.insert(k, j) {
+            return Err(WeftError::input(format!(
+                "reference nodes `{}` and `{}` both match candidate node `{}`",
+                reference.node_id[prev], reference.node_id[j], candidate.node_id[k]
+            ))
+            .expected("one candidate node per reference node")
+            .hint("lower --tolerance"));
+        }
+        out.push(k);
+    }
+    Ok(out)
+}
+
+/// Linear interpolation of the candidate's samples onto times `t`.
+fn resample(c: &Series, t: &[f64]) -> Result<Vec<Vec<[f64; 6]>>> {
+    if c.t == t {
+        return Ok(c.values.clone());
+    }
+    let (t0, t1) = (c.t[0], *c.t.last().expect("samples"));
+    let eps = 1e-9 * (t1 - t0).abs().max(1e-30);
+    t.iter()
+        .map(|&tt| {
+            if tt < t0 - eps || tt > t1 + eps {
+                return Err(WeftError::input(format!("the candidate history covers [{t0:e}, {t1:e}] s but the reference has a sample at {tt:e} s"))
+                    .expected("a candidate history that covers the reference's time grid")
+                    .hint("simulate the candidate at least as long as the reference"));
+            }
+            let k = c.t.partition_point(|&x| x <= tt).clamp(1, c.t.len().max(2) - 1);
+            if c.t.len() == 1 {
+                return Ok(c.values[0].clone());
+            }
+            let w = ((tt - c.t[k - 1]) / (c.t[k] - c.t[k - 1])).clamp(0.0, 1.0);
+            Ok((0..c.node_id.len()).map(|j| std::array::from_fn(|q| c.values[k - 1][j][q] + w * (c.values[k][j][q] - c.values[k - 1][j][q]))).collect())
+        })
+        .collect()
+}
+
+/// T between a candidate p and a reference q over matched nodes and chosen components;
+/// `static_mode` compares the last samples only.
+pub fn mismatch(
+    reference: &Series,
+    candidate: &Series,
+    comps: &[usize],
+    tol: f64,
+    static_mode: bool,
+) -> Result<Mismatch> {
+    let pairs = match_nodes(reference, candidate, tol)?;
+    let (t, q_all): (Vec<f64>, Vec<Vec<[f64; 6]>>) = if static_mode {
+        (
+            vec![*reference.t.last().expect("samples")],
+            vec![reference.values.last().expect("samples").clone()],
+        )
+    } else {
+        (reference.t.clone(), reference.values.clone())
+    };
+    let p_all = if static_mode {
+        vec![candidate.values.last().expect("samples").clone()]
+    } else {
+        resample(candidate, &t)?
+    };
+    let n = pairs.len();
+    let mut num = vec![0.0; t.len()];
+    let mut den = vec![0.0; t.len()];
+    let mut peak_d = vec![0.0f64; n];
+    let mut peak_q = vec![0.0f64; n];
+    for k in 0..t.len() {
+        for (j, &c) in pairs.iter().enumerate() {
+            let (mut d2, mut p2, mut q2) = (0.0, 0.0, 0.0);
+            for &comp in comps {
+                let (p, q) = (p_all[k][c][comp], q_all[k][j][comp]);
+                d2 += (p - q) * (p - q);
+                p2 += p * p;
+                q2 += q * q;
+            }
+            num[k] += d2;
+            den[k] += p2 + q2;
+            peak_d[j] = peak_d[j].max(d2.sqrt());
+            peak_q[j] = peak_q[j].max(q2.sqrt());
+        }
+    }
+    let integrate = |f: &[f64]| -> f64 {
+        if f.len() == 1 {
+            f[0]
+        } else {
+            (1..f.len())
+                .map(|k| 0.5 * (f[k] + f[k - 1]) * (t[k] - t[k - 1]))
+                .sum()
+        }
+    };
+    let (nu, de) = (integrate(&num), integrate(&den));
+    if de <= 0.0 {
+        return Err(WeftError::input(
+            "both histories are zero on the compared nodes and components",
+        )
+        .expected("some motion to compare"));
+    }
+    let per_node: Vec<(i64, i64, f64)> = (0..n)
+        .map(|j| {
+            (
+                reference.node_id[j],
+                candidate.node_id[pairs[j]],
+                if peak_q[j] > 0.0 {
+                    peak_d[j] / peak_q[j]
+                } else {
+                    f64::NAN
+                },
+            )
+        })
+        .collect();
+    let max = per_node
+        .iter()
+        .map(|r| r.2)
+        .filter(|v| v.is_finite())
+        .fold(0.0, f64::max);
+    Ok(Mismatch {
+        t_value: nu / de,
+        per_node,
+        max_peak_relative_error: max,
+        samples: t.len(),
+    })
+}
