@@ -54,6 +54,8 @@ pub struct Projectile {
     pub tip: [f64; 3],
     /// Half-step velocity v^{n−½} (the constant velocity when prescribed).
     pub v: [f64; 3],
+    /// Full-step velocity v^n of the last step (output).
+    pub v_full: [f64; 3],
     pub prescribed: bool,
     /// Fixed penalty stiffness [N/m], or `None` for κ_c m/Δt².
     pub stiffness: Option<f64>,
@@ -76,6 +78,7 @@ impl Projectile {
             axis: [p.axis[0] / n, p.axis[1] / n, p.axis[2] / n],
             tip: p.tip,
             v: p.velocity,
+            v_full: p.velocity,
             prescribed: p.prescribed_velocity,
             stiffness: p.contact_stiffness,
             friction: p.friction,

@@ -1496,15 +1496,14 @@ impl Solver {
     }
 
     /// Advance the projectiles (central difference, like the nodes); returns their
-    /// kinetic energy at t_n (free ones) and their velocities at t_n.
-    fn advance_projectiles(&mut self, dt_next: f64) -> (f64, Option<Vec<[f64; 3]>>) {
+    /// kinetic energy at t_n (free ones) and keeps their velocity at t_n in `v_full`.
+    fn advance_projectiles(&mut self, dt_next: f64) -> f64 {
         let mut ke = 0.0;
-        let mut vs = Vec::with_capacity(self.projectiles.len());
         for p in self.projectiles.iter_mut() {
             if p.prescribed {
                 // The work the imposed motion does on the system.
                 self.w_prescribed -= dt_next * dot(&p.force, &p.v);
-                vs.push(p.v);
+                p.v_full = p.v;
             } else {
                 // In a symmetric model the projectile stays on the symmetry planes.
                 let a: [f64; 3] = std::array::from_fn(|d| {
@@ -1517,13 +1516,13 @@ impl Solver {
                 let vn: [f64; 3] = std::array::from_fn(|d| p.v[d] + 0.5 * self.dt_prev * a[d]);
                 ke += 0.5 * p.mass * dot(&vn, &vn);
                 p.v = std::array::from_fn(|d| vn[d] + 0.5 * dt_next * a[d]);
-                vs.push(vn);
+                p.v_full = vn;
             }
             for d in 0..3 {
                 p.tip[d] += dt_next * p.v[d];
             }
         }
-        (ke, Some(vs))
+        ke
     }
 
     /// Advance the rotations of the beam nodes; returns (rotational kinetic energy at t_n,
@@ -1943,8 +1942,8 @@ impl Solver {
                     std::mem::swap(&mut self.x, &mut self.xn);
                 }
             }
-            let (ke_proj, v_proj) = if self.projectiles.is_empty() {
-                (0.0, None)
+            let ke_proj = if self.projectiles.is_empty() {
+                0.0
             } else {
                 self.advance_projectiles(dt_next)
             };
@@ -1952,10 +1951,8 @@ impl Solver {
             let t3 = Instant::now();
             times.update += t3 - t2;
             if snap {
-                if let Some(vp) = v_proj {
-                    for (row, v) in cur.proj.iter_mut().zip(vp) {
-                        row[3..6].copy_from_slice(&v);
-                    }
+                for (row, p) in cur.proj.iter_mut().zip(&self.projectiles) {
+                    row[3..6].copy_from_slice(&p.v_full);
                 }
                 // Energies at t_n (positions x^n are in xn; internal energy from them).
                 std::mem::swap(&mut self.x, &mut self.xn);
