@@ -7,18 +7,26 @@
 mod common;
 use std::process::Command;
 
-#[test]
-fn tables_open_in_pandas_and_polars() {
+/// Whether python3 with pandas, polars and pyarrow is here; required when
+/// `WEFT_REQUIRE_PYTHON=1` (set by `.ci/run`, which installs them).
+fn python_ok() -> bool {
     let probe = Command::new("python3")
         .args(["-c", "import pandas, polars, pyarrow"])
         .output();
-    let available = probe.map(|o| o.status.success()).unwrap_or(false);
-    if !available {
+    let ok = probe.map(|o| o.status.success()).unwrap_or(false);
+    if !ok {
         assert!(
             std::env::var("WEFT_REQUIRE_PYTHON").as_deref() != Ok("1"),
             "WEFT_REQUIRE_PYTHON=1 but python3 with pandas, polars and pyarrow is not available"
         );
         eprintln!("SKIP: python3 with pandas, polars and pyarrow not found (pip install pandas polars pyarrow)");
+    }
+    ok
+}
+
+#[test]
+fn tables_open_in_pandas_and_polars() {
+    if !python_ok() {
         return;
     }
     let dir = tempfile::tempdir().unwrap();
@@ -55,15 +63,7 @@ fn tables_open_in_pandas_and_polars() {
 
 #[test]
 fn a_model_with_every_feature_opens_in_pandas_and_polars() {
-    let probe = Command::new("python3")
-        .args(["-c", "import pandas, polars, pyarrow"])
-        .output();
-    if !probe.map(|o| o.status.success()).unwrap_or(false) {
-        assert!(
-            std::env::var("WEFT_REQUIRE_PYTHON").as_deref() != Ok("1"),
-            "python3 with pandas, polars and pyarrow is required"
-        );
-        eprintln!("SKIP: python3 with pandas, polars and pyarrow not found");
+    if !python_ok() {
         return;
     }
     let dir = tempfile::tempdir().unwrap();
@@ -111,15 +111,7 @@ fn a_model_with_every_feature_opens_in_pandas_and_polars() {
 
 #[test]
 fn a_generated_woven_model_opens_in_pandas_and_polars() {
-    let probe = Command::new("python3")
-        .args(["-c", "import pandas, polars, pyarrow"])
-        .output();
-    if !probe.map(|o| o.status.success()).unwrap_or(false) {
-        assert!(
-            std::env::var("WEFT_REQUIRE_PYTHON").as_deref() != Ok("1"),
-            "python3 with pandas, polars and pyarrow is required"
-        );
-        eprintln!("SKIP: python3 with pandas, polars and pyarrow not found");
+    if !python_ok() {
         return;
     }
     let dir = tempfile::tempdir().unwrap();

@@ -172,6 +172,22 @@ fn coarse_membrane(
     Coarse { hole_sides, outer }
 }
 
+/// Pin the coarse zone's outer edge; a quarter model gets the symmetry planes x = 0, y = 0.
+fn hold_outer_edge(m: &mut Model, coarse: &Coarse, quarter: bool, length: f64) {
+    for &o in &coarse.outer {
+        m.constraints.push((o, [true, true, true]));
+    }
+    if quarter {
+        for normal in [0, 1] {
+            m.symmetry.push(SymmetryPlane {
+                normal,
+                position: 0.0,
+                tolerance: 1e-9 * length,
+            });
+        }
+    }
+}
+
 /// Tie every listed fine node lying on a hole side to the coarse edge it lies on.
 fn tie_to_hole(m: &mut Model, coarse: &Coarse, fine: &[usize]) -> Result<Vec<usize>> {
     let mut tied = vec![];
@@ -368,21 +384,7 @@ pub fn combined(p: &CombinedParams) -> Result<Model> {
         })
         .collect();
     let tied = tie_to_hole(&mut m, &coarse, &boundary)?;
-    for &o in &coarse.outer {
-        m.constraints.push((o, [true, true, true]));
-    }
-    if p.quarter {
-        m.symmetry.push(SymmetryPlane {
-            normal: 0,
-            position: 0.0,
-            tolerance: 1e-9 * p.length,
-        });
-        m.symmetry.push(SymmetryPlane {
-            normal: 1,
-            position: 0.0,
-            tolerance: 1e-9 * p.length,
-        });
-    }
+    hold_outer_edge(&mut m, &coarse, p.quarter, p.length);
     let centre = *fine
         .iter()
         .find(|&&f| m.coords[f][0].abs() < 1e-12 && m.coords[f][1].abs() < 1e-12)
@@ -631,49 +633,19 @@ pub fn woven_reduced(p: &WovenParams) -> Result<Model> {
         }
     }
     let coarse = coarse_membrane(&mut m, &pos, p.quarter, c, &p.membrane, 1_000_000);
-    // Warp ends on the sides x = ±c, weft ends on y = ±c; both yarns at the corners.
-    let ends: Vec<usize> = (0..warp.len())
-        .flat_map(|k| {
-            let x = m.coords[warp[k]];
-            let mut v = vec![];
-            if (x[0].abs() - c).abs() < 1e-12 {
-                v.push(warp[k]);
-            }
-            if (x[1].abs() - c).abs() < 1e-12 {
-                v.push(weft[k]);
-            }
-            v
-        })
-        .collect();
-    let tied = tie_to_hole(&mut m, &coarse, &ends)?;
-    // Yarn nodes on the boundary lines that are not yarn ends would have no mass path if
-    // untied: every boundary node of both yarns is tied.
-    let others: Vec<usize> = (0..warp.len())
-        .flat_map(|k| [warp[k], weft[k]])
-        .filter(|n| !tied.contains(n))
+    // Every yarn node on the patch boundary (the yarn ends and the nodes of the yarns
+    // that run along it) is tied to the membrane edge it lies on.
+    let on_boundary: Vec<usize> = warp
+        .iter()
+        .chain(weft.iter())
+        .copied()
         .filter(|&n| {
             let x = m.coords[n];
             (x[0].abs() - c).abs() < 1e-12 || (x[1].abs() - c).abs() < 1e-12
         })
         .collect();
-    let mut tied2 = tie_to_hole(&mut m, &coarse, &others)?;
-    let mut interface = tied;
-    interface.append(&mut tied2);
-    for &o in &coarse.outer {
-        m.constraints.push((o, [true, true, true]));
-    }
-    if p.quarter {
-        m.symmetry.push(SymmetryPlane {
-            normal: 0,
-            position: 0.0,
-            tolerance: 1e-9 * p.length,
-        });
-        m.symmetry.push(SymmetryPlane {
-            normal: 1,
-            position: 0.0,
-            tolerance: 1e-9 * p.length,
-        });
-    }
+    let interface = tie_to_hole(&mut m, &coarse, &on_boundary)?;
+    hold_outer_edge(&mut m, &coarse, p.quarter, p.length);
     let share = if p.quarter { 0.25 } else { 1.0 };
     m.projectiles.push(ProjectileSpec {
         id: 1,
