@@ -8,6 +8,7 @@
 
 pub mod analysis;
 pub mod error;
+pub mod fit;
 pub mod generate;
 pub mod model;
 pub mod pipeline;

@@ -87,6 +87,9 @@ pub enum Col {
     Str(&'static str, Vec<String>),
     Bool(&'static str, Vec<bool>),
     OptBool(&'static str, Vec<Option<bool>>),
+    OptStr(&'static str, Vec<Option<String>>),
+    /// A float column whose name is only known at run time (a fitted parameter's).
+    F64Named(String, Vec<f64>),
 }
 
 impl Col {
@@ -115,6 +118,14 @@ impl Col {
             Col::OptBool(n, v) => (
                 Field::new(n, DataType::Boolean, true),
                 Arc::new(BooleanArray::from(v)),
+            ),
+            Col::OptStr(n, v) => (
+                Field::new(n, DataType::Utf8, true),
+                Arc::new(StringArray::from(v)),
+            ),
+            Col::F64Named(n, v) => (
+                Field::new(n, DataType::Float64, false),
+                Arc::new(Float64Array::from(v)),
             ),
         }
     }

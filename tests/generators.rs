@@ -33,6 +33,7 @@ fn gp(cells: usize, load_case: LoadCase, rigid: bool) -> GirderParams {
         rod_thickness: None,
         rigid,
         full_edge_rods: false,
+        clamp_rotations: true,
     }
 }
 

@@ -256,6 +256,16 @@ struct GirderArgs {
     /// half a cell of the lattice, so that the girder matches its equivalent membrane of side L].
     #[arg(long)]
     full_edge_rods: bool,
+    /// Clamp at x = 0: `built-in` holds translations and rotations; `translations` holds the
+    /// translations only, as the membrane's clamp does.
+    #[arg(long, value_enum, default_value_t = Clamp::BuiltIn)]
+    clamp: Clamp,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum Clamp {
+    BuiltIn,
+    Translations,
 }
 
 #[derive(clap::Args)]
@@ -352,6 +362,7 @@ fn run() -> anyhow::Result<()> {
                 rod_thickness: a.rod_thickness,
                 rigid: a.joints == Joints::Rigid,
                 full_edge_rods: a.full_edge_rods,
+                clamp_rotations: a.clamp == Clamp::BuiltIn,
             };
             let (m, warnings) = girder(&p).context("cannot build the girder")?;
             for w in warnings {

@@ -159,6 +159,9 @@ pub struct GirderParams {
     pub rigid: bool,
     /// Rods along the boundary with full properties instead of half the modulus and density.
     pub full_edge_rods: bool,
+    /// Rigid joints: hold the rotations of the clamped nodes too (a built-in edge). Off, the
+    /// clamp holds translations only, like the membrane's clamp (which has no rotations).
+    pub clamp_rotations: bool,
 }
 
 impl GirderParams {
@@ -262,7 +265,13 @@ pub fn girder(p: &GirderParams) -> Result<(Model, Vec<String>)> {
             }
         }
     }
-    frame(&mut m, &p.square, p.youngs_modulus, p.density, p.rigid)?;
+    frame(
+        &mut m,
+        &p.square,
+        p.youngs_modulus,
+        p.density,
+        p.rigid && p.clamp_rotations,
+    )?;
     // A plane girder under in-plane loads: hold the out-of-plane motion (pinned joints have
     // no stiffness there at all).
     if p.square.load_case != LoadCase::Transverse {

@@ -1,0 +1,831 @@
+//! The `fit` stage: choose named part properties of a model, within bounds, to minimise
+//! the mismatch T (the paper's eq. 2) between its response and reference histories.
+//!
+//! - **Parameters** are part properties named `part.property` (`membrane.shear_modulus_12`;
+//!   short aliases such as `membrane.G12` are accepted). One parameter may drive several
+//!   properties, tied (`links.kx,links.ky`), each with an optional factor
+//!   (`membrane.density,membrane_half.density*0.5`). Each has bounds and a linear or log
+//!   scale; the optimisers work on the unit box z ∈ [0, 1]ⁿ of those scales.
+//! - **Objective:** for each case (a reference history and the candidate model loaded the
+//!   same way) the candidate is solved in-process (explicit, or the linear static solve) and
+//!   T is computed over a node set; the objective is the mean T over the cases. A run that
+//!   fails (instability, a parameter the solver refuses) scores [`FAILED_T`], above the
+//!   largest possible T (2), and its message goes into the trace.
+//! - **Methods:** COBYLA (derivative-free, bounded: Powell's linear-approximation trust
+//!   region, the `cobyla` crate's pure-Rust translation of NLopt's), and a projected BFGS
+//!   with central finite-difference gradients evaluated in parallel (the bounded
+//!   quasi-Newton fmincon-like option). `starts > 1` adds a multistart global search: the
+//!   first start is the initial point, the others a Halton sequence over the box; the
+//!   local searches run in parallel and the best result wins.
+//! - **Reproducible:** every evaluation is deterministic and each local search is
+//!   sequential, so the result and the trace (ordered by start, then evaluation) do not
+//!   depend on the thread count; only the wall times do.
+
+use std::sync::Mutex;
+use std::time::Instant;
+
+use rayon::prelude::*;
+use serde::Serialize;
+
+use crate::analysis::{mismatch, Series};
+use crate::error::{Result, WeftError};
+use crate::model::{ElementKind, Model, PartProps};
+use crate::solver::output::MemorySink;
+use crate::solver::Solver;
+
+/// T scored by an evaluation whose solve failed: above any real T (which lies in [0, 2]).
+pub const FAILED_T: f64 = 4.0;
+
+/// Numeric part properties a fit can set, with the kinds they apply to.
+const PROPERTIES: &[(&str, &[ElementKind])] = &[
+    ("youngs_modulus", &[ElementKind::Truss, ElementKind::Beam]),
+    (
+        "density",
+        &[
+            ElementKind::Truss,
+            ElementKind::Beam,
+            ElementKind::Tri,
+            ElementKind::Quad,
+        ],
+    ),
+    ("area", &[ElementKind::Truss]),
+    ("prestrain", &[ElementKind::Truss]),
+    ("kx", &[ElementKind::Link]),
+    ("ky", &[ElementKind::Link]),
+    ("kz", &[ElementKind::Link]),
+    ("cx", &[ElementKind::Link]),
+    ("cy", &[ElementKind::Link]),
+    ("cz", &[ElementKind::Link]),
+    ("slip_force", &[ElementKind::Link]),
+    ("mass", &[ElementKind::PointMass]),
+    ("youngs_modulus_1", &[ElementKind::Tri, ElementKind::Quad]),
+    ("youngs_modulus_2", &[ElementKind::Tri, ElementKind::Quad]),
+    ("poisson_ratio_12", &[ElementKind::Tri, ElementKind::Quad]),
+    ("shear_modulus_12", &[ElementKind::Tri, ElementKind::Quad]),
+    ("thickness", &[ElementKind::Tri, ElementKind::Quad]),
+    ("hourglass", &[ElementKind::Quad]),
+    ("material_angle", &[ElementKind::Tri, ElementKind::Quad]),
+    ("width", &[ElementKind::Beam]),
+    ("height", &[ElementKind::Beam]),
+    ("poisson_ratio", &[ElementKind::Beam]),
+];
+
+/// Short names researchers write, and the property each stands for.
+const ALIASES: &[(&str, &str)] = &[
+    ("E", "youngs_modulus"),
+    ("rho", "density"),
+    ("A", "area"),
+    ("E1", "youngs_modulus_1"),
+    ("E2", "youngs_modulus_2"),
+    ("nu12", "poisson_ratio_12"),
+    ("G12", "shear_modulus_12"),
+    ("G", "shear_modulus_12"),
+    ("s", "thickness"),
+    ("b", "width"),
+    ("h", "height"),
+];
+
+fn slot<'a>(p: &'a mut PartProps, name: &str) -> Option<&'a mut Option<f64>> {
+    Some(match name {
+        "youngs_modulus" => &mut p.youngs_modulus,
+        "density" => &mut p.density,
+        "area" => &mut p.area,
+        "prestrain" => &mut p.prestrain,
+        "kx" => &mut p.kx,
+        "ky" => &mut p.ky,
+        "kz" => &mut p.kz,
+        "cx" => &mut p.cx,
+        "cy" => &mut p.cy,
+        "cz" => &mut p.cz,
+        "slip_force" => &mut p.slip_force,
+        "mass" => &mut p.mass,
+        "youngs_modulus_1" => &mut p.youngs_modulus_1,
+        "youngs_modulus_2" => &mut p.youngs_modulus_2,
+        "poisson_ratio_12" => &mut p.poisson_ratio_12,
+        "shear_modulus_12" => &mut p.shear_modulus_12,
+        "thickness" => &mut p.thickness,
+        "hourglass" => &mut p.hourglass,
+        "material_angle" => &mut p.material_angle,
+        "width" => &mut p.width,
+        "height" => &mut p.height,
+        "poisson_ratio" => &mut p.poisson_ratio,
+        _ => return None,
+    })
+}
+
+/// One part property a parameter sets: value × factor.
+#[derive(Debug, Clone, Serialize)]
+pub struct Target {
+    pub part: String,
+    pub property: String,
+    pub factor: f64,
+    #[serde(skip)]
+    part_index: usize,
+}
+
+/// A fitted parameter.
+#[derive(Debug, Clone, Serialize)]
+pub struct Parameter {
+    /// The name as given (`membrane.shear_modulus_12`, `links.kx,links.ky`).
+    pub name: String,
+    pub targets: Vec<Target>,
+    pub lower: f64,
+    pub upper: f64,
+    pub log: bool,
+    /// Start value (the model's own when not given).
+    pub initial: f64,
+}
+
+impl Parameter {
+    /// Value at z ∈ [0, 1] of the parameter's scale.
+    pub fn value(&self, z: f64) -> f64 {
+        let z = z.clamp(0.0, 1.0);
+        if self.log {
+            (self.lower.ln() + z * (self.upper.ln() - self.lower.ln())).exp()
+        } else {
+            self.lower + z * (self.upper - self.lower)
+        }
+    }
+    /// Position of `v` on the parameter's scale.
+    pub fn unit(&self, v: f64) -> f64 {
+        let z = if self.log {
+            (v.ln() - self.lower.ln()) / (self.upper.ln() - self.lower.ln())
+        } else {
+            (v - self.lower) / (self.upper - self.lower)
+        };
+        z.clamp(0.0, 1.0)
+    }
+}
+
+fn bad_param(spec: &str, what: impl Into<String>) -> WeftError {
+    WeftError::input(format!("--param `{spec}`: {}", what.into())).expected(
+        "PART.PROPERTY[*FACTOR][,PART.PROPERTY[*FACTOR]...]:LOWER:UPPER[:log|lin][:INITIAL], \
+         e.g. `membrane.shear_modulus_12:1e8:1e10:log`",
+    )
+}
+
+fn number(spec: &str, field: &str, s: &str) -> Result<f64> {
+    s.trim()
+        .parse::<f64>()
+        .ok()
+        .filter(|v| v.is_finite())
+        .ok_or_else(|| bad_param(spec, format!("{field} `{s}` is not a finite number")))
+}
+
+/// Parse `--param` against the model whose parts it names.
+pub fn parse_param(spec: &str, m: &Model) -> Result<Parameter> {
+    let fields: Vec<&str> = spec.split(':').collect();
+    if !(3..=5).contains(&fields.len()) {
+        return Err(bad_param(
+            spec,
+            format!("{} `:`-separated fields", fields.len()),
+        ));
+    }
+    let lower = number(spec, "lower bound", fields[1])?;
+    let upper = number(spec, "upper bound", fields[2])?;
+    let mut log = false;
+    let mut initial = None;
+    for f in &fields[3..] {
+        match f.trim() {
+            "log" => log = true,
+            "lin" => log = false,
+            v => initial = Some(number(spec, "initial value", v)?),
+        }
+    }
+    if lower >= upper {
+        return Err(bad_param(
+            spec,
+            format!("lower bound {lower:e} is not below the upper bound {upper:e}"),
+        ));
+    }
+    if log && lower <= 0.0 {
+        return Err(bad_param(
+            spec,
+            format!("a log scale needs bounds > 0, the lower bound is {lower:e}"),
+        ));
+    }
+    let mut targets = vec![];
+    for t in fields[0].split(',') {
+        let (name, factor) = match t.split_once('*') {
+            Some((n, f)) => (n.trim(), number(spec, "factor", f)?),
+            None => (t.trim(), 1.0),
+        };
+        let (part, prop) = name
+            .split_once('.')
+            .ok_or_else(|| bad_param(spec, format!("`{name}` is not of the form PART.PROPERTY")))?;
+        let prop = ALIASES
+            .iter()
+            .find(|a| a.0 == prop)
+            .map(|a| a.1)
+            .unwrap_or(prop);
+        let pi = m.parts.iter().position(|p| p.name == part).ok_or_else(|| {
+            bad_param(spec, format!("the model has no part named `{part}`")).hint(format!(
+                "parts: {}",
+                m.parts
+                    .iter()
+                    .map(|p| format!("`{}` ({})", p.name, p.kind.name()))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ))
+        })?;
+        let kind = m.parts[pi].kind;
+        let applies: Vec<&str> = PROPERTIES
+            .iter()
+            .filter(|(_, ks)| ks.contains(&kind))
+            .map(|(n, _)| *n)
+            .collect();
+        if !applies.contains(&prop) {
+            return Err(bad_param(
+                spec,
+                format!("part `{part}` ({}) has no property `{prop}`", kind.name()),
+            )
+            .hint(format!(
+                "a {} part's fittable properties: {}",
+                kind.name(),
+                applies.join(", ")
+            )));
+        }
+        targets.push(Target {
+            part: part.to_string(),
+            property: prop.to_string(),
+            factor,
+            part_index: pi,
+        });
+    }
+    let current = {
+        let t = &targets[0];
+        let mut p = m.parts[t.part_index].props.clone();
+        slot(&mut p, &t.property)
+            .and_then(|v| *v)
+            .map(|v| v / t.factor)
+    };
+    let initial = match initial.or(current) {
+        Some(v) if (lower..=upper).contains(&v) => v,
+        Some(v) if initial.is_some() => {
+            return Err(bad_param(
+                spec,
+                format!("initial value {v:e} lies outside [{lower:e}, {upper:e}]"),
+            ))
+        }
+        // The model's own value is outside the bounds: start from the middle of the scale.
+        _ => {
+            let mid = Parameter {
+                name: String::new(),
+                targets: vec![],
+                lower,
+                upper,
+                log,
+                initial: 0.0,
+            };
+            mid.value(0.5)
+        }
+    };
+    Ok(Parameter {
+        name: fields[0].trim().to_string(),
+        targets,
+        lower,
+        upper,
+        log,
+        initial,
+    })
+}
+
+/// Set the parameters' values (physical units) on a model.
+pub fn apply(m: &mut Model, params: &[Parameter], values: &[f64]) {
+    for (p, &v) in params.iter().zip(values) {
+        for t in &p.targets {
+            let s = slot(&mut m.parts[t.part_index].props, &t.property)
+                .expect("checked by parse_param");
+            *s = Some(v * t.factor);
+        }
+    }
+}
+
+/// One reference to match: its history over a node set, and the candidate model loaded
+/// the same way.
+#[derive(Debug, Clone)]
+pub struct Case {
+    pub name: String,
+    pub reference: Series,
+    pub model: Model,
+    /// The candidate's node set compared with the reference's.
+    pub set: String,
+}
+
+/// What is minimised.
+#[derive(Debug, Clone)]
+pub struct Problem {
+    pub cases: Vec<Case>,
+    pub params: Vec<Parameter>,
+    /// Displacement components compared (0..3 = ux, uy, uz).
+    pub components: Vec<usize>,
+    /// Node matching tolerance [m].
+    pub tolerance: f64,
+    /// Linear static solves, comparing final displacements.
+    pub static_mode: bool,
+}
+
+impl Problem {
+    /// Check the cases once: node sets exist and match the references.
+    pub fn check(&self) -> Result<()> {
+        if self.params.is_empty() {
+            return Err(WeftError::input("no parameter to fit")
+                .expected("at least one --param PART.PROPERTY:LOWER:UPPER"));
+        }
+        for c in &self.cases {
+            let set = c.model.node_sets.get(&c.set).ok_or_else(|| {
+                WeftError::input(format!(
+                    "case `{}`: the candidate model has no node set `{}`",
+                    c.name, c.set
+                ))
+                .expected(format!(
+                    "one of {}",
+                    c.model
+                        .node_sets
+                        .keys()
+                        .cloned()
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ))
+            })?;
+            let cand = Series {
+                t: vec![0.0],
+                node_id: set.iter().map(|&i| c.model.node_id[i]).collect(),
+                x0: set.iter().map(|&i| c.model.coords[i]).collect(),
+                values: vec![vec![[0.0; 6]; set.len()]],
+            };
+            crate::analysis::match_nodes(&c.reference, &cand, self.tolerance)
+                .map_err(|e| prefix(e, &c.name))?;
+        }
+        Ok(())
+    }
+
+    /// The candidate model of case `k` at parameter values `x`.
+    pub fn model_at(&self, k: usize, x: &[f64]) -> Model {
+        let mut m = self.cases[k].model.clone();
+        apply(&mut m, &self.params, x);
+        m
+    }
+
+    /// T of one case at `x` (physical values).
+    pub fn case_t(&self, k: usize, x: &[f64]) -> Result<f64> {
+        let c = &self.cases[k];
+        let cand = respond(&self.model_at(k, x), &c.set, self.static_mode)?;
+        Ok(mismatch(
+            &c.reference,
+            &cand,
+            &self.components,
+            self.tolerance,
+            self.static_mode,
+        )?
+        .t_value)
+    }
+
+    /// Mean T over the cases at `x` (physical values).
+    pub fn objective(&self, x: &[f64]) -> Result<f64> {
+        let mut sum = 0.0;
+        for k in 0..self.cases.len() {
+            sum += self
+                .case_t(k, x)
+                .map_err(|e| prefix(e, &self.cases[k].name))?;
+        }
+        Ok(sum / self.cases.len() as f64)
+    }
+
+    fn values(&self, z: &[f64]) -> Vec<f64> {
+        self.params
+            .iter()
+            .zip(z)
+            .map(|(p, &z)| p.value(z))
+            .collect()
+    }
+}
+
+/// Solve a model in-process (explicit, or the linear static solve) and return the
+/// response of node set `set` as a [`Series`] (one sample at t = 0 when static).
+pub fn respond(m: &Model, set: &str, static_mode: bool) -> Result<Series> {
+    let mut m = m.clone();
+    let nodes = m
+        .node_sets
+        .get(set)
+        .ok_or_else(|| {
+            WeftError::input(format!("the model has no node set `{set}`")).expected(format!(
+                "one of {}",
+                m.node_sets.keys().cloned().collect::<Vec<_>>().join(", ")
+            ))
+        })?
+        .clone();
+    m.analysis.history_sets = vec![set.to_string()];
+    let solver = match Solver::new(&m) {
+        // A fixed step chosen for the generator's parameters may exceed the stable step of
+        // the candidate's: fall back to the stable step.
+        Err(_) if m.analysis.time_step.is_some() => {
+            m.analysis.time_step = None;
+            Solver::new(&m)?
+        }
+        r => r?,
+    };
+    let (t, values) = if static_mode {
+        let r = solver.solve_static(&m)?;
+        let v: Vec<[f64; 6]> = nodes
+            .iter()
+            .map(|&i| [r.u[i][0], r.u[i][1], r.u[i][2], 0.0, 0.0, 0.0])
+            .collect();
+        (vec![0.0], vec![v])
+    } else {
+        let mut solver = solver;
+        let mut sink = MemorySink::default();
+        solver.run(&mut sink, &mut |_| {})?;
+        let pos: std::collections::HashMap<usize, usize> = sink
+            .nodes
+            .iter()
+            .enumerate()
+            .map(|(j, &i)| (i, j))
+            .collect();
+        let values = (0..sink.t.len())
+            .map(|k| {
+                nodes
+                    .iter()
+                    .map(|i| {
+                        let j = pos[i];
+                        let (u, v) = (sink.u[k][j], sink.v[k][j]);
+                        [u[0], u[1], u[2], v[0], v[1], v[2]]
+                    })
+                    .collect()
+            })
+            .collect();
+        (sink.t.clone(), values)
+    };
+    Ok(Series {
+        t,
+        node_id: nodes.iter().map(|&i| m.node_id[i]).collect(),
+        x0: nodes.iter().map(|&i| m.coords[i]).collect(),
+        values,
+    })
+}
+
+fn prefix(e: WeftError, case: &str) -> WeftError {
+    match e {
+        WeftError::Input {
+            what,
+            at,
+            expected,
+            hint,
+        } => WeftError::Input {
+            what: format!("case `{case}`: {what}"),
+            at,
+            expected,
+            hint,
+        },
+        e => e,
+    }
+}
+
+/// Local method.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum Method {
+    /// COBYLA: derivative-free, bounded (Powell 1994).
+    Cobyla,
+    /// Projected BFGS with central finite-difference gradients.
+    Gradient,
+}
+
+/// Stopping rules and the global search.
+#[derive(Debug, Clone, Serialize)]
+pub struct Options {
+    pub method: Method,
+    /// Local searches: 1 = local only; more = multistart.
+    pub starts: usize,
+    /// Objective evaluations per local search, at most.
+    pub max_evaluations: usize,
+    /// Stop when steps on the unit box are below this.
+    pub xtol: f64,
+    /// Stop when T changes by less than this, relatively.
+    pub ftol: f64,
+    /// Stop a search when T falls below this.
+    pub target: f64,
+    /// Initial step on the unit box (COBYLA's ρ_beg).
+    pub initial_step: f64,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Options {
+            method: Method::Cobyla,
+            starts: 1,
+            max_evaluations: 200,
+            xtol: 1e-6,
+            ftol: 1e-10,
+            target: 0.0,
+            initial_step: 0.1,
+        }
+    }
+}
+
+/// One objective evaluation.
+#[derive(Debug, Clone)]
+pub struct Evaluation {
+    pub start: usize,
+    /// Index within its start.
+    pub index: usize,
+    /// Parameter values (physical units).
+    pub x: Vec<f64>,
+    pub t: f64,
+    pub seconds: f64,
+    pub error: Option<String>,
+}
+
+/// Outcome of one local search.
+#[derive(Debug, Clone)]
+pub struct StartResult {
+    pub start: usize,
+    pub x0: Vec<f64>,
+    pub x: Vec<f64>,
+    pub t: f64,
+    pub evaluations: usize,
+    pub status: String,
+}
+
+/// Outcome of a fit.
+#[derive(Debug, Clone)]
+pub struct FitResult {
+    pub x: Vec<f64>,
+    pub t: f64,
+    pub t_initial: f64,
+    pub starts: Vec<StartResult>,
+    /// Every evaluation, ordered by start, then index.
+    pub evaluations: Vec<Evaluation>,
+}
+
+/// Halton sequence point `i` (i ≥ 1) in [0, 1]ⁿ: deterministic, well spread starts.
+pub fn halton(i: usize, n: usize) -> Vec<f64> {
+    const PRIMES: [usize; 16] = [2, 3, 5, 7, 11, 13, 17, 19, 23, 29, 31, 37, 41, 43, 47, 53];
+    (0..n)
+        .map(|d| {
+            let b = PRIMES[d % PRIMES.len()];
+            let (mut f, mut r, mut k) = (1.0, 0.0, i);
+            while k > 0 {
+                f /= b as f64;
+                r += f * (k % b) as f64;
+                k /= b;
+            }
+            r
+        })
+        .collect()
+}
+
+/// Evaluations of one local search, with the caller's callback.
+struct Evaluator<'a> {
+    problem: &'a Problem,
+    start: usize,
+    log: Mutex<Vec<Evaluation>>,
+    on_eval: &'a (dyn Fn(&Evaluation) + Sync),
+}
+
+impl Evaluator<'_> {
+    /// T at unit-box points, evaluated in parallel, logged in the given order.
+    fn eval_many(&self, zs: &[Vec<f64>]) -> Vec<f64> {
+        let out: Vec<(Vec<f64>, f64, f64, Option<String>)> = zs
+            .par_iter()
+            .map(|z| {
+                let x = self.problem.values(z);
+                let t0 = Instant::now();
+                let (t, err) = match self.problem.objective(&x) {
+                    Ok(t) if t.is_finite() => (t, None),
+                    Ok(t) => (FAILED_T, Some(format!("T = {t}"))),
+                    Err(e) => (FAILED_T, Some(e.to_string())),
+                };
+                (x, t, t0.elapsed().as_secs_f64(), err)
+            })
+            .collect();
+        let mut log = self.log.lock().expect("log");
+        out.into_iter()
+            .map(|(x, t, seconds, error)| {
+                let e = Evaluation {
+                    start: self.start,
+                    index: log.len(),
+                    x,
+                    t,
+                    seconds,
+                    error,
+                };
+                (self.on_eval)(&e);
+                log.push(e);
+                t
+            })
+            .collect()
+    }
+    fn eval(&self, z: &[f64]) -> f64 {
+        self.eval_many(&[z.to_vec()])[0]
+    }
+    fn count(&self) -> usize {
+        self.log.lock().expect("log").len()
+    }
+}
+
+/// Minimise the problem's T. `on_eval` sees every evaluation as it completes (progress).
+pub fn fit(
+    problem: &Problem,
+    opts: &Options,
+    on_eval: &(dyn Fn(&Evaluation) + Sync),
+) -> Result<FitResult> {
+    problem.check()?;
+    let n = problem.params.len();
+    let z_init: Vec<f64> = problem.params.iter().map(|p| p.unit(p.initial)).collect();
+    let starts: Vec<Vec<f64>> = (0..opts.starts.max(1))
+        .map(|s| if s == 0 { z_init.clone() } else { halton(s, n) })
+        .collect();
+    let runs: Vec<(StartResult, Vec<Evaluation>)> = starts
+        .par_iter()
+        .enumerate()
+        .map(|(s, z0)| {
+            let ev = Evaluator {
+                problem,
+                start: s,
+                log: Mutex::new(vec![]),
+                on_eval,
+            };
+            let (z, t, status) = match opts.method {
+                Method::Cobyla => cobyla_search(&ev, z0, opts),
+                Method::Gradient => gradient_search(&ev, z0, opts),
+            };
+            let r = StartResult {
+                start: s,
+                x0: problem.values(z0),
+                x: problem.values(&z),
+                t,
+                evaluations: ev.count(),
+                status,
+            };
+            (r, ev.log.into_inner().expect("log"))
+        })
+        .collect();
+    let t_initial = runs[0].1.first().map(|e| e.t).unwrap_or(f64::NAN);
+    let mut starts_out = vec![];
+    let mut evaluations = vec![];
+    for (r, log) in runs {
+        starts_out.push(r);
+        evaluations.extend(log);
+    }
+    // The best evaluation overall (the first one on ties, in trace order).
+    let best = evaluations
+        .iter()
+        .min_by(|a, b| a.t.total_cmp(&b.t))
+        .expect("at least one evaluation");
+    if best.t >= FAILED_T {
+        return Err(WeftError::input(format!(
+            "every one of {} evaluations failed; the first: {}",
+            evaluations.len(),
+            evaluations[0].error.as_deref().unwrap_or("?")
+        ))
+        .expected("parameter bounds within which the model runs")
+        .hint("narrow the bounds to values the model can run with"));
+    }
+    Ok(FitResult {
+        x: best.x.clone(),
+        t: best.t,
+        t_initial,
+        starts: starts_out,
+        evaluations,
+    })
+}
+
+fn cobyla_search(ev: &Evaluator, z0: &[f64], opts: &Options) -> (Vec<f64>, f64, String) {
+    let n = z0.len();
+    let f = |z: &[f64], _: &mut ()| ev.eval(z);
+    let cons: Vec<&dyn cobyla::Func<()>> = vec![];
+    let stop = cobyla::StopTols {
+        ftol_rel: opts.ftol,
+        xtol_abs: vec![opts.xtol; n],
+        ..Default::default()
+    };
+    // Stop on the target T through COBYLA's own `stopval`-like check: the crate has none,
+    // so the evaluation budget and tolerances end the search.
+    match cobyla::minimize(
+        f,
+        z0,
+        &vec![(0.0, 1.0); n],
+        &cons,
+        (),
+        opts.max_evaluations,
+        cobyla::RhoBeg::All(opts.initial_step),
+        Some(stop),
+    ) {
+        Ok((status, z, t)) => (z, t, format!("{status:?}")),
+        Err((status, z, t)) => (z, t, format!("{status:?}")),
+    }
+}
+
+/// Projected BFGS on the unit box with central-difference gradients (one-sided at a
+/// bound), the 2n gradient evaluations in parallel; Armijo backtracking along the
+/// projected path.
+fn gradient_search(ev: &Evaluator, z0: &[f64], opts: &Options) -> (Vec<f64>, f64, String) {
+    let n = z0.len();
+    let h = 1e-5;
+    let grad = |z: &[f64], f: f64| -> Vec<f64> {
+        let mut pts = vec![];
+        for i in 0..n {
+            let (mut zp, mut zm) = (z.to_vec(), z.to_vec());
+            zp[i] = (z[i] + h).min(1.0);
+            zm[i] = (z[i] - h).max(0.0);
+            pts.push(zp);
+            pts.push(zm);
+        }
+        let fs = ev.eval_many(&pts);
+        (0..n)
+            .map(|i| {
+                let (zp, zm) = (pts[2 * i][i], pts[2 * i + 1][i]);
+                // The centre value stands in for a side clipped to the bound.
+                let fp = if zp > z[i] { fs[2 * i] } else { f };
+                let fm = if zm < z[i] { fs[2 * i + 1] } else { f };
+                (fp - fm) / (zp.max(z[i]) - zm.min(z[i]))
+            })
+            .collect()
+    };
+    let project = |z: &mut [f64]| z.iter_mut().for_each(|v| *v = v.clamp(0.0, 1.0));
+    let mut z = z0.to_vec();
+    let mut f = ev.eval(&z);
+    let mut g = grad(&z, f);
+    let mut hinv = nalgebra::DMatrix::<f64>::identity(n, n);
+    let status = loop {
+        if ev.count() >= opts.max_evaluations {
+            break "MaxEvalReached".to_string();
+        }
+        if f <= opts.target {
+            break "StopValReached".to_string();
+        }
+        // Variables held at a bound by the gradient are out of the step.
+        let free: Vec<bool> = (0..n)
+            .map(|i| !((z[i] <= 0.0 && g[i] > 0.0) || (z[i] >= 1.0 && g[i] < 0.0)))
+            .collect();
+        let pg: f64 = (0..n)
+            .filter(|&i| free[i])
+            .map(|i| g[i].abs())
+            .fold(0.0, f64::max);
+        if pg < 1e-12 {
+            break "GradientSmall".to_string();
+        }
+        let gv =
+            nalgebra::DVector::from_iterator(n, (0..n).map(|i| if free[i] { g[i] } else { 0.0 }));
+        let mut d: Vec<f64> = (-(&hinv * &gv)).iter().copied().collect();
+        for i in 0..n {
+            if !free[i] {
+                d[i] = 0.0;
+            }
+        }
+        if d.iter().zip(&g).map(|(a, b)| a * b).sum::<f64>() >= 0.0 {
+            hinv = nalgebra::DMatrix::identity(n, n);
+            d = (0..n).map(|i| if free[i] { -g[i] } else { 0.0 }).collect();
+        }
+        // Keep a first step within the box's scale.
+        let dmax = d.iter().map(|v| v.abs()).fold(0.0, f64::max);
+        let mut alpha = if dmax > 0.5 { 0.5 / dmax } else { 1.0 };
+        let mut accepted = None;
+        for _ in 0..30 {
+            let mut zn: Vec<f64> = z.iter().zip(&d).map(|(a, b)| a + alpha * b).collect();
+            project(&mut zn);
+            let dz: Vec<f64> = zn.iter().zip(&z).map(|(a, b)| a - b).collect();
+            let decrease: f64 = dz.iter().zip(&g).map(|(a, b)| a * b).sum();
+            if dz.iter().all(|v| v.abs() < opts.xtol * 1e-3) {
+                break;
+            }
+            let fn_ = ev.eval(&zn);
+            if fn_ <= f + 1e-4 * decrease {
+                accepted = Some((zn, fn_));
+                break;
+            }
+            alpha *= 0.5;
+        }
+        let Some((zn, fnew)) = accepted else {
+            break "LineSearchStalled".to_string();
+        };
+        let step: f64 = zn
+            .iter()
+            .zip(&z)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
+        let df = (f - fnew).abs();
+        let gn = grad(&zn, fnew);
+        let s = nalgebra::DVector::from_iterator(n, zn.iter().zip(&z).map(|(a, b)| a - b));
+        let y = nalgebra::DVector::from_iterator(n, gn.iter().zip(&g).map(|(a, b)| a - b));
+        let sy = s.dot(&y);
+        if sy > 1e-14 * s.norm() * y.norm() && sy > 0.0 {
+            let rho = 1.0 / sy;
+            let i = nalgebra::DMatrix::<f64>::identity(n, n);
+            let a = &i - rho * &s * y.transpose();
+            let b = &i - rho * &y * s.transpose();
+            hinv = &a * &hinv * &b + rho * &s * s.transpose();
+        }
+        z = zn;
+        f = fnew;
+        g = gn;
+        if step < opts.xtol {
+            break "XtolReached".to_string();
+        }
+        if df <= opts.ftol * f.abs().max(1e-300) {
+            break "FtolReached".to_string();
+        }
+    };
+    (z, f, status)
+}
