@@ -81,13 +81,19 @@ fn run() -> anyhow::Result<()> {
         &cli.out_dir.join("error.parquet"),
         &batch(vec![
             Col::I64("node_id", r.per_node.iter().map(|x| x.0).collect()),
+            Col::F64("x", q.x0.iter().map(|x| x[0]).collect()),
+            Col::F64("y", q.x0.iter().map(|x| x[1]).collect()),
+            Col::F64("z", q.x0.iter().map(|x| x[2]).collect()),
             Col::I64(
                 "candidate_node_id",
                 r.per_node.iter().map(|x| x.1).collect(),
             ),
-            Col::F64(
+            Col::OptF64(
                 "peak_relative_error",
-                r.per_node.iter().map(|x| x.2).collect(),
+                r.per_node
+                    .iter()
+                    .map(|x| x.2.is_finite().then_some(x.2))
+                    .collect(),
             ),
         ]),
         &prov,
