@@ -88,6 +88,10 @@ struct Cli {
     /// First step on the unit parameter box (COBYLA's ρ_beg).
     #[arg(long, default_value_t = 0.1)]
     initial_step: f64,
+    /// A value to compare a fitted parameter with (repeat): NAME=VALUE, NAME as in --param
+    /// (e.g. a closed form); fit_result.parquet gets `expected` and `relative_difference`.
+    #[arg(long)]
+    expected: Vec<String>,
     /// Worker threads (0: all cores). Results do not depend on it.
     #[arg(long, default_value_t = 0)]
     threads: usize,
@@ -180,6 +184,22 @@ fn run() -> anyhow::Result<()> {
         for s in &cli.params {
             parse_param(s, &c.model).with_context(|| format!("case `{}`", c.name))?;
         }
+    }
+    let mut expected = vec![None; params.len()];
+    for e in &cli.expected {
+        let (name, value) = e.split_once('=').with_context(|| {
+            format!("--expected `{e}`: expected NAME=VALUE, NAME one of the --param names")
+        })?;
+        let k = params.iter().position(|p| p.name == name.trim()).with_context(|| {
+            format!(
+                "--expected `{e}`: no fitted parameter is named `{name}` (expected one of {})",
+                params.iter().map(|p| format!("`{}`", p.name)).collect::<Vec<_>>().join(", ")
+            )
+        })?;
+        let v: f64 = value.trim().parse().ok().filter(|v: &f64| v.is_finite()).with_context(|| {
+            format!("--expected `{e}`: `{value}` is not a finite number")
+        })?;
+        expected[k] = Some(v);
     }
     let problem = Problem {
         cases,
@@ -313,6 +333,15 @@ fn run() -> anyhow::Result<()> {
                     })
                     .collect(),
             ),
+            Col::OptF64("expected", expected.clone()),
+            Col::OptF64(
+                "relative_difference",
+                expected
+                    .iter()
+                    .zip(&r.x)
+                    .map(|(e, v)| e.map(|e| (v - e) / e))
+                    .collect(),
+            ),
             Col::F64("T", rep(r.t)),
             Col::F64("T_initial", rep(r.t_initial)),
             Col::I64("evaluations", vec![ev.len() as i64; np]),
@@ -342,9 +371,12 @@ fn run() -> anyhow::Result<()> {
         cli.starts,
         wall
     );
-    for (p, v) in problem.params.iter().zip(&r.x) {
+    for ((p, v), e) in problem.params.iter().zip(&r.x).zip(&expected) {
+        let cmp = e
+            .map(|e| format!(", expected {e:.4e}: {:+.2} %", 100.0 * (v - e) / e))
+            .unwrap_or_default();
         eprintln!(
-            "  {:<32} {:.6e}  (start {:.4e}, bounds {:.3e} … {:.3e}, {})",
+            "  {:<32} {:.6e}  (start {:.4e}, bounds {:.3e} … {:.3e}, {}{cmp})",
             p.name,
             v,
             p.initial,
