@@ -148,3 +148,94 @@ fn a_generated_woven_model_opens_in_pandas_and_polars() {
     );
     eprintln!("{}", String::from_utf8_lossy(&o.stdout));
 }
+
+/// The fit and error stages' tables open in pandas and polars, with a parameter's name
+/// (`membrane.G12`) as a column and nulls where documented.
+#[test]
+fn fit_and_error_tables_open_in_pandas_and_polars() {
+    if !python_ok() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let s = |p: &str| d.join(p).to_string_lossy().to_string();
+    let ok = |c: &mut Command| {
+        let o = c.output().unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    };
+    ok(Command::new(env!("CARGO_BIN_EXE_weft-weave")).args([
+        "membrane",
+        "--cells",
+        "3",
+        "--load-case",
+        "shear",
+        "--out",
+        &s("ref"),
+    ]));
+    ok(Command::new(env!("CARGO_BIN_EXE_weft-weave")).args([
+        "membrane",
+        "--cells",
+        "3",
+        "--load-case",
+        "shear",
+        "--shear-modulus",
+        "1e9",
+        "--out",
+        &s("cand"),
+    ]));
+    ok(Command::new(env!("CARGO_BIN_EXE_weft-simulate")).args([
+        "--static",
+        "--quiet",
+        "--model",
+        &s("ref"),
+        "--out",
+        &s("refout"),
+    ]));
+    ok(Command::new(env!("CARGO_BIN_EXE_weft-fit")).args([
+        "--reference-model",
+        &s("ref"),
+        "--reference-history",
+        &s("refout/history.parquet"),
+        "--model",
+        &s("cand"),
+        "--static",
+        "--components",
+        "ux,uy",
+        "--quiet",
+        "--param",
+        "membrane.G12:1e8:1e10:log",
+        "--expected",
+        "membrane.G12=7.5e8",
+        "--out",
+        &s("fit"),
+    ]));
+    ok(Command::new(env!("CARGO_BIN_EXE_weft-error")).args([
+        "--reference-model",
+        &s("ref"),
+        "--reference-history",
+        &s("refout/history.parquet"),
+        "--model",
+        &s("ref"),
+        "--history",
+        &s("refout/history.parquet"),
+        "--static",
+        "--out-dir",
+        &s("fit"),
+    ]));
+    let o = Command::new("python3")
+        .arg(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/read_tables.py"))
+        .arg(env!("CARGO_BIN_EXE_weft-simulate"))
+        .arg(d.join("fit/models/cand"))
+        .arg(d.join("fit"))
+        .arg(d)
+        .arg("open-only")
+        .output()
+        .unwrap();
+    assert!(
+        o.status.success(),
+        "read_tables.py failed:\n{}\n{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    );
+    eprintln!("{}", String::from_utf8_lossy(&o.stdout));
+}

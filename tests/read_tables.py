@@ -36,6 +36,12 @@ EXPECT = {
     "ties.parquet": {"slave": "int64", "m1": "int64", "m2": "int64"},
     "symmetry.parquet": {"normal": "string", "position": "float64"},
     "curves.parquet": {"curve": "string", "t": "float64", "value": "float64"},
+    "fit_trace.parquet": {"evaluation": "int64", "start": "int64", "T": "float64", "best_T": "float64",
+                          "wall_seconds": "float64", "membrane.G12": "float64"},
+    "fit_result.parquet": {"name": "string", "value": "float64", "lower": "float64", "upper": "float64",
+                           "T": "float64", "T_initial": "float64", "expected": "float64", "at_bound": "bool"},
+    "error.parquet": {"node_id": "int64", "x": "float64", "peak_relative_error": "float64"},
+    "error_summary.parquet": {"T": "float64", "max_peak_relative_error": "float64"},
 }
 # Result tables that share a name with a model table.
 RESULT_EXPECT = {

@@ -190,15 +190,22 @@ fn run() -> anyhow::Result<()> {
         let (name, value) = e.split_once('=').with_context(|| {
             format!("--expected `{e}`: expected NAME=VALUE, NAME one of the --param names")
         })?;
-        let k = params.iter().position(|p| p.name == name.trim()).with_context(|| {
-            format!(
+        let k =
+            params
+                .iter()
+                .position(|p| p.name == name.trim())
+                .with_context(|| {
+                    format!(
                 "--expected `{e}`: no fitted parameter is named `{name}` (expected one of {})",
                 params.iter().map(|p| format!("`{}`", p.name)).collect::<Vec<_>>().join(", ")
             )
-        })?;
-        let v: f64 = value.trim().parse().ok().filter(|v: &f64| v.is_finite()).with_context(|| {
-            format!("--expected `{e}`: `{value}` is not a finite number")
-        })?;
+                })?;
+        let v: f64 = value
+            .trim()
+            .parse()
+            .ok()
+            .filter(|v: &f64| v.is_finite())
+            .with_context(|| format!("--expected `{e}`: `{value}` is not a finite number"))?;
         expected[k] = Some(v);
     }
     let problem = Problem {

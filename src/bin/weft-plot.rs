@@ -206,12 +206,7 @@ fn label(labels: &[String], k: usize, path: &Path) -> String {
 
 /// Scale a quantity to a readable unit: (factor, unit prefix).
 fn readable(max_abs: f64, unit: &str) -> (f64, String) {
-    let steps = [
-        (1.0, ""),
-        (1e3, "m"),
-        (1e6, "µ"),
-        (1e9, "n"),
-    ];
+    let steps = [(1.0, ""), (1e3, "m"), (1e6, "µ"), (1e9, "n")];
     for (f, p) in steps {
         if max_abs * f >= 1.0 || f == 1e9 {
             return (f, format!("{p}{unit}"));
@@ -249,7 +244,12 @@ fn history(a: &HistoryArgs) -> anyhow::Result<Chart> {
                 format!(
                     "model `{}` has no node set `{set}` (expected one of {})",
                     a.model[0].display(),
-                    first.node_sets.keys().cloned().collect::<Vec<_>>().join(", ")
+                    first
+                        .node_sets
+                        .keys()
+                        .cloned()
+                        .collect::<Vec<_>>()
+                        .join(", ")
                 )
             })?;
             if nodes.len() > 8 {
@@ -271,7 +271,10 @@ fn history(a: &HistoryArgs) -> anyhow::Result<Chart> {
     let mut positions = vec![];
     for id in &ids {
         let i = index.get(id).with_context(|| {
-            format!("--nodes: model `{}` has no node `{id}`", a.model[0].display())
+            format!(
+                "--nodes: model `{}` has no node `{id}`",
+                a.model[0].display()
+            )
         })?;
         positions.push(first.coords[*i]);
     }
@@ -407,9 +410,12 @@ fn wavespeed(a: &WavespeedArgs) -> anyhow::Result<Chart> {
         let t = Table::read(p)?;
         const COLS: &str = "position, node_speed, segment_speed";
         let x = t.f64("position", COLS)?;
-        let v = t
-            .f64_opt(col)?
-            .with_context(|| format!("`{}` has no column `{col}` (expected a wavespeeds.parquet)", p.display()))?;
+        let v = t.f64_opt(col)?.with_context(|| {
+            format!(
+                "`{}` has no column `{col}` (expected a wavespeeds.parquet)",
+                p.display()
+            )
+        })?;
         let points: Vec<(f64, f64)> = x
             .iter()
             .zip(v)
@@ -438,7 +444,12 @@ fn error(a: &ErrorArgs) -> anyhow::Result<Chart> {
         const COLS: &str = "node_id, x, y, z, peak_relative_error";
         let e: Vec<f64> = t
             .f64_opt("peak_relative_error")?
-            .with_context(|| format!("`{}` has no column `peak_relative_error` (expected an error.parquet)", p.display()))?
+            .with_context(|| {
+                format!(
+                    "`{}` has no column `peak_relative_error` (expected an error.parquet)",
+                    p.display()
+                )
+            })?
             .into_iter()
             .map(|v| v.unwrap_or(f64::NAN))
             .collect();
@@ -461,11 +472,7 @@ fn error(a: &ErrorArgs) -> anyhow::Result<Chart> {
         };
         series.push(Series {
             label: label(&a.label, k, p),
-            points: s
-                .into_iter()
-                .zip(e)
-                .filter(|p| p.1.is_finite())
-                .collect(),
+            points: s.into_iter().zip(e).filter(|p| p.1.is_finite()).collect(),
             style: if a.along == "distance" {
                 Style::LinePoints
             } else {
@@ -491,21 +498,35 @@ fn fit(a: &FitArgs) -> anyhow::Result<Chart> {
     for (k, p) in a.trace.iter().enumerate() {
         let t = Table::read(p)?;
         const COLS: &str = "evaluation, T, best_T";
-        let n: Vec<f64> = t.i64("evaluation", COLS)?.iter().map(|&v| v as f64 + 1.0).collect();
+        let n: Vec<f64> = t
+            .i64("evaluation", COLS)?
+            .iter()
+            .map(|&v| v as f64 + 1.0)
+            .collect();
         let best = t.f64("best_T", COLS)?;
         let all = t.f64("T", COLS)?;
         let name = label(&a.label, k, p);
         if a.all {
             series.push(Series {
                 label: format!("{name}: T"),
-                points: n.iter().zip(&all).filter(|p| *p.1 > 0.0).map(|(x, y)| (*x, *y)).collect(),
+                points: n
+                    .iter()
+                    .zip(&all)
+                    .filter(|p| *p.1 > 0.0)
+                    .map(|(x, y)| (*x, *y))
+                    .collect(),
                 style: Style::Points,
                 color: k,
             });
         }
         series.push(Series {
             label: format!("{name}: best T"),
-            points: n.iter().zip(&best).filter(|p| *p.1 > 0.0).map(|(x, y)| (*x, *y)).collect(),
+            points: n
+                .iter()
+                .zip(&best)
+                .filter(|p| *p.1 > 0.0)
+                .map(|(x, y)| (*x, *y))
+                .collect(),
             style: Style::Line,
             color: k,
         });
@@ -526,17 +547,29 @@ fn save(chart: &Chart, c: &Common) -> anyhow::Result<()> {
         .map(|e| e.to_string_lossy().to_lowercase())
         .unwrap_or_default();
     if c.width < 200 || c.height < 150 {
-        bail!("--width {} --height {}: expected at least 200 × 150 pixels", c.width, c.height);
+        bail!(
+            "--width {} --height {}: expected at least 200 × 150 pixels",
+            c.width,
+            c.height
+        );
     }
     if chart.series.iter().all(|s| s.points.is_empty()) {
         bail!("nothing to plot: every series is empty");
     }
     if let Some(dir) = c.out.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir).with_context(|| format!("cannot create `{}`", dir.display()))?;
+        std::fs::create_dir_all(dir)
+            .with_context(|| format!("cannot create `{}`", dir.display()))?;
     }
     // Written beside the target, then renamed: an interrupted run leaves no half figure.
-    let name = c.out.file_name().context("--out has no file name")?.to_string_lossy().to_string();
-    let tmp = c.out.with_file_name(format!(".{name}.tmp-{}.{ext}", std::process::id()));
+    let name = c
+        .out
+        .file_name()
+        .context("--out has no file name")?
+        .to_string_lossy()
+        .to_string();
+    let tmp = c
+        .out
+        .with_file_name(format!(".{name}.tmp-{}.{ext}", std::process::id()));
     let size = (c.width, c.height);
     let r = match ext.as_str() {
         "png" => draw(BitMapBackend::new(&tmp, size).into_drawing_area(), chart),
@@ -660,5 +693,9 @@ fn tick(v: f64) -> String {
     }
     let s = format!("{v:.4}");
     let s = s.trim_end_matches('0').trim_end_matches('.');
-    if s == "-0" { "0".into() } else { s.to_string() }
+    if s == "-0" {
+        "0".into()
+    } else {
+        s.to_string()
+    }
 }

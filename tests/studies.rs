@@ -1,0 +1,170 @@
+//! The study pipelines shipped in `pipelines/` run end to end through `weft run` in a
+//! fresh project, give the physics they are about, and a second run finds them fresh.
+
+use std::path::Path;
+use std::process::Command;
+
+use weft::table::Table;
+
+fn project_with(pipeline: &str) -> tempfile::TempDir {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::create_dir_all(dir.path().join("pipelines")).unwrap();
+    std::fs::copy(
+        Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("pipelines")
+            .join(pipeline),
+        dir.path().join("pipelines").join(pipeline),
+    )
+    .unwrap();
+    dir
+}
+
+fn weft_run(root: &Path, pipeline: &str) -> String {
+    let o = Command::new(env!("CARGO_BIN_EXE_weft"))
+        .args(["run", &format!("pipelines/{pipeline}")])
+        .current_dir(root)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr).to_string();
+    assert!(o.status.success(), "weft run {pipeline} failed:\n{err}");
+    err
+}
+
+/// The paper's §4 study: the fitted membrane matches the closed forms of a rigid-jointed
+/// square lattice (DESIGN.md §8; Gibson & Ashby, Cellular Solids, §4.3) within 5 % at
+/// N = 10, statically and dynamically, with T far below its start; figures are written.
+#[test]
+fn girder_membrane_study_recovers_the_lattice_closed_forms() {
+    let dir = project_with("girder_membrane.toml");
+    let root = dir.path();
+    weft_run(root, "girder_membrane.toml");
+    let out = root.join("runs/girder_membrane");
+    for mode in ["static", "dynamic"] {
+        let r = Table::read(&out.join(format!("fit/{mode}/fit_result.parquet"))).unwrap();
+        let names = r.str("name", "").unwrap();
+        let diff = r.f64_opt("relative_difference").unwrap().unwrap();
+        let (t0, t) = (
+            r.f64("T_initial", "").unwrap()[0],
+            r.f64("T", "").unwrap()[0],
+        );
+        assert_eq!(names.len(), if mode == "static" { 2 } else { 3 });
+        for (n, d) in names.iter().zip(&diff) {
+            let d = d.expect("every parameter has a closed form");
+            eprintln!("{mode}: {n} {:+.3} % (T {t0:.3e} -> {t:.3e})", 100.0 * d);
+            assert!(d.abs() < 0.05, "{mode}: {n} differs by {d}");
+        }
+        assert!(t0 > 0.5 && t < 1e-3, "{mode}: T {t0} -> {t}");
+    }
+    for (case, bound) in [("tension", 1e-4), ("shear", 1e-3)] {
+        let e = Table::read(&out.join(format!("error/{case}/error_summary.parquet"))).unwrap();
+        let t = e.f64("T", "").unwrap()[0];
+        assert!(
+            t < bound,
+            "{case}: fitted membrane against the girder T = {t}"
+        );
+    }
+    for f in [
+        "time_laws_tension.png",
+        "time_laws_shear.png",
+        "wavespeed_tension.png",
+        "error.png",
+        "fit_convergence.png",
+    ] {
+        let b = std::fs::read(out.join("figures").join(f)).unwrap();
+        assert!(
+            b.starts_with(b"\x89PNG\r\n\x1a\n") && b.len() > 10_000,
+            "{f}"
+        );
+    }
+    let svg = std::fs::read_to_string(out.join("figures/fit_convergence.svg")).unwrap();
+    assert!(svg.contains("<svg") && svg.contains("best T"), "svg");
+    // Nothing changed: nothing reruns.
+    let err = weft_run(root, "girder_membrane.toml");
+    assert!(err.contains("0 ran, 17 fresh"), "{err}");
+}
+
+/// Outputs of the fit and plot stages with bad input: clear errors, no panic, no file.
+#[test]
+fn weft_plot_refuses_bad_input_clearly() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let trace = d.join("t.parquet");
+    weft::table::write_table(
+        &trace,
+        &weft::table::batch(vec![weft::table::Col::F64("x", vec![1.0])]),
+        &weft::table::Provenance::new("test", serde_json::json!({})),
+    )
+    .unwrap();
+    let plot = |args: &[&str]| {
+        Command::new(env!("CARGO_BIN_EXE_weft-plot"))
+            .args(args)
+            .output()
+            .unwrap()
+    };
+    let t = trace.to_string_lossy().to_string();
+    let o = plot(&[
+        "fit",
+        "--trace",
+        &t,
+        "--out",
+        &d.join("f.png").to_string_lossy(),
+    ]);
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success() && e.contains("evaluation") && e.contains("t.parquet"),
+        "{e}"
+    );
+    let good = d.join("good.parquet");
+    weft::table::write_table(
+        &good,
+        &weft::table::batch(vec![
+            weft::table::Col::I64("evaluation", vec![0, 1]),
+            weft::table::Col::F64("T", vec![0.5, 0.1]),
+            weft::table::Col::F64("best_T", vec![0.5, 0.1]),
+        ]),
+        &weft::table::Provenance::new("test", serde_json::json!({})),
+    )
+    .unwrap();
+    let g = good.to_string_lossy().to_string();
+    let o = plot(&[
+        "fit",
+        "--trace",
+        &g,
+        "--out",
+        &d.join("f.pdf").to_string_lossy(),
+    ]);
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success()
+            && e.contains("unknown figure format `pdf`")
+            && e.contains(".png or .svg"),
+        "{e}"
+    );
+    let o = plot(&[
+        "fit",
+        "--trace",
+        &g,
+        "--out",
+        &d.join("ok.svg").to_string_lossy(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    std::fs::remove_file(d.join("ok.svg")).unwrap();
+    let o = plot(&[
+        "wavespeed",
+        "--table",
+        &d.join("none.parquet").to_string_lossy(),
+        "--out",
+        &d.join("w.svg").to_string_lossy(),
+    ]);
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success() && e.contains("none.parquet"), "{e}");
+    for o in [&o] {
+        assert!(!String::from_utf8_lossy(&o.stderr).contains("panicked"));
+    }
+    let left: Vec<_> = std::fs::read_dir(d)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().to_string())
+        .filter(|n| n.ends_with(".png") || n.ends_with(".svg") || n.contains("tmp"))
+        .collect();
+    assert!(left.is_empty(), "{left:?}");
+}
