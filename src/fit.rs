@@ -323,11 +323,67 @@ pub struct Problem {
     pub tolerance: f64,
     /// Linear static solves, comparing final displacements.
     pub static_mode: bool,
+    /// What is compared: displacement histories (T), or wave arrival times.
+    pub objective: Objective,
+}
+
+/// The quantity a fit matches.
+#[derive(Debug, Clone, Copy)]
+pub enum Objective {
+    /// The paper's T over the node set and `components`.
+    Displacement,
+    /// Arrival times of a wave along the (ordered) node set, the first time `component`
+    /// (0..6 = ux … vz) reaches `level` at each node (as `weft-wavespeed` measures them):
+    /// W = Σ(t_c − t_r)² / Σ(t_c² + t_r²) over the nodes the reference wave reaches, T's
+    /// form for arrival times (0 equal); a node the candidate's wave never reaches counts
+    /// as reached at the end of its run. Matching arrival times matches the wave speeds.
+    Arrival {
+        component: usize,
+        level: crate::analysis::Level,
+    },
+}
+
+/// The arrival-time mismatch W of a candidate against a reference (see
+/// [`Objective::Arrival`]).
+pub fn arrival_mismatch(
+    reference: &Series,
+    candidate: &Series,
+    component: usize,
+    level: crate::analysis::Level,
+    tol: f64,
+) -> Result<f64> {
+    let pairs = crate::analysis::match_nodes(reference, candidate, tol)?;
+    let wr = crate::analysis::wave_speeds(reference, component, level);
+    let wc = crate::analysis::wave_speeds(candidate, component, level);
+    let end = *candidate.t.last().expect("samples");
+    let (mut num, mut den, mut n) = (0.0, 0.0, 0);
+    for (j, &k) in pairs.iter().enumerate() {
+        if let Some(tr) = wr.arrival[j] {
+            let tc = wc.arrival[k].unwrap_or(end);
+            num += (tc - tr) * (tc - tr);
+            den += tc * tc + tr * tr;
+            n += 1;
+        }
+    }
+    if n == 0 || den <= 0.0 {
+        return Err(WeftError::input(
+            "the reference wave reaches none of the compared nodes after t = 0",
+        )
+        .expected("a reference history in which the chosen component reaches the level")
+        .hint(
+            "choose the component the load excites (vx for tension, vy for shear) or a lower level",
+        ));
+    }
+    Ok(num / den)
 }
 
 impl Problem {
     /// Check the cases once: node sets exist and match the references.
     pub fn check(&self) -> Result<()> {
+        if self.static_mode && matches!(self.objective, Objective::Arrival { .. }) {
+            return Err(WeftError::input("a wave-arrival objective with --static")
+                .expected("an explicit (dynamic) fit: a static solve has no waves"));
+        }
         if self.params.is_empty() {
             return Err(WeftError::input("no parameter to fit")
                 .expected("at least one --param PART.PROPERTY:LOWER:UPPER"));
@@ -371,6 +427,9 @@ impl Problem {
     pub fn case_t(&self, k: usize, x: &[f64]) -> Result<f64> {
         let c = &self.cases[k];
         let cand = respond(&self.model_at(k, x), &c.set, self.static_mode)?;
+        if let Objective::Arrival { component, level } = self.objective {
+            return arrival_mismatch(&c.reference, &cand, component, level, self.tolerance);
+        }
         Ok(mismatch(
             &c.reference,
             &cand,

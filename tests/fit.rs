@@ -3,8 +3,9 @@
 
 use std::process::Command;
 
+use weft::analysis::Level;
 use weft::analysis::Series;
-use weft::fit::{fit, parse_param, respond, Case, Method, Options, Problem};
+use weft::fit::{fit, parse_param, respond, Case, Method, Objective, Options, Problem};
 use weft::generate::square::{girder, membrane, GirderParams, LoadCase, MembraneParams, Square};
 use weft::model::Model;
 
@@ -105,6 +106,7 @@ fn fit_recovers_a_models_own_parameters() {
         components: vec![0, 1],
         tolerance: 1e-9,
         static_mode: false,
+        objective: Objective::Displacement,
     };
     for method in [Method::Cobyla, Method::Gradient] {
         let opts = Options {
@@ -177,6 +179,7 @@ fn section4_errors(cells: usize, static_mode: bool) -> (Vec<f64>, f64, usize) {
         components: vec![0, 1],
         tolerance: 1e-9,
         static_mode,
+        objective: Objective::Displacement,
     };
     // The dynamic T is multi-extremal in (G, s, ρ) (the paper's §6 warns of it): from
     // (2e9, 1e-3, 5000) COBYLA alone stops at T = 0.48. A multistart finds the basin.
@@ -259,6 +262,7 @@ fn multistart_is_reproducible_across_thread_counts() {
         components: vec![0, 1],
         tolerance: 1e-9,
         static_mode: false,
+        objective: Objective::Displacement,
     };
     let opts = Options {
         starts: 3,
@@ -424,4 +428,51 @@ fn weft_fit_binary_writes_its_tables_and_refuses_bad_input() {
         "{e}"
     );
     assert!(!e.contains("panicked"), "{e}");
+}
+
+/// The wave-speed objective: a membrane's density is recovered from the arrival times of
+/// its own longitudinal wave along y = 0 (c = √(E/ρ), DESIGN.md §8).
+#[test]
+fn arrival_time_objective_recovers_the_wave_speed() {
+    let p = period();
+    let (g, s, rho) = (7.5e8, 1e-4, 14820.0);
+    let reference = membrane_model(10, LoadCase::Tension, p, g, s, rho);
+    let cand = membrane_model(10, LoadCase::Tension, p, g, s, 6000.0);
+    let r = respond(&reference, "axis_x", false).unwrap();
+    let problem = Problem {
+        params: params(&cand, &["membrane.rho:1e3:1e5:log"]),
+        cases: vec![case("tension", r.clone(), cand.clone())],
+        components: vec![0],
+        tolerance: 1e-9,
+        static_mode: false,
+        objective: Objective::Arrival {
+            component: 3,
+            level: Level::Relative(0.5),
+        },
+    };
+    let mut problem = problem;
+    problem.cases[0].set = "axis_x".into();
+    let fit_r = fit(
+        &problem,
+        &Options {
+            max_evaluations: 200,
+            ..Default::default()
+        },
+        &|_| {},
+    )
+    .unwrap();
+    let err = (fit_r.x[0] - rho).abs() / rho;
+    eprintln!(
+        "arrival objective: ρ {:.2} (true {rho}), W {:.3e} -> {:.3e}, {} evaluations",
+        fit_r.x[0],
+        fit_r.t_initial,
+        fit_r.t,
+        fit_r.evaluations.len()
+    );
+    assert!(err < 1e-3, "ρ recovered to {err:.2e}");
+    assert!(
+        fit_r.t_initial > 1e-2,
+        "a 1.57× faster wave is far off: W {}",
+        fit_r.t_initial
+    );
 }

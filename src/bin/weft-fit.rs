@@ -10,7 +10,7 @@ use anyhow::Context;
 use clap::Parser;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use weft::analysis::{components, read_series};
-use weft::fit::{fit, parse_param, Case, Method, Options, Problem};
+use weft::fit::{fit, parse_param, Case, Method, Objective, Options, Problem};
 use weft::model::io::{read_model, write_model};
 use weft::table::{batch, write_table, Col, Provenance};
 
@@ -29,6 +29,9 @@ use weft::table::{batch, write_table, Col, Provenance};
                   the property names are the columns of parts.parquet (docs/tables.md; aliases E, rho, A, E1, E2, nu12, \
                   G12, G, s, b, h), comma-separated targets are tied to one value (each times its factor), and the \
                   start is the model's own value unless given.\n\n\
+                  --objective arrival matches wave arrival times along the ordered --set instead (the first time \
+                  --arrival-component reaches --relative-level of each node's peak, as weft-wavespeed measures \
+                  them), which matches the wave speeds: W = Σ(t_c − t_r)²/Σ(t_c² + t_r²).\n\n\
                   Methods: cobyla (derivative-free, bounded) and gradient (projected BFGS, finite-difference gradients \
                   evaluated in parallel); --starts K > 1 adds a multistart global search (Halton points), the local \
                   searches running in parallel.\n\n\
@@ -68,6 +71,17 @@ struct Cli {
     /// Node matching tolerance [m].
     #[arg(long, default_value_t = 1e-9)]
     tolerance: f64,
+    /// What is matched: `displacement` (the paper's T over --components) or `arrival` (the
+    /// arrival times of a wave along the ordered --set, hence its speed: the first time
+    /// --arrival-component reaches --relative-level of each node's peak).
+    #[arg(long, value_enum, default_value_t = ObjectiveKind::Displacement)]
+    objective: ObjectiveKind,
+    /// Component whose arrival is timed (--objective arrival): ux … vz.
+    #[arg(long, default_value = "vx")]
+    arrival_component: String,
+    /// Arrival level as a fraction of each node's peak (--objective arrival).
+    #[arg(long, default_value_t = 0.5)]
+    relative_level: f64,
     /// Linear static solves; T compares the final displacements.
     #[arg(long = "static")]
     static_mode: bool,
@@ -101,6 +115,13 @@ struct Cli {
     /// Output folder.
     #[arg(long)]
     out: PathBuf,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, serde::Serialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+enum ObjectiveKind {
+    Displacement,
+    Arrival,
 }
 
 fn main() -> ExitCode {
@@ -141,6 +162,26 @@ fn run() -> anyhow::Result<()> {
         "--components `{}`: a fit compares displacements; expected some of ux, uy, uz",
         cli.components
     );
+    let objective = match cli.objective {
+        ObjectiveKind::Displacement => Objective::Displacement,
+        ObjectiveKind::Arrival => {
+            let c = components(&cli.arrival_component)?;
+            anyhow::ensure!(
+                c.len() == 1,
+                "--arrival-component takes one component, got `{}`",
+                cli.arrival_component
+            );
+            anyhow::ensure!(
+                cli.relative_level > 0.0 && cli.relative_level <= 1.0,
+                "--relative-level {}: expected a fraction of the peak in (0, 1]",
+                cli.relative_level
+            );
+            Objective::Arrival {
+                component: c[0],
+                level: weft::analysis::Level::Relative(cli.relative_level),
+            }
+        }
+    };
     let mut cases = vec![];
     let mut prov_inputs: Vec<PathBuf> = vec![];
     for k in 0..n {
@@ -214,6 +255,7 @@ fn run() -> anyhow::Result<()> {
         components: comps,
         tolerance: cli.tolerance,
         static_mode: cli.static_mode,
+        objective,
     };
     let opts = Options {
         method: cli.method,
