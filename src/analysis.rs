@@ -52,6 +52,17 @@ pub fn read_series(model: &Path, history: &Path, set: &str) -> Result<Series> {
                 .join(", ")
         ))
     })?;
+    read_nodes(&m, history, nodes, &format!("of set `{set}`"))
+}
+
+/// Read the history of model nodes `nodes` (indices, in that order) from a history
+/// table; `what` names them in errors (e.g. "of set `axis_x`").
+pub fn read_nodes(
+    m: &crate::model::Model,
+    history: &Path,
+    nodes: &[usize],
+    what: &str,
+) -> Result<Series> {
     let h = Table::read(history)?;
     const COLS: &str = "t, node_id, ux, uy, uz, vx, vy, vz";
     let t = h.f64("t", COLS)?;
@@ -88,7 +99,7 @@ pub fn read_series(model: &Path, history: &Path, set: &str) -> Result<Series> {
     }
     if let Some(j) = (0..nodes.len()).find(|&j| seen[j] != times.len()) {
         return Err(WeftError::input(format!(
-            "node `{}` of set `{set}` has {} of {} samples in the history",
+            "node `{}` {what} has {} of {} samples in the history",
             m.node_id[nodes[j]],
             seen[j],
             times.len()

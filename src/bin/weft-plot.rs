@@ -305,9 +305,9 @@ fn history(a: &HistoryArgs) -> anyhow::Result<Chart> {
                     d
                 );
             }
-            chosen.push(model.node_id[i]);
+            chosen.push(i);
         }
-        let s = read_series_ids(m, h, &chosen)?;
+        let s = weft::analysis::read_nodes(&model, h, &chosen, "chosen for the figure")?;
         let lines = ids
             .iter()
             .enumerate()
@@ -351,51 +351,6 @@ fn history(a: &HistoryArgs) -> anyhow::Result<Chart> {
         y_label: format!("{} [{uy}]", a.component),
         log_y: false,
         series,
-    })
-}
-
-/// The history of chosen node ids (in that order) of one model.
-fn read_series_ids(
-    model_dir: &Path,
-    history: &Path,
-    ids: &[i64],
-) -> anyhow::Result<weft::analysis::Series> {
-    let h = Table::read(history)?;
-    const COLS: &str = "t, node_id, ux, uy, uz, vx, vy, vz";
-    let t = h.f64("t", COLS)?;
-    let node = h.i64("node_id", COLS)?;
-    let cols: Vec<Vec<f64>> = weft::analysis::COMPONENTS
-        .iter()
-        .map(|c| h.f64(c, COLS))
-        .collect::<weft::Result<_>>()?;
-    let want: std::collections::HashMap<i64, usize> =
-        ids.iter().enumerate().map(|(j, &id)| (id, j)).collect();
-    let mut times: Vec<f64> = vec![];
-    let mut values: Vec<Vec<[f64; 6]>> = vec![];
-    for r in 0..t.len() {
-        if times.last() != Some(&t[r]) {
-            times.push(t[r]);
-            values.push(vec![[f64::NAN; 6]; ids.len()]);
-        }
-        if let Some(&j) = want.get(&node[r]) {
-            let k = times.len() - 1;
-            values[k][j] = std::array::from_fn(|c| cols[c][r]);
-        }
-    }
-    for (j, id) in ids.iter().enumerate() {
-        if values.iter().any(|v| v[j][0].is_nan()) {
-            bail!(
-                "`{}` lacks node {id} at some output times (model `{}`; hint: simulate with its history written)",
-                history.display(),
-                model_dir.display()
-            );
-        }
-    }
-    Ok(weft::analysis::Series {
-        t: times,
-        node_id: ids.to_vec(),
-        x0: vec![[0.0; 3]; ids.len()],
-        values,
     })
 }
 
