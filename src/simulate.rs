@@ -144,11 +144,7 @@ fn run_static(
     let v = vec![[0.0; 3]; nodes.len()];
     crate::solver::Sink::history(&mut sink, 0.0, nodes, &u, &v)?;
     sink.finish_history_only()?;
-    let elements = solver.truss.id.len()
-        + solver.link.id.len()
-        + solver.tri.id.len()
-        + solver.quad.id.len()
-        + solver.beam.id.len();
+    let elements = solver.op.el.len() - solver.op.el.point_mass.id.len();
     write_table(
         &c.out.join("summary.parquet"),
         &batch(vec![

@@ -188,7 +188,7 @@ fn patch_test_reproduces_a_uniform_strain_exactly() {
         let mut s = Solver::new(&m).unwrap();
         for i in 0..9 {
             let x0 = s.x0[i];
-            s.x[i] = [
+            s.state.x[i] = [
                 x0[0] + a[0][0] * x0[0] + a[0][1] * x0[1],
                 x0[1] + a[1][0] * x0[0] + a[1][1] * x0[1],
                 0.0,
@@ -264,7 +264,7 @@ fn rigid_rotation_gives_no_force() {
         ];
         for i in 0..9 {
             let x = s.x0[i];
-            s.x[i] =
+            s.state.x[i] =
                 std::array::from_fn(|d| r[d][0] * x[0] + r[d][1] * x[1] + r[d][2] * x[2] + 0.3);
         }
         let f = s.internal_forces();

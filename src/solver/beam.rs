@@ -38,21 +38,8 @@ pub struct BeamProps {
     pub e0: [[f64; 3]; 3],
 }
 
-pub type Mat3 = [[f64; 3]; 3];
-
-fn cross(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-fn dot(a: &[f64; 3], b: &[f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-fn mv(r: &Mat3, v: &[f64; 3]) -> [f64; 3] {
-    std::array::from_fn(|i| r[i][0] * v[0] + r[i][1] * v[1] + r[i][2] * v[2])
-}
+pub use super::vec3::Mat3;
+use super::vec3::{cross, dot, mv};
 
 /// Torsion constant of a b × h rectangle (Roark).
 pub fn torsion_constant(b: f64, h: f64) -> f64 {
@@ -182,4 +169,232 @@ pub fn rotate(r: &Mat3, phi: &[f64; 3]) -> Mat3 {
         })
     });
     std::array::from_fn(|i| std::array::from_fn(|j| (0..3).map(|m| q[i][m] * r[m][j]).sum()))
+}
+
+// ---------------------------------------------------------------------------------------
+// The beam family and the rotational nodes it creates.
+
+use rayon::prelude::*;
+
+use super::family::{Build, EnergyGroup, EnergyPartial, Family, ForceCtx, StiffCtx, CHUNK};
+use crate::error::{Result, WeftError};
+use crate::model::{ElementKind, Model};
+
+/// Rotational state of the nodes that carry beams.
+#[derive(Debug, Clone, Default)]
+pub struct Rotations {
+    /// Node index of each rotational node.
+    pub node: Vec<usize>,
+    /// Rotational node of each node (u32::MAX: none).
+    pub of_node: Vec<u32>,
+    /// Orientation R (global).
+    pub r: Vec<Mat3>,
+    /// Half-step angular velocity ω^{n−½} (global) [rad/s].
+    pub omega: Vec<[f64; 3]>,
+    /// Lumped rotational inertia J [kg·m²].
+    pub j: Vec<f64>,
+    /// Bit d set when the rotation about axis d is fixed.
+    pub fixed: Vec<u8>,
+    /// Moment slots per rotational node (CSR into the beams' end moments).
+    pub ptr: Vec<u32>,
+    pub slots: Vec<u32>,
+}
+
+impl Rotations {
+    pub fn new(nodes: usize) -> Rotations {
+        Rotations { of_node: vec![u32::MAX; nodes], ..Default::default() }
+    }
+    pub fn len(&self) -> usize {
+        self.node.len()
+    }
+    pub fn is_empty(&self) -> bool {
+        self.node.is_empty()
+    }
+    /// The rotational node of node n, created (at rest, J = 0) when missing.
+    fn get_or_add(&mut self, n: usize) -> u32 {
+        if self.of_node[n] == u32::MAX {
+            self.of_node[n] = self.node.len() as u32;
+            self.node.push(n);
+            self.r.push([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]);
+            self.omega.push([0.0; 3]);
+            self.j.push(0.0);
+            self.fixed.push(0);
+        }
+        self.of_node[n]
+    }
+    /// Rotation constraints and symmetry planes, and the moment gather index of the
+    /// beams (two end moments per beam, gathered per rotational node in slot order).
+    pub fn finish(&mut self, m: &Model, beams: &BeamGroup) {
+        for (n, f) in &m.rot_constraints {
+            if self.of_node[*n] != u32::MAX {
+                for d in 0..3 {
+                    if f[d] {
+                        self.fixed[self.of_node[*n] as usize] |= 1 << d;
+                    }
+                }
+            }
+        }
+        // On a symmetry plane with normal d the rotations about the other two axes vanish.
+        for sp in &m.symmetry {
+            for (k, &n) in self.node.iter().enumerate() {
+                if (m.coords[n][sp.normal] - sp.position).abs() <= sp.tolerance {
+                    for d in 0..3 {
+                        if d != sp.normal {
+                            self.fixed[k] |= 1 << d;
+                        }
+                    }
+                }
+            }
+        }
+        let nr = self.node.len();
+        let mut cnt = vec![0u32; nr + 1];
+        for r in beams.rot.iter().flatten() {
+            cnt[*r as usize + 1] += 1;
+        }
+        for i in 0..nr {
+            cnt[i + 1] += cnt[i];
+        }
+        self.ptr = cnt.clone();
+        self.slots = vec![0; 2 * beams.id.len()];
+        for (sl, r) in beams.rot.iter().flatten().enumerate() {
+            self.slots[cnt[*r as usize] as usize] = sl as u32;
+            cnt[*r as usize] += 1;
+        }
+    }
+}
+
+/// Beams, struct-of-arrays; their nodes carry rotations.
+#[derive(Debug, Clone, Default)]
+pub struct BeamGroup {
+    pub id: Vec<i64>,
+    pub nodes: Vec<[u32; 2]>,
+    /// Rotation indices of the two nodes.
+    pub rot: Vec<[u32; 2]>,
+    pub props: Vec<BeamProps>,
+    /// End moments, two per beam [N·m].
+    pub moments: Vec<[f64; 3]>,
+    partials: Vec<EnergyPartial>,
+}
+
+impl Family for BeamGroup {
+    const KIND: ElementKind = ElementKind::Beam;
+    const SLOTS: usize = 2;
+    const GROUP: EnergyGroup = EnergyGroup::Beam;
+
+    fn build(bd: &mut Build) -> Result<Self> {
+        let m = bd.model;
+        let mut g = BeamGroup::default();
+        let Some(b) = m.block(ElementKind::Beam) else { return Ok(g) };
+        for e in 0..b.len() {
+            let p = &m.parts[b.part[e]].props;
+            let (a, c) = (b.nodes[2 * e], b.nodes[2 * e + 1]);
+            let e0 = reference_frame(&m.coords[a], &m.coords[c]).ok_or_else(|| {
+                WeftError::input(format!("beam `{}` has zero length", b.id[e]))
+                    .in_file("elements_beam.parquet")
+                    .at_row(e)
+                    .expected("two nodes at distinct positions")
+            })?;
+            let d = super::vec3::sub(&m.coords[c], &m.coords[a]);
+            let l0 = dot(&d, &d).sqrt();
+            let (em, rho, bw, hh) =
+                (p.youngs_modulus.unwrap(), p.density.unwrap(), p.width.unwrap(), p.height.unwrap());
+            let gm = em / (2.0 * (1.0 + p.poisson_ratio.unwrap_or(0.3)));
+            let area = bw * hh;
+            let me = rho * area * l0;
+            // Lumped rotary inertia: each half of the beam as a rigid bar about its end
+            // node's centre of mass, isotropic (J = ½ m (L² + b² + h²)/12).
+            let jn = 0.5 * me * (l0 * l0 + bw * bw + hh * hh) / 12.0;
+            let mut rids = [0u32; 2];
+            for (k, &n) in [a, c].iter().enumerate() {
+                bd.mass[n] += 0.5 * me;
+                rids[k] = bd.rot.get_or_add(n);
+                bd.rot.j[rids[k] as usize] += jn;
+            }
+            g.id.push(b.id[e]);
+            g.nodes.push([a as u32, c as u32]);
+            g.rot.push(rids);
+            g.props.push(BeamProps {
+                l0,
+                ea: em * area,
+                gj: gm * torsion_constant(bw, hh),
+                eiy: em * bw * hh.powi(3) / 12.0,
+                eiz: em * hh * bw.powi(3) / 12.0,
+                e0,
+            });
+        }
+        g.moments = vec![[0.0; 3]; 2 * g.id.len()];
+        Ok(g)
+    }
+    fn len(&self) -> usize {
+        self.id.len()
+    }
+    fn id(&self, e: usize) -> i64 {
+        self.id[e]
+    }
+    fn slot_nodes(&self, e: usize) -> &[u32] {
+        &self.nodes[e]
+    }
+    fn stiffness(&self, e: usize) -> f64 {
+        self.props[e].ea / self.props[e].l0
+    }
+    fn forces(&mut self, ctx: &ForceCtx, fe: &mut [[f64; 3]]) {
+        let (x, rr) = (ctx.x, ctx.rot_r);
+        let (nodes, rot, props) = (&self.nodes, &self.rot, &self.props);
+        let body = |(ci, (out, mo)): (usize, (&mut [[f64; 3]], &mut [[f64; 3]]))| {
+            let e0 = ci * CHUNK;
+            for (j, (f, m)) in out.chunks_exact_mut(2).zip(mo.chunks_exact_mut(2)).enumerate() {
+                let e = e0 + j;
+                let [a, b] = nodes[e];
+                let [ra, rb] = rot[e];
+                let r = forces(&x[a as usize], &x[b as usize], &rr[ra as usize], &rr[rb as usize], &props[e]);
+                f[0] = r[0];
+                f[1] = r[1];
+                m[0] = r[2];
+                m[1] = r[3];
+            }
+        };
+        if self.id.len() <= CHUNK {
+            fe.chunks_mut(2 * CHUNK)
+                .zip(self.moments.chunks_mut(2 * CHUNK))
+                .enumerate()
+                .for_each(body);
+        } else {
+            fe.par_chunks_mut(2 * CHUNK)
+                .zip(self.moments.par_chunks_mut(2 * CHUNK))
+                .enumerate()
+                .for_each(body);
+        }
+    }
+    /// Row sums of M^{-1/2} K M^{-1/2}. A translational row carries the axial and
+    /// bending-shear terms and the coupling 12EI/L² to the rotations (scaled by √(m/J)
+    /// so that it adds to S/m); a rotational row carries 12EI/(L²√(mJ)) + (4 + 2)EI/(L J)
+    /// + 2GJ/(L J). A node's bound is the larger of the two rows.
+    fn stiffness_sums(&self, ctx: &StiffCtx, s: &mut [f64], _c: &mut [f64], rrow: &mut [f64]) {
+        for (e, p) in self.props.iter().enumerate() {
+            let [a, b] = self.nodes[e];
+            let ei = p.eiy.max(p.eiz);
+            let l = p.l0;
+            for (n, o, rk) in [(a, b, self.rot[e][0]), (b, a, self.rot[e][1])] {
+                let (n, o) = (n as usize, o as usize);
+                let (mn, jn) = (ctx.mass[n].max(f64::MIN_POSITIVE), ctx.rot_j[rk as usize]);
+                let wo = if ctx.fixed[o] == 0b111 { 1.0 } else { 2.0 };
+                s[n] += wo * p.ea / l + 24.0 * ei / l.powi(3) + 12.0 * ei / (l * l) * (mn / jn).sqrt();
+                rrow[n] += 12.0 * ei / (l * l * (mn * jn).sqrt()) + 6.0 * ei / (l * jn) + 2.0 * p.gj / (l * jn);
+            }
+        }
+    }
+    /// The strain energy, summed serially (element order).
+    fn energies(&mut self, ctx: &ForceCtx) -> &[EnergyPartial] {
+        let (x, rr) = (ctx.x, ctx.rot_r);
+        let e: f64 = (0..self.id.len())
+            .map(|e| {
+                let [a, b] = self.nodes[e];
+                let [ra, rb] = self.rot[e];
+                energy(&x[a as usize], &x[b as usize], &rr[ra as usize], &rr[rb as usize], &self.props[e])
+            })
+            .sum();
+        self.partials.clear();
+        self.partials.push([e, 0.0, 0.0, 0.0]);
+        &self.partials
+    }
 }

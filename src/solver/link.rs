@@ -101,3 +101,134 @@ pub fn energy(d: &[f64; 3], p: &LinkProps, slip: &[f64; 2]) -> f64 {
     let ey = d[1] - slip[1];
     0.5 * (p.k[0] * ex * ex + p.k[1] * ey * ey + p.k[2] * d[2] * d[2])
 }
+
+// ---------------------------------------------------------------------------------------
+// The link family.
+
+use rayon::prelude::*;
+
+use super::family::{chunk_partials, Build, EnergyGroup, EnergyPartial, Family, ForceCtx, StiffCtx, CHUNK};
+use crate::error::Result;
+use crate::model::ElementKind;
+
+/// Links, struct-of-arrays.
+#[derive(Debug, Clone, Default)]
+pub struct LinkGroup {
+    pub id: Vec<i64>,
+    pub nodes: Vec<[u32; 2]>,
+    pub props: Vec<LinkProps>,
+    /// Initial offset X₂ − X₁ [m].
+    pub d0: Vec<[f64; 3]>,
+    pub state: Vec<LinkState>,
+    partials: Vec<EnergyPartial>,
+}
+
+impl Family for LinkGroup {
+    const KIND: ElementKind = ElementKind::Link;
+    const SLOTS: usize = 2;
+    const GROUP: EnergyGroup = EnergyGroup::Line;
+
+    fn build(bd: &mut Build) -> Result<Self> {
+        let m = bd.model;
+        let mut g = LinkGroup::default();
+        let Some(b) = m.block(ElementKind::Link) else { return Ok(g) };
+        for e in 0..b.len() {
+            let p = &m.parts[b.part[e]].props;
+            let (a, c) = (b.nodes[2 * e], b.nodes[2 * e + 1]);
+            let z = |v: Option<f64>| v.unwrap_or(0.0);
+            g.id.push(b.id[e]);
+            g.nodes.push([a as u32, c as u32]);
+            g.props.push(LinkProps {
+                k: [z(p.kx), z(p.ky), z(p.kz)],
+                c: [z(p.cx), z(p.cy), z(p.cz)],
+                slip_force: p.slip_force.unwrap_or(f64::INFINITY),
+            });
+            g.d0.push(super::vec3::sub(&m.coords[c], &m.coords[a]));
+            g.state.push(LinkState::default());
+        }
+        Ok(g)
+    }
+    fn len(&self) -> usize {
+        self.id.len()
+    }
+    fn id(&self, e: usize) -> i64 {
+        self.id[e]
+    }
+    fn slot_nodes(&self, e: usize) -> &[u32] {
+        &self.nodes[e]
+    }
+    fn stiffness(&self, e: usize) -> f64 {
+        let p = &self.props[e];
+        p.k.iter().chain(p.c.iter()).cloned().fold(0.0, f64::max)
+    }
+    fn forces(&mut self, ctx: &ForceCtx, fe: &mut [[f64; 3]]) {
+        let (x, v, dt_prev) = (ctx.x, ctx.v, ctx.dt_prev);
+        let (nodes, props, d0) = (&self.nodes, &self.props, &self.d0);
+        let body = |(ci, (out, st)): (usize, (&mut [[f64; 3]], &mut [LinkState]))| {
+            let e0 = ci * CHUNK;
+            for (j, (pair, s)) in out.chunks_exact_mut(2).zip(st.iter_mut()).enumerate() {
+                let e = e0 + j;
+                let [a, b] = nodes[e];
+                let (a, b) = (a as usize, b as usize);
+                let d = rel_disp(&x[a], &x[b], &d0[e]);
+                let dd = [v[b][0] - v[a][0], v[b][1] - v[a][1], v[b][2] - v[a][2]];
+                let f2 = force_update(&d, &dd, &props[e], s, dt_prev);
+                pair[0] = [-f2[0], -f2[1], -f2[2]];
+                pair[1] = f2;
+            }
+        };
+        if self.id.len() <= CHUNK {
+            fe.chunks_mut(2 * CHUNK)
+                .zip(self.state.chunks_mut(CHUNK))
+                .enumerate()
+                .for_each(body);
+        } else {
+            fe.par_chunks_mut(2 * CHUNK)
+                .zip(self.state.par_chunks_mut(CHUNK))
+                .enumerate()
+                .for_each(body);
+        }
+    }
+    fn stiffness_sums(&self, ctx: &StiffCtx, s: &mut [f64], c: &mut [f64], _r: &mut [f64]) {
+        let w = |other: u32| if ctx.fixed[other as usize] == 0b111 { 1.0 } else { 2.0 };
+        for (e, p) in self.nodes.iter().enumerate() {
+            let pr = &self.props[e];
+            let kmax = pr.k.iter().cloned().fold(0.0, f64::max);
+            let cmax = pr.c.iter().cloned().fold(0.0, f64::max);
+            for (n, o) in [(p[0], p[1]), (p[1], p[0])] {
+                s[n as usize] += w(o) * kmax;
+                c[n as usize] += w(o) * cmax;
+            }
+        }
+    }
+    fn energies(&mut self, ctx: &ForceCtx) -> &[EnergyPartial] {
+        let (x, nodes, d0, props, state) = (ctx.x, &self.nodes, &self.d0, &self.props, &self.state);
+        chunk_partials(&mut self.partials, nodes.len(), |r| {
+            let mut acc = [0.0; 4];
+            for k in r {
+                let [a, b] = nodes[k];
+                let d = rel_disp(&x[a as usize], &x[b as usize], &d0[k]);
+                acc[0] += energy(&d, &props[k], &state[k].slip);
+                acc[1] += state[k].damping_energy;
+                acc[2] += state[k].friction_energy;
+            }
+            acc
+        });
+        &self.partials
+    }
+}
+
+impl LinkGroup {
+    /// Current force of every link on its node 2 at the positions `x`: spring and
+    /// slider (the slider return-mapped on a copy of its state), without the dashpot.
+    pub fn elastic_forces(&self, x: &[[f64; 3]]) -> Vec<[f64; 3]> {
+        (0..self.id.len())
+            .map(|e| {
+                let [a, b] = self.nodes[e];
+                let d = rel_disp(&x[a as usize], &x[b as usize], &self.d0[e]);
+                let mut st = self.state[e];
+                force_update(&d, &[0.0; 3], &self.props[e], &mut st, 0.0)
+            })
+            .collect()
+    }
+}

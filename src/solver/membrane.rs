@@ -83,23 +83,7 @@ pub struct Reference<const N: usize> {
     pub gamma: [f64; N],
 }
 
-fn sub(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-fn cross(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-fn dot(a: &[f64; 3], b: &[f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-fn unit(a: [f64; 3]) -> Option<[f64; 3]> {
-    let n = dot(&a, &a).sqrt();
-    (n > 0.0).then(|| [a[0] / n, a[1] / n, a[2] / n])
-}
+use super::vec3::{cross, dot, sub, unit};
 
 impl<const N: usize> Reference<N> {
     /// Set up from the reference positions; `angle` turns material direction 1 from the
@@ -391,4 +375,146 @@ pub fn max_stiffness<const N: usize>(
         .cloned()
         .fold(0.0, f64::max);
     lam.max(k_hg * g2)
+}
+
+// ---------------------------------------------------------------------------------------
+// The membrane families (triangles and quads).
+
+use super::family::{chunk_partials, for_chunks, Build, EnergyGroup, EnergyPartial, Family, ForceCtx, StiffCtx, CHUNK};
+use crate::model::ElementKind;
+
+/// Membrane elements with `N` nodes (3: triangles, 4: quads), struct-of-arrays.
+#[derive(Debug, Clone, Default)]
+pub struct MembraneGroup<const N: usize> {
+    pub id: Vec<i64>,
+    pub nodes: Vec<[u32; N]>,
+    pub reference: Vec<Reference<N>>,
+    pub material: Vec<Material>,
+    pub thickness: Vec<f64>,
+    /// Hourglass stiffness k_hg [N/m] (quads).
+    pub k_hg: Vec<f64>,
+    /// Largest eigenvalue of the element stiffness [N/m] (stable step).
+    pub k_max: Vec<f64>,
+    /// Element mass ρ s A₀ [kg].
+    pub mass: Vec<f64>,
+    partials: Vec<EnergyPartial>,
+}
+
+impl<const N: usize> Family for MembraneGroup<N> {
+    const KIND: ElementKind = if N == 3 { ElementKind::Tri } else { ElementKind::Quad };
+    const SLOTS: usize = N;
+    const GROUP: EnergyGroup = EnergyGroup::Membrane;
+
+    fn build(bd: &mut Build) -> Result<Self> {
+        let (m, kind) = (bd.model, Self::KIND);
+        let mut g = MembraneGroup::<N> {
+            id: vec![],
+            nodes: vec![],
+            reference: vec![],
+            material: vec![],
+            thickness: vec![],
+            k_hg: vec![],
+            k_max: vec![],
+            mass: vec![],
+            partials: vec![],
+        };
+        let Some(b) = m.block(kind) else { return Ok(g) };
+        for e in 0..b.len() {
+            let part = &m.parts[b.part[e]];
+            let p = &part.props;
+            let ns: [usize; N] = std::array::from_fn(|a| b.nodes[N * e + a]);
+            let x: [[f64; 3]; N] = std::array::from_fn(|a| m.coords[ns[a]]);
+            let r = Reference::<N>::new(&x, p.material_angle.unwrap_or(0.0)).ok_or_else(|| {
+                WeftError::input(format!(
+                    "{} `{}` is degenerate: zero area, inverted or (quad) not convex; nodes {}",
+                    kind.name(),
+                    b.id[e],
+                    ns.iter()
+                        .map(|&n| format!("`{}`", m.node_id[n]))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ))
+                .in_file(format!("elements_{}.parquet", kind.name()))
+                .at_row(e)
+                .expected("nodes in counter-clockwise order around a convex element of positive area")
+            })?;
+            let mat = Material::orthotropic(
+                p.youngs_modulus_1.unwrap(),
+                p.youngs_modulus_2.unwrap(),
+                p.poisson_ratio_12.unwrap_or(0.0),
+                p.shear_modulus_12.unwrap(),
+                p.no_compression.unwrap_or(false),
+            )
+            .map_err(|err| err.in_file("parts.parquet").in_column("poisson_ratio_12"))?;
+            let s = p.thickness.unwrap();
+            let k_hg = if N == 4 {
+                p.hourglass_coefficient() * mat.e_max() * s * r.area * r.grad2()
+            } else {
+                0.0
+            };
+            let me = p.density.unwrap() * s * r.area;
+            for &n in &ns {
+                bd.mass[n] += me / N as f64;
+            }
+            g.k_max.push(max_stiffness(&r, &mat, s, k_hg));
+            g.mass.push(me);
+            g.id.push(b.id[e]);
+            g.nodes.push(std::array::from_fn(|a| ns[a] as u32));
+            g.reference.push(r);
+            g.material.push(mat);
+            g.thickness.push(s);
+            g.k_hg.push(k_hg);
+        }
+        Ok(g)
+    }
+    fn len(&self) -> usize {
+        self.id.len()
+    }
+    fn id(&self, e: usize) -> i64 {
+        self.id[e]
+    }
+    fn slot_nodes(&self, e: usize) -> &[u32] {
+        &self.nodes[e]
+    }
+    fn stiffness(&self, e: usize) -> f64 {
+        self.k_max[e]
+    }
+    fn forces(&mut self, ctx: &ForceCtx, fe: &mut [[f64; 3]]) {
+        let (g, x) = (&*self, ctx.x);
+        for_chunks(fe, N, g.id.len(), |ci, out| {
+            let e0 = ci * CHUNK;
+            for (j, el) in out.chunks_exact_mut(N).enumerate() {
+                let e = e0 + j;
+                let nodes = &g.nodes[e];
+                let xe: [[f64; 3]; N] = std::array::from_fn(|a| x[nodes[a] as usize]);
+                let f = forces(&xe, &g.reference[e], &g.material[e], g.thickness[e], g.k_hg[e]);
+                el.copy_from_slice(&f);
+            }
+        });
+    }
+    fn stiffness_sums(&self, _: &StiffCtx, s: &mut [f64], _c: &mut [f64], _r: &mut [f64]) {
+        // uₑᵀKₑuₑ ≤ λ_max(Kₑ) Σ_{a∈e} |u_a|², so each node of e gets λ_max(Kₑ).
+        for (p, k) in self.nodes.iter().zip(&self.k_max) {
+            for &n in p {
+                s[n as usize] += k;
+            }
+        }
+    }
+    fn energies(&mut self, ctx: &ForceCtx) -> &[EnergyPartial] {
+        let x = ctx.x;
+        let (nodes, reference, material, thickness, k_hg) =
+            (&self.nodes, &self.reference, &self.material, &self.thickness, &self.k_hg);
+        chunk_partials(&mut self.partials, nodes.len(), |r| {
+            let mut acc = [0.0; 4];
+            for e in r {
+                let ns = &nodes[e];
+                let xe: [[f64; 3]; N] = std::array::from_fn(|a| x[ns[a] as usize]);
+                let (w, h) = energy(&xe, &reference[e], &material[e], thickness[e], k_hg[e]);
+                acc[0] += w;
+                acc[3] += h;
+            }
+            acc
+        });
+        &self.partials
+    }
 }

@@ -76,10 +76,12 @@ impl Solver {
         let mut eq = vec![[usize::MAX; 3]; nn];
         let mut neq = 0;
         let slave: std::collections::HashMap<usize, usize> = self
+            .op
+            .ties
             .ties
             .iter()
             .enumerate()
-            .map(|(k, t)| (t.0, k))
+            .map(|(k, t)| (t.slave, k))
             .collect();
         for i in 0..nn {
             if slave.contains_key(&i) {
@@ -93,10 +95,10 @@ impl Solver {
             }
         }
         // Rotations of beam nodes, after the translations.
-        let mut eqr = vec![[usize::MAX; 3]; self.rot.node.len()];
+        let mut eqr = vec![[usize::MAX; 3]; self.state.rot.node.len()];
         for (k, e) in eqr.iter_mut().enumerate() {
             for d in 0..3 {
-                if self.rot.fixed[k] & (1 << d) == 0 {
+                if self.state.rot.fixed[k] & (1 << d) == 0 {
                     e[d] = neq;
                     neq += 1;
                 }
@@ -112,9 +114,10 @@ impl Solver {
         let map = |i: usize, d: usize| -> Vec<(usize, f64)> {
             match slave.get(&i) {
                 Some(&k) => {
-                    let (_, ms, w) = &self.ties[k];
-                    ms.iter()
-                        .zip(w)
+                    let t = &self.op.ties.ties[k];
+                    t.masters
+                        .iter()
+                        .zip(&t.w)
                         .filter(|(&a, _)| eq[a][d] != usize::MAX)
                         .map(|(&a, &wa)| (eq[a][d], wa))
                         .collect()
@@ -147,7 +150,7 @@ impl Solver {
         };
         let mut add_element = |nodes: &[usize], ke: &[f64]| add_maps(&tmaps(nodes), ke);
         let x0 = &self.x0;
-        let g = &self.truss;
+        let g = &self.op.el.truss;
         for e in 0..g.id.len() {
             let [a, b] = g.nodes[e].map(|v| v as usize);
             let ke = fd_stiffness(&[x0[a], x0[b]], 1e-6 * g.l0[e], |x| {
@@ -156,7 +159,7 @@ impl Solver {
             });
             add_element(&[a, b], &ke);
         }
-        let l = &self.link;
+        let l = &self.op.el.link;
         for e in 0..l.id.len() {
             let [a, b] = l.nodes[e].map(|v| v as usize);
             let ke = fd_stiffness(&[x0[a], x0[b]], 1e-6, |x| {
@@ -170,7 +173,7 @@ impl Solver {
             add_element(&[a, b], &ke);
         }
         fn membranes<const N: usize>(
-            grp: &super::MembraneGroup<N>,
+            grp: &super::membrane::MembraneGroup<N>,
             x0: &[[f64; 3]],
             add: &mut dyn FnMut(&[usize], &[f64]),
         ) {
@@ -193,9 +196,9 @@ impl Solver {
                 add(&nodes, &ke);
             }
         }
-        membranes(&self.tri, x0, &mut add_element);
-        membranes(&self.quad, x0, &mut add_element);
-        let bg = &self.beam;
+        membranes(&self.op.el.tri, x0, &mut add_element);
+        membranes(&self.op.el.quad, x0, &mut add_element);
+        let bg = &self.op.el.beam;
         for e in 0..bg.id.len() {
             let [a, b] = bg.nodes[e].map(|v| v as usize);
             let [ra, rb] = bg.rot[e].map(|v| v as usize);

@@ -58,3 +58,104 @@ pub fn axial_force(x1: &[f64; 3], x2: &[f64; 3], k: f64, l0: f64, tension_only: 
         n
     }
 }
+
+// ---------------------------------------------------------------------------------------
+// The truss family.
+
+use super::family::{chunk_partials, for_chunks, Build, EnergyGroup, EnergyPartial, Family, ForceCtx, StiffCtx, CHUNK};
+use super::vec3::dot;
+use crate::error::Result;
+use crate::model::ElementKind;
+
+/// Trusses, struct-of-arrays.
+#[derive(Debug, Clone, Default)]
+pub struct TrussGroup {
+    pub id: Vec<i64>,
+    pub nodes: Vec<[u32; 2]>,
+    /// Axial stiffness E·A/L_ref [N/m].
+    pub k: Vec<f64>,
+    /// Unstressed length L_ref = L₀/(1 + ε₀) [m].
+    pub l0: Vec<f64>,
+    pub tension_only: Vec<bool>,
+    partials: Vec<EnergyPartial>,
+}
+
+impl Family for TrussGroup {
+    const KIND: ElementKind = ElementKind::Truss;
+    const SLOTS: usize = 2;
+    const GROUP: EnergyGroup = EnergyGroup::Line;
+
+    fn build(bd: &mut Build) -> Result<Self> {
+        let (m, mass) = (bd.model, &mut *bd.mass);
+        let mut g = TrussGroup::default();
+        let Some(b) = m.block(ElementKind::Truss) else { return Ok(g) };
+        for e in 0..b.len() {
+            let p = &m.parts[b.part[e]].props;
+            let (a, c) = (b.nodes[2 * e], b.nodes[2 * e + 1]);
+            let d = super::vec3::sub(&m.coords[c], &m.coords[a]);
+            let l0 = dot(&d, &d).sqrt();
+            let (e_mod, rho, area) = (p.youngs_modulus.unwrap(), p.density.unwrap(), p.area.unwrap());
+            let me = rho * area * l0;
+            mass[a] += 0.5 * me;
+            mass[c] += 0.5 * me;
+            g.id.push(b.id[e]);
+            g.nodes.push([a as u32, c as u32]);
+            // Pretension: the unstressed length is shorter than the geometric one.
+            let lref = l0 / (1.0 + p.prestrain.unwrap_or(0.0));
+            g.k.push(e_mod * area / lref);
+            g.l0.push(lref);
+            g.tension_only.push(p.tension_only.unwrap_or(false));
+        }
+        Ok(g)
+    }
+    fn len(&self) -> usize {
+        self.id.len()
+    }
+    fn id(&self, e: usize) -> i64 {
+        self.id[e]
+    }
+    fn slot_nodes(&self, e: usize) -> &[u32] {
+        &self.nodes[e]
+    }
+    fn stiffness(&self, e: usize) -> f64 {
+        self.k[e]
+    }
+    fn forces(&mut self, ctx: &ForceCtx, fe: &mut [[f64; 3]]) {
+        let (g, x) = (&*self, ctx.x);
+        for_chunks(fe, 2, g.id.len(), |ci, out| {
+            let e0 = ci * CHUNK;
+            let n = out.len() / 2;
+            for (((pair, nodes), k), (l0, to)) in out
+                .chunks_exact_mut(2)
+                .zip(&g.nodes[e0..e0 + n])
+                .zip(&g.k[e0..e0 + n])
+                .zip(g.l0[e0..e0 + n].iter().zip(&g.tension_only[e0..e0 + n]))
+            {
+                let f2 = force(&x[nodes[0] as usize], &x[nodes[1] as usize], *k, *l0, *to);
+                pair[0] = [-f2[0], -f2[1], -f2[2]];
+                pair[1] = f2;
+            }
+        });
+    }
+    fn stiffness_sums(&self, ctx: &StiffCtx, s: &mut [f64], _c: &mut [f64], _r: &mut [f64]) {
+        // Row sum of |K| for node i: k_e on the diagonal, plus k_e off the diagonal when
+        // the other node can move (a fully fixed node's degrees of freedom are eliminated).
+        let w = |other: u32| if ctx.fixed[other as usize] == 0b111 { 1.0 } else { 2.0 };
+        for (e, p) in self.nodes.iter().enumerate() {
+            s[p[0] as usize] += w(p[1]) * self.k[e];
+            s[p[1] as usize] += w(p[0]) * self.k[e];
+        }
+    }
+    fn energies(&mut self, ctx: &ForceCtx) -> &[EnergyPartial] {
+        let (x, nodes, k, l0, to) = (ctx.x, &self.nodes, &self.k, &self.l0, &self.tension_only);
+        chunk_partials(&mut self.partials, nodes.len(), |r| {
+            let mut e = 0.0;
+            for i in r {
+                let [a, b] = nodes[i];
+                e += energy(&x[a as usize], &x[b as usize], k[i], l0[i], to[i]);
+            }
+            [e, 0.0, 0.0, 0.0]
+        });
+        &self.partials
+    }
+}

@@ -1,0 +1,487 @@
+//! Rigid projectile against nodes: penalty contact with Coulomb friction.
+//!
+//! Glossary: P the nose tip [m]; a the unit axis, pointing in the direction of travel
+//! (from the body to the tip); R radius; L_c body length behind the nose; for a node at
+//! x: s = (x − P)·a (axial, < 0 inside the body), ρ = |x − P − s a| (radial); g ≥ 0 the
+//! penetration depth and n the outward normal of the surface through which the node is
+//! pushed out (the nearest one).
+//!
+//! Shapes: `sphere` (centre P − R a); `flat` (flat-nosed cylinder: face through P normal
+//! to a, side ρ = R); `round` (round-nosed cylinder: hemisphere of centre P − R a, then
+//! the cylinder ρ = R behind it).
+//!
+//! Force on the node f = k g n − friction, on the projectile the opposite (momentum is
+//! exchanged exactly). Friction: f_t = −μ k g t̂ min(1, |v_t|/v_reg), t̂ along the
+//! tangential relative velocity v_t; v_reg = 10⁻³ m/s regularises sticking. Penalty
+//! k = κ_c m_i/Δt² per node (κ_c = 0.1: the contact spring alone has ω Δt ≈ 0.32, well
+//! inside stability) unless the projectile gives `contact_stiffness`. Stored contact
+//! energy ½ k g², friction work accumulated. Reference: Belytschko, Liu, Moran,
+//! *Nonlinear Finite Elements*, §10.4 (penalty contact), Wriggers, *Computational
+//! Contact Mechanics*, §5.2 (regularised Coulomb friction).
+
+use crate::model::{ProjectileShape, ProjectileSpec};
+
+/// Default κ_c of the penalty stiffness k = κ_c m/Δt².
+pub const PENALTY_FACTOR: f64 = 0.1;
+/// Penalty of a face sample point relative to the interpolated nodal penalty: with a
+/// quarter, the node and face contacts together stay well inside stability.
+pub const SEGMENT_FACTOR: f64 = 0.25;
+
+/// A contact point on a membrane face: x = Σ w_a x_a over up to four nodes.
+#[derive(Debug, Clone, Copy)]
+pub struct SamplePoint {
+    pub nodes: [u32; 4],
+    pub w: [f64; 4],
+    pub n: usize,
+    /// Tributary mass for the penalty k = κ_c·SEGMENT_FACTOR·m/Δt² [kg].
+    pub mass: f64,
+}
+
+/// Friction regularisation velocity [m/s].
+pub const V_REG: f64 = 1e-3;
+
+/// A projectile's state during a run.
+#[derive(Debug, Clone)]
+pub struct Projectile {
+    pub id: i64,
+    pub shape: ProjectileShape,
+    pub radius: f64,
+    pub length: f64,
+    pub mass: f64,
+    /// Unit axis (direction of travel).
+    pub axis: [f64; 3],
+    /// Nose tip position P^n.
+    pub tip: [f64; 3],
+    /// Half-step velocity v^{n−½} (the constant velocity when prescribed).
+    pub v: [f64; 3],
+    /// Full-step velocity v^n of the last step (output).
+    pub v_full: [f64; 3],
+    pub prescribed: bool,
+    /// Fixed penalty stiffness [N/m], or `None` for κ_c m/Δt².
+    pub stiffness: Option<f64>,
+    pub friction: f64,
+    /// Contact the membrane faces' sample points too.
+    pub segments: bool,
+    /// Contact force on the projectile at the last step [N].
+    pub force: [f64; 3],
+}
+
+impl Projectile {
+    pub fn new(p: &ProjectileSpec) -> Projectile {
+        let n = (p.axis[0].powi(2) + p.axis[1].powi(2) + p.axis[2].powi(2)).sqrt();
+        Projectile {
+            id: p.id,
+            shape: p.shape,
+            radius: p.radius,
+            length: p.length,
+            mass: p.mass,
+            axis: [p.axis[0] / n, p.axis[1] / n, p.axis[2] / n],
+            tip: p.tip,
+            v: p.velocity,
+            v_full: p.velocity,
+            prescribed: p.prescribed_velocity,
+            stiffness: p.contact_stiffness,
+            friction: p.friction,
+            segments: p.segment_contact,
+            force: [0.0; 3],
+        }
+    }
+
+    /// Centre of the spherical nose (spheres and round-nosed cylinders).
+    pub fn nose_centre(&self) -> Option<[f64; 3]> {
+        match self.shape {
+            ProjectileShape::Sphere | ProjectileShape::Round => Some(std::array::from_fn(|d| {
+                self.tip[d] - self.radius * self.axis[d]
+            })),
+            ProjectileShape::Flat => None,
+        }
+    }
+
+    /// Penetration depth and outward normal of a point, if it is inside.
+    #[inline]
+    pub fn penetration(&self, x: &[f64; 3]) -> Option<(f64, [f64; 3])> {
+        let (r, a, p) = (self.radius, &self.axis, &self.tip);
+        let d = [x[0] - p[0], x[1] - p[1], x[2] - p[2]];
+        let s = d[0] * a[0] + d[1] * a[1] + d[2] * a[2];
+        if s > 0.0 {
+            return None; // ahead of the tip
+        }
+        let sphere = |c_off: f64| -> Option<(f64, [f64; 3])> {
+            let dc = [
+                d[0] + c_off * a[0],
+                d[1] + c_off * a[1],
+                d[2] + c_off * a[2],
+            ];
+            let rr = (dc[0] * dc[0] + dc[1] * dc[1] + dc[2] * dc[2]).sqrt();
+            (rr < r && rr > 0.0).then(|| (r - rr, [dc[0] / rr, dc[1] / rr, dc[2] / rr]))
+        };
+        let radial = [d[0] - s * a[0], d[1] - s * a[1], d[2] - s * a[2]];
+        let rho = (radial[0] * radial[0] + radial[1] * radial[1] + radial[2] * radial[2]).sqrt();
+        let side_n = || {
+            if rho > 0.0 {
+                [radial[0] / rho, radial[1] / rho, radial[2] / rho]
+            } else {
+                [0.0; 3]
+            }
+        };
+        match self.shape {
+            ProjectileShape::Sphere => sphere(r),
+            ProjectileShape::Flat => {
+                if rho >= r || s < -self.length {
+                    return None;
+                }
+                let (face, side) = (-s, r - rho);
+                if face <= side {
+                    Some((face, *a))
+                } else {
+                    Some((side, side_n()))
+                }
+            }
+            ProjectileShape::Round => {
+                if s >= -r {
+                    sphere(r)
+                } else if rho < r && s >= -self.length {
+                    Some((r - rho, side_n()))
+                } else {
+                    None
+                }
+            }
+        }
+    }
+}
+
+/// Regularised Coulomb friction at a contact point with normal `n` and normal force
+/// `fnorm`, for the point's velocity `vr` relative to the projectile: the force on the
+/// point, −μ f_n t̂ min(1, |v_t|/v_reg), and the power it dissipates (≥ 0).
+#[inline]
+pub fn friction(n: &[f64; 3], fnorm: f64, vr: &[f64; 3], mu: f64) -> ([f64; 3], f64) {
+    let vn = vr[0] * n[0] + vr[1] * n[1] + vr[2] * n[2];
+    let vt = [vr[0] - vn * n[0], vr[1] - vn * n[1], vr[2] - vn * n[2]];
+    let vtm = (vt[0] * vt[0] + vt[1] * vt[1] + vt[2] * vt[2]).sqrt();
+    if vtm == 0.0 {
+        return ([0.0; 3], 0.0);
+    }
+    let ft = mu * fnorm * (vtm / V_REG).min(1.0);
+    (
+        [-ft * vt[0] / vtm, -ft * vt[1] / vtm, -ft * vt[2] / vtm],
+        ft * vtm,
+    )
+}
+
+/// Closest point of the triangle (a, b, c) to p, as barycentric weights (w_a, w_b, w_c)
+/// (Ericson, *Real-Time Collision Detection*, §5.1.5).
+pub fn closest_on_triangle(p: &[f64; 3], a: &[f64; 3], b: &[f64; 3], c: &[f64; 3]) -> [f64; 3] {
+    let sub = |x: &[f64; 3], y: &[f64; 3]| [x[0] - y[0], x[1] - y[1], x[2] - y[2]];
+    let dot = |x: &[f64; 3], y: &[f64; 3]| x[0] * y[0] + x[1] * y[1] + x[2] * y[2];
+    let (ab, ac, ap) = (sub(b, a), sub(c, a), sub(p, a));
+    let (d1, d2) = (dot(&ab, &ap), dot(&ac, &ap));
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return [1.0, 0.0, 0.0];
+    }
+    let bp = sub(p, b);
+    let (d3, d4) = (dot(&ab, &bp), dot(&ac, &bp));
+    if d3 >= 0.0 && d4 <= d3 {
+        return [0.0, 1.0, 0.0];
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        let v = d1 / (d1 - d3);
+        return [1.0 - v, v, 0.0];
+    }
+    let cp = sub(p, c);
+    let (d5, d6) = (dot(&ab, &cp), dot(&ac, &cp));
+    if d6 >= 0.0 && d5 <= d6 {
+        return [0.0, 0.0, 1.0];
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        let w = d2 / (d2 - d6);
+        return [1.0 - w, 0.0, w];
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+        let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        return [0.0, 1.0 - w, w];
+    }
+    let denom = 1.0 / (va + vb + vc);
+    let (v, w) = (vb * denom, vc * denom);
+    [1.0 - v - w, v, w]
+}
+
+// ---------------------------------------------------------------------------------------
+// Projectile contact during a run: the projectiles, the face sample points and face
+// triangles they meet, and the force and energy passes.
+
+use crate::model::Model;
+use crate::solver::vec3::{add, dot};
+
+/// A face triangle with its tributary mass (a quad gives four, along both diagonals).
+#[derive(Debug, Clone, Copy)]
+pub struct FaceTri {
+    pub nodes: [u32; 3],
+    pub mass: f64,
+}
+
+/// Contact of one sphere (centre c, radius r) with a face triangle: closest-point
+/// weights, outward normal, penetration and penalty. The single geometry kernel of the
+/// force and the energy passes.
+#[inline]
+fn sphere_face(
+    p: &Projectile,
+    c: &[f64; 3],
+    t: &FaceTri,
+    x: &[[f64; 3]],
+    dt2: f64,
+) -> Option<([f64; 3], [f64; 3], f64, f64)> {
+    let xs = t.nodes.map(|n| x[n as usize]);
+    let w = closest_on_triangle(c, &xs[0], &xs[1], &xs[2]);
+    let q: [f64; 3] = std::array::from_fn(|d| w[0] * xs[0][d] + w[1] * xs[1][d] + w[2] * xs[2][d]);
+    let dq = [q[0] - c[0], q[1] - c[1], q[2] - c[2]];
+    let dist = dot(&dq, &dq).sqrt();
+    if dist >= p.radius || dist == 0.0 {
+        return None;
+    }
+    // A round nose's hemisphere only: the cylinder behind it is left to node contact.
+    if p.shape == ProjectileShape::Round && dot(&dq, &p.axis) < 0.0 {
+        return None;
+    }
+    let n = [dq[0] / dist, dq[1] / dist, dq[2] / dist];
+    let kp = p.stiffness.unwrap_or(PENALTY_FACTOR * t.mass / (3.0 * dt2));
+    Some((w, n, p.radius - dist, kp))
+}
+
+/// Penalty of a face sample point.
+#[inline]
+fn sample_penalty(p: &Projectile, sp: &SamplePoint, dt2: f64) -> f64 {
+    SEGMENT_FACTOR * p.stiffness.unwrap_or(PENALTY_FACTOR * sp.mass / dt2)
+}
+
+/// Every projectile of a model and what it can touch.
+#[derive(Debug, Clone, Default)]
+pub struct ProjectileContact {
+    pub projectiles: Vec<Projectile>,
+    /// Contact sample points on the membrane faces (centroids, edge midpoints), for
+    /// flat noses.
+    samples: Vec<SamplePoint>,
+    /// Face triangles (quads split along both diagonals), for spherical noses.
+    face_tris: Vec<FaceTri>,
+    /// Default penalty stiffness per node κ_c m/Δt² [N/m].
+    k_node: Vec<f64>,
+    /// Friction work dissipated in contact [J].
+    pub friction_work: f64,
+    /// Work done by projectiles with prescribed velocity [J].
+    pub prescribed_work: f64,
+    /// Directions normal to the symmetry planes: projectiles cannot move along them.
+    fixed: [bool; 3],
+}
+
+impl ProjectileContact {
+    /// `faces`: every membrane face (its nodes, 3 or 4) with its mass.
+    pub fn new(m: &Model, faces: &[(&[u32], f64)]) -> ProjectileContact {
+        // Contact sample points on the faces, each with a tributary mass for its penalty:
+        // half the face's mass at its centroid, the other half shared among its edges (an
+        // edge collects from every face it bounds), so the penalty of a face does not
+        // depend on what lies beyond it (a symmetry plane, a free edge).
+        let mut samples = Vec::new();
+        let mut edge_at: std::collections::BTreeMap<(u32, u32), usize> = Default::default();
+        for &(f, mf) in faces {
+            let n = f.len();
+            let mut nodes = [0u32; 4];
+            nodes[..n].copy_from_slice(f);
+            let mut w = [0.0; 4];
+            for x in w.iter_mut().take(n) {
+                *x = 1.0 / n as f64;
+            }
+            samples.push(SamplePoint { nodes, w, n, mass: 0.5 * mf });
+            for a in 0..n {
+                let (p, q) = (f[a], f[(a + 1) % n]);
+                let k = *edge_at.entry((p.min(q), p.max(q))).or_insert_with(|| {
+                    samples.push(SamplePoint { nodes: [p, q, 0, 0], w: [0.5, 0.5, 0.0, 0.0], n: 2, mass: 0.0 });
+                    samples.len() - 1
+                });
+                samples[k].mass += 0.5 * mf / n as f64;
+            }
+        }
+        let mut face_tris = Vec::new();
+        for &(f, m) in faces {
+            if f.len() == 3 {
+                face_tris.push(FaceTri { nodes: [f[0], f[1], f[2]], mass: m });
+            } else {
+                // Both diagonals, so that the split has no handedness (a mirrored mesh,
+                // e.g. across a symmetry plane, gets the mirrored contact).
+                for t in [[f[0], f[1], f[2]], [f[0], f[2], f[3]], [f[1], f[2], f[3]], [f[1], f[3], f[0]]] {
+                    face_tris.push(FaceTri { nodes: t, mass: 0.25 * m });
+                }
+            }
+        }
+        ProjectileContact {
+            projectiles: m.projectiles.iter().map(Projectile::new).collect(),
+            samples,
+            face_tris,
+            k_node: vec![],
+            friction_work: 0.0,
+            prescribed_work: 0.0,
+            fixed: std::array::from_fn(|d| m.symmetry.iter().any(|sp| sp.normal == d)),
+        }
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.projectiles.is_empty()
+    }
+
+    /// Node penalties κ_c m_i/Δt², once the step is known.
+    pub fn set_step(&mut self, mass: &[f64], dt: f64) {
+        self.k_node = mass.iter().map(|m| PENALTY_FACTOR * m / (dt * dt)).collect();
+    }
+
+    /// Penalty contact of every projectile against every node with mass and (when
+    /// asked) the faces, at x^n: forces on the nodes into `fcon` (the nodes touched are
+    /// pushed on `touched`), the opposite force on each projectile.
+    #[allow(clippy::too_many_arguments)]
+    pub fn forces(
+        &mut self,
+        x: &[[f64; 3]],
+        v: &[[f64; 3]],
+        mass: &[f64],
+        dt: f64,
+        dt_prev: f64,
+        fcon: &mut [[f64; 3]],
+        touched: &mut Vec<usize>,
+    ) {
+        let kc = &self.k_node;
+        let dt2 = dt * dt;
+        for p in self.projectiles.iter_mut() {
+            let mut ftot = [0.0; 3];
+            for i in 0..x.len() {
+                if mass[i] <= 0.0 {
+                    continue;
+                }
+                let Some((g, n)) = p.penetration(&x[i]) else {
+                    continue;
+                };
+                let fnorm = p.stiffness.unwrap_or(kc[i]) * g;
+                let mut f = [n[0] * fnorm, n[1] * fnorm, n[2] * fnorm];
+                if p.friction > 0.0 {
+                    let vr = [v[i][0] - p.v[0], v[i][1] - p.v[1], v[i][2] - p.v[2]];
+                    let (ft, power) = friction(&n, fnorm, &vr, p.friction);
+                    f = [f[0] + ft[0], f[1] + ft[1], f[2] + ft[2]];
+                    self.friction_work += power * dt_prev;
+                }
+                add(&mut fcon[i], &f);
+                ftot = [ftot[0] - f[0], ftot[1] - f[1], ftot[2] - f[2]];
+                touched.push(i);
+            }
+            if p.segments && p.nose_centre().is_some() {
+                // Exact: the sphere against the closest point of every face triangle.
+                let c = p.nose_centre().expect("spherical nose");
+                for t in &self.face_tris {
+                    let Some((w, n, g, kp)) = sphere_face(p, &c, t, x, dt2) else {
+                        continue;
+                    };
+                    let fnorm = kp * g;
+                    let mut f = [n[0] * fnorm, n[1] * fnorm, n[2] * fnorm];
+                    if p.friction > 0.0 {
+                        let vq: [f64; 3] =
+                            std::array::from_fn(|d| (0..3).map(|a| w[a] * v[t.nodes[a] as usize][d]).sum());
+                        let vr = [vq[0] - p.v[0], vq[1] - p.v[1], vq[2] - p.v[2]];
+                        let (ft, power) = friction(&n, fnorm, &vr, p.friction);
+                        f = [f[0] + ft[0], f[1] + ft[1], f[2] + ft[2]];
+                        self.friction_work += power * dt_prev;
+                    }
+                    for a in 0..3 {
+                        let i = t.nodes[a] as usize;
+                        add(&mut fcon[i], &[w[a] * f[0], w[a] * f[1], w[a] * f[2]]);
+                        touched.push(i);
+                    }
+                    ftot = [ftot[0] - f[0], ftot[1] - f[1], ftot[2] - f[2]];
+                }
+            } else if p.segments {
+                for sp in &self.samples {
+                    let nodes = &sp.nodes[..sp.n];
+                    let pos: [f64; 3] =
+                        std::array::from_fn(|d| (0..sp.n).map(|a| sp.w[a] * x[nodes[a] as usize][d]).sum());
+                    let Some((g, n)) = p.penetration(&pos) else {
+                        continue;
+                    };
+                    let fnorm = sample_penalty(p, sp, dt2) * g;
+                    let mut f = [n[0] * fnorm, n[1] * fnorm, n[2] * fnorm];
+                    if p.friction > 0.0 {
+                        let vp: [f64; 3] =
+                            std::array::from_fn(|d| (0..sp.n).map(|a| sp.w[a] * v[nodes[a] as usize][d]).sum());
+                        let vr = [vp[0] - p.v[0], vp[1] - p.v[1], vp[2] - p.v[2]];
+                        let (ft, power) = friction(&n, fnorm, &vr, p.friction);
+                        f = [f[0] + ft[0], f[1] + ft[1], f[2] + ft[2]];
+                        self.friction_work += power * dt_prev;
+                    }
+                    for a in 0..sp.n {
+                        let i = nodes[a] as usize;
+                        add(&mut fcon[i], &[sp.w[a] * f[0], sp.w[a] * f[1], sp.w[a] * f[2]]);
+                        touched.push(i);
+                    }
+                    ftot = [ftot[0] - f[0], ftot[1] - f[1], ftot[2] - f[2]];
+                }
+            }
+            p.force = ftot;
+        }
+    }
+
+    /// Stored penalty energy ½ Σ k g² at the positions `x`.
+    pub fn energy(&self, x: &[[f64; 3]], mass: &[f64], dt: f64) -> f64 {
+        let dt2 = dt * dt;
+        let mut e = 0.0;
+        for p in self.projectiles.iter().filter(|p| p.segments) {
+            if let Some(c) = p.nose_centre() {
+                for t in &self.face_tris {
+                    if let Some((_, _, g, kp)) = sphere_face(p, &c, t, x, dt2) {
+                        e += 0.5 * kp * g.powi(2);
+                    }
+                }
+                continue;
+            }
+            for sp in &self.samples {
+                let nodes = &sp.nodes[..sp.n];
+                let pos: [f64; 3] =
+                    std::array::from_fn(|d| (0..sp.n).map(|a| sp.w[a] * x[nodes[a] as usize][d]).sum());
+                if let Some((g, _)) = p.penetration(&pos) {
+                    e += 0.5 * sample_penalty(p, sp, dt2) * g * g;
+                }
+            }
+        }
+        for p in &self.projectiles {
+            for i in 0..x.len() {
+                if mass[i] <= 0.0 {
+                    continue;
+                }
+                if let Some((g, _)) = p.penetration(&x[i]) {
+                    e += 0.5 * p.stiffness.unwrap_or(self.k_node[i]) * g * g;
+                }
+            }
+        }
+        e
+    }
+
+    /// Advance the projectiles (central difference, like the nodes); returns their
+    /// kinetic energy at t_n (free ones) and keeps their velocity at t_n in `v_full`.
+    pub fn advance(&mut self, dt_prev: f64, dt_next: f64) -> f64 {
+        let mut ke = 0.0;
+        for p in self.projectiles.iter_mut() {
+            if p.prescribed {
+                // The work the imposed motion does on the system.
+                self.prescribed_work -= dt_next * dot(&p.force, &p.v);
+                p.v_full = p.v;
+            } else {
+                // In a symmetric model the projectile stays on the symmetry planes.
+                let a: [f64; 3] =
+                    std::array::from_fn(|d| if self.fixed[d] { 0.0 } else { p.force[d] / p.mass });
+                let vn: [f64; 3] = std::array::from_fn(|d| p.v[d] + 0.5 * dt_prev * a[d]);
+                ke += 0.5 * p.mass * dot(&vn, &vn);
+                p.v = std::array::from_fn(|d| vn[d] + 0.5 * dt_next * a[d]);
+                p.v_full = vn;
+            }
+            for d in 0..3 {
+                p.tip[d] += dt_next * p.v[d];
+            }
+        }
+        ke
+    }
+}

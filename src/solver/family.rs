@@ -1,0 +1,249 @@
+//! Element families: one vocabulary for every kind of element, and the list of families
+//! the solver iterates with static dispatch.
+//!
+//! A family (truss, link, point mass, membrane triangle, membrane quad, beam) owns its
+//! elements as struct-of-arrays, builds them from the model, and walks the same phases
+//! as every other family (after OpenRadioss' element groups):
+//! - `build`: read its block of the model, add its lumped masses (and rotary inertia);
+//! - `forces`: gather positions → kinematics → constitutive → internal force, written
+//!   into the family's own force slots (one slot per element node), in parallel fixed
+//!   chunks of [`CHUNK`] elements; the node update gathers the slots in a fixed order;
+//! - `stiffness_sums`: its contribution to the nodal Gershgorin bound of the stable step
+//!   (see [`super::stable`]) and `stiffness` for the report of the controlling element;
+//! - `energies`: per-chunk partial sums (internal, damping, friction, hourglass).
+//!
+//! Adding a family is one file that implements [`Family`] and one line in
+//! [`families!`](crate::families)' invocation in `solver/mod.rs`. The order of that list
+//! is the order of the force slots, of the masses' accumulation and of the sums, so it
+//! is part of what makes results reproducible bit for bit.
+
+use super::beam::Rotations;
+use super::vec3::{Mat3, Vec3};
+use crate::error::Result;
+use crate::model::{ElementKind, Model};
+
+/// Elements per parallel chunk. Fixed, so that chunked reductions do not depend on the
+/// thread count; large enough (≈50 kB of element data) to amortise task overhead, small
+/// enough that a 10⁴-element model splits evenly over two threads.
+pub const CHUNK: usize = 1024;
+
+/// What a family's build reads and adds to besides itself.
+pub struct Build<'a> {
+    pub model: &'a Model,
+    /// Lumped nodal masses [kg], accumulated family by family in list order.
+    pub mass: &'a mut Vec<f64>,
+    /// Rotational nodes (created by the families whose nodes carry rotations).
+    pub rot: &'a mut Rotations,
+}
+
+/// The state a force kernel reads.
+pub struct ForceCtx<'a> {
+    /// Positions x^n [m].
+    pub x: &'a [Vec3],
+    /// Half-step velocities v^{n−½} [m/s].
+    pub v: &'a [Vec3],
+    /// Orientations of the rotational nodes.
+    pub rot_r: &'a [Mat3],
+    /// Δt^{n−½} [s].
+    pub dt_prev: f64,
+}
+
+/// What the stable-step bound reads.
+pub struct StiffCtx<'a> {
+    /// Bit d set when translation d of the node is fixed.
+    pub fixed: &'a [u8],
+    /// Lumped masses [kg].
+    pub mass: &'a [f64],
+    /// Rotary inertia of each rotational node [kg·m²].
+    pub rot_j: &'a [f64],
+}
+
+/// Per-chunk partial sums of the element energies [J]:
+/// `[internal, damping, friction, hourglass]`.
+pub type EnergyPartial = [f64; 4];
+
+/// Summation groups of the energy ledger: each group sums its families' chunk partials
+/// in list order; the totals are (Line + Membrane) + Beam. The grouping is the order
+/// the sums have always been taken in, kept so that results stay bit-identical.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum EnergyGroup {
+    /// One-dimensional elements: trusses and links (and point masses, which store none).
+    Line = 0,
+    /// Membrane triangles and quads.
+    Membrane = 1,
+    /// Beams (energy taken before the rotations advance).
+    Beam = 2,
+}
+
+/// One element family (see the module docs for the phases).
+pub trait Family: Sized + Send + Sync {
+    const KIND: ElementKind;
+    /// Force slots (nodes) per element.
+    const SLOTS: usize;
+    const GROUP: EnergyGroup;
+    fn build(b: &mut Build) -> Result<Self>;
+    fn len(&self) -> usize;
+    fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+    /// Element id (the `id` column of its table).
+    fn id(&self, e: usize) -> i64;
+    /// Node indices of element e, one per force slot.
+    fn slot_nodes(&self, e: usize) -> &[u32];
+    /// A representative stiffness [N/m] (or damping [N·s/m]) for naming the element
+    /// that controls the step.
+    fn stiffness(&self, e: usize) -> f64;
+    /// Internal forces exerted on the element nodes into `fe` (`SLOTS` per element).
+    /// Families with state (link sliders, dissipated energies) advance it here: call
+    /// once per step.
+    fn forces(&mut self, ctx: &ForceCtx, fe: &mut [Vec3]);
+    /// Adds the family's row sums S_i, C_i (and the rotational rows) of the stable-step
+    /// bound.
+    fn stiffness_sums(&self, ctx: &StiffCtx, s: &mut [f64], c: &mut [f64], rot_row: &mut [f64]);
+    /// Per-chunk energy partials at the positions in `ctx`.
+    fn energies(&mut self, ctx: &ForceCtx) -> &[EnergyPartial];
+}
+
+/// Totals of the energy ledger's groups (see [`EnergyGroup`]).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct EnergySums {
+    pub groups: [EnergyPartial; 3],
+}
+
+impl EnergySums {
+    pub fn add(&mut self, group: EnergyGroup, parts: &[EnergyPartial]) {
+        let g = &mut self.groups[group as usize];
+        for p in parts {
+            for c in 0..4 {
+                g[c] += p[c];
+            }
+        }
+    }
+    /// Component c of the total: (Line + Membrane) + Beam.
+    pub fn total(&self, c: usize) -> f64 {
+        (self.groups[0][c] + self.groups[1][c]) + self.groups[2][c]
+    }
+}
+
+/// Declares the solver's element families, in slot order: generates the `Families`
+/// struct (one field per family) and its loops over all of them.
+#[macro_export]
+macro_rules! families {
+    ($($field:ident : $ty:ty),* $(,)?) => {
+        /// Every element family of a model, in slot order.
+        #[derive(Debug, Clone)]
+        pub struct Families {
+            $(pub $field: $ty,)*
+        }
+
+        impl Families {
+            pub fn build(b: &mut $crate::solver::family::Build) -> $crate::error::Result<Self> {
+                Ok(Families { $($field: <$ty as $crate::solver::family::Family>::build(b)?,)* })
+            }
+            /// Total number of elements.
+            pub fn len(&self) -> usize {
+                0 $(+ $crate::solver::family::Family::len(&self.$field))*
+            }
+            pub fn is_empty(&self) -> bool {
+                self.len() == 0
+            }
+            /// Total number of force slots.
+            pub fn slots(&self) -> usize {
+                0 $(+ <$ty as $crate::solver::family::Family>::SLOTS
+                    * $crate::solver::family::Family::len(&self.$field))*
+            }
+            /// Node of every force slot, in slot order.
+            pub fn slot_nodes(&self) -> Vec<u32> {
+                let mut v = Vec::with_capacity(self.slots());
+                $(
+                    for e in 0..$crate::solver::family::Family::len(&self.$field) {
+                        v.extend_from_slice($crate::solver::family::Family::slot_nodes(&self.$field, e));
+                    }
+                )*
+                v
+            }
+            /// The element of a force slot: kind, id, stiffness.
+            pub fn slot_element(&self, mut slot: usize) -> Option<($crate::model::ElementKind, i64, f64)> {
+                $(
+                    let n = <$ty as $crate::solver::family::Family>::SLOTS
+                        * $crate::solver::family::Family::len(&self.$field);
+                    if slot < n {
+                        let e = slot / <$ty as $crate::solver::family::Family>::SLOTS.max(1);
+                        return Some((
+                            <$ty as $crate::solver::family::Family>::KIND,
+                            $crate::solver::family::Family::id(&self.$field, e),
+                            $crate::solver::family::Family::stiffness(&self.$field, e),
+                        ));
+                    }
+                    slot -= n;
+                )*
+                let _ = slot;
+                None
+            }
+            /// Internal forces of every family into its slots of `fe`.
+            pub fn forces(&mut self, ctx: &$crate::solver::family::ForceCtx, fe: &mut [[f64; 3]]) {
+                let mut rest = fe;
+                $(
+                    let n = <$ty as $crate::solver::family::Family>::SLOTS
+                        * $crate::solver::family::Family::len(&self.$field);
+                    let (mine, r) = std::mem::take(&mut rest).split_at_mut(n);
+                    rest = r;
+                    if n > 0 {
+                        $crate::solver::family::Family::forces(&mut self.$field, ctx, mine);
+                    }
+                )*
+                let _ = rest;
+            }
+            pub fn stiffness_sums(
+                &self,
+                ctx: &$crate::solver::family::StiffCtx,
+                s: &mut [f64],
+                c: &mut [f64],
+                rot_row: &mut [f64],
+            ) {
+                $($crate::solver::family::Family::stiffness_sums(&self.$field, ctx, s, c, rot_row);)*
+            }
+            /// Element energies summed by group (see `EnergyGroup`).
+            pub fn energies(&mut self, ctx: &$crate::solver::family::ForceCtx) -> $crate::solver::family::EnergySums {
+                let mut sums = $crate::solver::family::EnergySums::default();
+                $(
+                    if !$crate::solver::family::Family::is_empty(&self.$field) {
+                        let p = $crate::solver::family::Family::energies(&mut self.$field, ctx);
+                        sums.add(<$ty as $crate::solver::family::Family>::GROUP, p);
+                    }
+                )*
+                sums
+            }
+        }
+    };
+}
+
+/// Runs `body(chunk index, chunk)` over `CHUNK`-element chunks of `out` (`per` slots
+/// per element), in parallel when there is more than one chunk.
+#[inline]
+pub fn for_chunks<T: Send, F>(out: &mut [T], per: usize, n_elements: usize, body: F)
+where
+    F: Fn(usize, &mut [T]) + Send + Sync,
+{
+    use rayon::prelude::*;
+    if n_elements <= CHUNK {
+        out.chunks_mut(per * CHUNK).enumerate().for_each(|(ci, o)| body(ci, o));
+    } else {
+        out.par_chunks_mut(per * CHUNK).enumerate().for_each(|(ci, o)| body(ci, o));
+    }
+}
+
+/// Fills `partials` (one per `CHUNK` elements) with `f(element range)`, in parallel.
+#[inline]
+pub fn chunk_partials<F>(partials: &mut Vec<EnergyPartial>, n_elements: usize, f: F)
+where
+    F: Fn(std::ops::Range<usize>) -> EnergyPartial + Send + Sync,
+{
+    use rayon::prelude::*;
+    partials.resize(n_elements.div_ceil(CHUNK), [0.0; 4]);
+    partials
+        .par_iter_mut()
+        .enumerate()
+        .with_min_len(4)
+        .for_each(|(ci, out)| *out = f(ci * CHUNK..((ci + 1) * CHUNK).min(n_elements)));
+}

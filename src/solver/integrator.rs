@@ -1,0 +1,172 @@
+//! Explicit central difference with lumped masses: the time integrator. It reads the
+//! operator's nodal forces and advances the state; it computes no force itself.
+//!
+//! One step (Belytschko, Liu, Moran, *Nonlinear Finite Elements*, Box 6.1, with the
+//! damping force −α m v^n evaluated at the full step):
+//!   v^n     = (v^{n−½} + ½ Δt^{n−½} a^n) / (1 + ½ α Δt^{n−½})
+//!   v^{n+½} = v^n (1 − ½ α Δt^{n+½}) + ½ Δt^{n+½} a^n
+//!   x^{n+1} = x^n + Δt^{n+½} v^{n+½}
+//! At n = 0, Δt^{−½} = 0, so v^0 is the initial velocity and the first step is the
+//! usual half step. Rotations (beam nodes) follow the same scheme with J and the
+//! moments, the orientation updated by the exponential map.
+
+use rayon::prelude::*;
+
+use super::beam;
+use super::family::CHUNK;
+use super::operator::{Operator, State};
+use super::vec3::{add, dot};
+use crate::error::{Result, WeftError};
+
+/// Per-chunk sums of the node update.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct NodePartial {
+    pub ke: f64,
+    pub damp_power: f64,
+    /// First node whose state became non-finite (usize::MAX: none).
+    pub bad: usize,
+}
+
+/// What the node update needs besides the state and the forces.
+pub struct Nodal<'a> {
+    pub inv_m: &'a [f64],
+    pub mass: &'a [f64],
+    /// Bit d set when direction d is fixed.
+    pub fixed: &'a [u8],
+    /// Mass-proportional damping α [1/s].
+    pub alpha: f64,
+}
+
+/// Gather forces and advance every node by one step; when `SNAP`, x^n and v^n are
+/// kept in `st.xn`, `st.vn`. Returns (kinetic energy at t_n when `SNAP`, mass-damping
+/// power α Σ m |v^n|²), or the first node that became non-finite.
+pub fn advance_nodes<const SNAP: bool>(
+    st: &mut State,
+    op: &Operator,
+    nd: &Nodal,
+    dt_next: f64,
+    partials: &mut [NodePartial],
+) -> std::result::Result<(f64, f64), usize> {
+    let (alpha, dt_prev) = (nd.alpha, st.dt_prev);
+    let c1 = 1.0 / (1.0 + 0.5 * alpha * dt_prev);
+    let c2 = 1.0 - 0.5 * alpha * dt_next;
+    let (h_prev, h_next) = (0.5 * dt_prev, 0.5 * dt_next);
+    let (fe, gather) = (&op.fe, &op.gather);
+    let (fext, inv_m, mass, fixed) = (&op.fext, nd.inv_m, nd.mass, nd.fixed);
+    let fcon = op.has_fcon().then_some(&op.fcon);
+    type Chunk<'c> = (
+        usize,
+        ((((&'c mut [[f64; 3]], &'c mut [[f64; 3]]), &'c mut [[f64; 3]]), &'c mut [[f64; 3]]), &'c mut NodePartial),
+    );
+    let body = |(ci, ((((x, v), xn), vn), part)): Chunk| {
+        let i0 = ci * CHUNK;
+        let (mut ke, mut dp, mut bad) = (0.0, 0.0, usize::MAX);
+        for j in 0..x.len() {
+            let i = i0 + j;
+            let mut f = fext[i];
+            if let Some(fc) = fcon {
+                add(&mut f, &fc[i]);
+            }
+            for &s in gather.of(i) {
+                add(&mut f, &fe[s as usize]);
+            }
+            let im = inv_m[i];
+            let mut a = [f[0] * im, f[1] * im, f[2] * im];
+            let fx = fixed[i];
+            if fx != 0 {
+                for (d, ad) in a.iter_mut().enumerate() {
+                    if fx & (1 << d) != 0 {
+                        *ad = 0.0;
+                    }
+                }
+            }
+            let vo = v[j];
+            let vh = [(vo[0] + h_prev * a[0]) * c1, (vo[1] + h_prev * a[1]) * c1, (vo[2] + h_prev * a[2]) * c1];
+            let vnew = [vh[0] * c2 + h_next * a[0], vh[1] * c2 + h_next * a[1], vh[2] * c2 + h_next * a[2]];
+            let v2 = dot(&vh, &vh);
+            if SNAP {
+                xn[j] = x[j];
+                vn[j] = vh;
+                ke += 0.5 * mass[i] * v2;
+            }
+            dp += mass[i] * v2;
+            let xo = x[j];
+            let xnew = [xo[0] + dt_next * vnew[0], xo[1] + dt_next * vnew[1], xo[2] + dt_next * vnew[2]];
+            if !(vnew[0] + vnew[1] + vnew[2] + xnew[0] + xnew[1] + xnew[2]).is_finite() && bad == usize::MAX {
+                bad = i;
+            }
+            v[j] = vnew;
+            x[j] = xnew;
+        }
+        *part = NodePartial { ke, damp_power: alpha * dp, bad };
+    };
+    if st.x.len() <= CHUNK {
+        st.x.chunks_mut(CHUNK)
+            .zip(st.v.chunks_mut(CHUNK))
+            .zip(st.xn.chunks_mut(CHUNK))
+            .zip(st.vn.chunks_mut(CHUNK))
+            .zip(partials.iter_mut())
+            .enumerate()
+            .for_each(body);
+    } else {
+        st.x.par_chunks_mut(CHUNK)
+            .zip(st.v.par_chunks_mut(CHUNK))
+            .zip(st.xn.par_chunks_mut(CHUNK))
+            .zip(st.vn.par_chunks_mut(CHUNK))
+            .zip(partials.par_iter_mut())
+            .enumerate()
+            .for_each(body);
+    }
+    let (mut ke, mut dp) = (0.0, 0.0);
+    for p in partials.iter() {
+        if p.bad != usize::MAX {
+            return Err(p.bad);
+        }
+        ke += p.ke;
+        dp += p.damp_power;
+    }
+    Ok((ke, dp))
+}
+
+/// Advance the rotations of the beam nodes by one step; returns (rotational kinetic
+/// energy at t_n, mass-damping power α Σ J |ω^n|²). `moments`: the beams' end moments,
+/// gathered per rotational node through `st.rot.slots`.
+pub fn advance_rotations(
+    st: &mut State,
+    moments: &[[f64; 3]],
+    alpha: f64,
+    dt_next: f64,
+    node_id: &[i64],
+) -> Result<(f64, f64)> {
+    let dt_prev = st.dt_prev;
+    let c1 = 1.0 / (1.0 + 0.5 * alpha * dt_prev);
+    let c2 = 1.0 - 0.5 * alpha * dt_next;
+    let (mut ke, mut dp) = (0.0, 0.0);
+    let (step, t) = (st.step, st.t);
+    let rot = &mut st.rot;
+    for k in 0..rot.node.len() {
+        let mut mom = [0.0; 3];
+        for &sl in &rot.slots[rot.ptr[k] as usize..rot.ptr[k + 1] as usize] {
+            add(&mut mom, &moments[sl as usize]);
+        }
+        let ij = 1.0 / rot.j[k];
+        let a: [f64; 3] = std::array::from_fn(|d| if rot.fixed[k] & (1 << d) != 0 { 0.0 } else { mom[d] * ij });
+        let w = rot.omega[k];
+        let wn: [f64; 3] = std::array::from_fn(|d| (w[d] + 0.5 * dt_prev * a[d]) * c1);
+        let wnew: [f64; 3] = std::array::from_fn(|d| wn[d] * c2 + 0.5 * dt_next * a[d]);
+        let w2 = dot(&wn, &wn);
+        ke += 0.5 * rot.j[k] * w2;
+        dp += alpha * rot.j[k] * w2;
+        if !(wnew[0] + wnew[1] + wnew[2]).is_finite() {
+            return Err(WeftError::Numerical {
+                what: format!("the rotation of node `{}` became NaN or infinite", node_id[rot.node[k]]),
+                step,
+                time: t,
+                hint: Some("check the beam properties near this node".into()),
+            });
+        }
+        rot.omega[k] = wnew;
+        rot.r[k] = beam::rotate(&rot.r[k], &[dt_next * wnew[0], dt_next * wnew[1], dt_next * wnew[2]]);
+    }
+    Ok((ke, dp))
+}
