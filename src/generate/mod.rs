@@ -2,6 +2,7 @@
 //! with named node sets, ready to simulate.
 
 pub mod grid;
+pub mod layers;
 pub mod rod;
 pub mod square;
 pub mod zones;

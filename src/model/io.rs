@@ -42,6 +42,7 @@ pub const MODEL_TABLES: &[&str] = &[
     "projectile.parquet",
     "symmetry.parquet",
     "ties.parquet",
+    "contacts.parquet",
     "analysis.parquet",
 ];
 
@@ -232,6 +233,24 @@ fn read_model_inner(dir: &Path) -> Result<Model> {
             let ids = t.i64(c, exp)?;
             cols.push(node_refs(&t, c, &ids, &map)?);
         }
+        // Nodal thickness of membranes: t1… (null: the part's thickness).
+        let mut tcols = Vec::new();
+        if matches!(kind, ElementKind::Tri | ElementKind::Quad) {
+            for c in ["t1", "t2", "t3", "t4"].iter().take(kind.nodes_per_element()) {
+                if let Some(v) = t.f64_opt(c)? {
+                    tcols.push(v);
+                }
+            }
+            if !tcols.is_empty() && tcols.len() != kind.nodes_per_element() {
+                return Err(WeftError::input(format!(
+                    "{} of the nodal thickness columns t1…t{} are present",
+                    tcols.len(),
+                    kind.nodes_per_element()
+                ))
+                .in_file(&t.path)
+                .expected("all of them or none"));
+            }
+        }
         let mut b = ElementBlock::default();
         for row in 0..eid.len() {
             let part = *part_map.get(&pid[row]).ok_or_else(|| {
@@ -246,6 +265,10 @@ fn read_model_inner(dir: &Path) -> Result<Model> {
             b.part.push(part);
             for c in &cols {
                 b.nodes.push(c[row]);
+            }
+            for c in &tcols {
+                let pt = m.parts[part].props.thickness.unwrap_or(0.0);
+                b.thickness.push(c[row].unwrap_or(pt));
             }
         }
         m.elements.insert(kind, b);
@@ -509,6 +532,7 @@ fn read_model_inner(dir: &Path) -> Result<Model> {
             });
         }
     }
+    super::contacts::read(dir, &mut m)?;
     if let Some(t) = opt_table(dir, "analysis.parquet")? {
         if t.num_rows() != 1 {
             return Err(
@@ -643,6 +667,11 @@ fn write_tables(m: &Model, dir: &Path, prov: &Provenance) -> Result<()> {
         for (j, c) in ["n1", "n2", "n3", "n4"].into_iter().take(npe).enumerate() {
             let v: Vec<usize> = b.nodes.iter().skip(j).step_by(npe).copied().collect();
             cols.push(Col::I64(c, ids(&v)));
+        }
+        if !b.thickness.is_empty() {
+            for (j, c) in ["t1", "t2", "t3", "t4"].into_iter().take(npe).enumerate() {
+                cols.push(Col::F64(c, b.thickness.iter().skip(j).step_by(npe).copied().collect()));
+            }
         }
         write_table(
             &dir.join(format!("elements_{}.parquet", kind.name())),
@@ -873,6 +902,7 @@ fn write_tables(m: &Model, dir: &Path, prov: &Provenance) -> Result<()> {
             prov,
         )?;
     }
+    super::contacts::write(m, dir, prov)?;
     let a = &m.analysis;
     write_table(
         &dir.join("analysis.parquet"),

@@ -6,6 +6,7 @@
 //! build models with [`Model`]'s `add_*` methods; [`Model::validate`] checks every
 //! property and reference and names the offending part, element, node or row.
 
+pub mod contacts;
 pub mod io;
 
 use std::collections::{BTreeMap, HashMap};
@@ -138,6 +139,10 @@ pub struct ElementBlock {
     pub part: Vec<usize>,
     /// Node indices, `nodes_per_element` consecutive entries per element.
     pub nodes: Vec<usize>,
+    /// Membranes: thickness at each element node [m], `nodes_per_element` entries per
+    /// element (LS-DYNA's shell nodal thickness); empty when every element has its
+    /// part's thickness.
+    pub thickness: Vec<f64>,
 }
 
 impl ElementBlock {
@@ -369,6 +374,8 @@ pub struct Model {
     pub projectiles: Vec<ProjectileSpec>,
     pub symmetry: Vec<SymmetryPlane>,
     pub ties: Vec<Tie>,
+    /// Contact definitions (`contacts.parquet`).
+    pub contacts: Vec<contacts::ContactDef>,
     pub analysis: Analysis,
 }
 
@@ -404,10 +411,39 @@ impl Model {
             "node count of a {}",
             kind.name()
         );
+        let t = self.parts[part].props.thickness.unwrap_or(0.0);
         let b = self.elements.entry(kind).or_default();
         b.id.push(id);
         b.part.push(part);
         b.nodes.extend_from_slice(nodes);
+        if !b.thickness.is_empty() {
+            b.thickness.extend(std::iter::repeat_n(t, nodes.len()));
+        }
+    }
+
+    /// Add a membrane element with a thickness at each of its nodes [m].
+    pub fn add_element_with_thickness(&mut self, id: i64, part: usize, nodes: &[usize], thickness: &[f64]) {
+        assert_eq!(nodes.len(), thickness.len(), "one thickness per node");
+        let kind = self.parts[part].kind;
+        let parts = &self.parts;
+        let b = self.elements.entry(kind).or_default();
+        if b.thickness.is_empty() && !b.is_empty() {
+            // Earlier elements have their part's thickness.
+            let npe = kind.nodes_per_element();
+            b.thickness = b
+                .part
+                .iter()
+                .flat_map(|&p| std::iter::repeat_n(parts[p].props.thickness.unwrap_or(0.0), npe))
+                .collect();
+        }
+        self.add_element(id, part, nodes);
+        let b = self.elements.get_mut(&kind).expect("just added");
+        if b.thickness.is_empty() {
+            b.thickness.extend_from_slice(thickness);
+        } else {
+            let n = b.thickness.len();
+            b.thickness[n - thickness.len()..].copy_from_slice(thickness);
+        }
     }
 
     pub fn block(&self, kind: ElementKind) -> Option<&ElementBlock> {
@@ -676,7 +712,45 @@ impl Model {
                 .expected("a finite position and a tolerance ≥ 0 in m"));
             }
         }
+        self.validate_nodal_thickness()?;
+        contacts::validate(self)?;
         validate_analysis(&self.analysis)
+    }
+
+    /// Nodal thickness: one finite value > 0 per element node, membranes only.
+    fn validate_nodal_thickness(&self) -> Result<()> {
+        for (kind, b) in &self.elements {
+            if b.thickness.is_empty() {
+                continue;
+            }
+            let npe = kind.nodes_per_element();
+            let file = format!("elements_{}.parquet", kind.name());
+            if !matches!(kind, ElementKind::Tri | ElementKind::Quad) || b.thickness.len() != npe * b.len() {
+                return Err(WeftError::input(format!(
+                    "{} elements carry {} nodal thicknesses for {} elements",
+                    kind.name(),
+                    b.thickness.len(),
+                    b.len()
+                ))
+                .in_file(file)
+                .expected("nodal thickness columns t1… on tri and quad tables only, one per element node"));
+            }
+            for (k, &t) in b.thickness.iter().enumerate() {
+                if !(t.is_finite() && t >= 0.0) {
+                    return Err(WeftError::input(format!(
+                        "{} `{}` has nodal thickness `{t}` at its node {}",
+                        kind.name(),
+                        b.id[k / npe],
+                        k % npe + 1
+                    ))
+                    .in_file(file)
+                    .in_column(format!("t{}", k % npe + 1))
+                    .at_row(k / npe)
+                    .expected("a thickness ≥ 0 in m (the element's mean > 0), or null for the part's thickness"));
+                }
+            }
+        }
+        Ok(())
     }
 }
 

@@ -446,7 +446,22 @@ impl<const N: usize> Family for MembraneGroup<N> {
                 p.no_compression.unwrap_or(false),
             )
             .map_err(|err| err.in_file("parts.parquet").in_column("poisson_ratio_12"))?;
-            let s = p.thickness.unwrap();
+            // One-point element: the mean of the nodal thicknesses when they are given.
+            let s = if b.thickness.is_empty() {
+                p.thickness.unwrap()
+            } else {
+                b.thickness[N * e..N * e + N].iter().sum::<f64>() / N as f64
+            };
+            if !(s > 0.0) {
+                return Err(WeftError::input(format!(
+                    "{} `{}` has a mean nodal thickness of {s:e} m",
+                    kind.name(),
+                    b.id[e]
+                ))
+                .in_file(format!("elements_{}.parquet", kind.name()))
+                .at_row(e)
+                .expected("a positive mean thickness (t1…)"));
+            }
             let k_hg = if N == 4 {
                 p.hourglass_coefficient() * mat.e_max() * s * r.area * r.grad2()
             } else {

@@ -137,6 +137,8 @@ pub struct PhaseTimes {
     pub forces: Duration,
     pub update: Duration,
     pub output: Duration,
+    /// Contact search and forces (part of `forces`).
+    pub contact: Duration,
 }
 
 /// What a run did.
@@ -418,8 +420,13 @@ impl Solver {
             analysis: m.analysis.clone(),
             ledger: Ledger::default(),
         };
-        s.set_time_step()?;
+        let kappa = m.contacts.iter().map(|c| contact::PENALTY_FACTOR * c.penalty_scale).fold(0.0, f64::max);
+        s.set_time_step(kappa)?;
         s.op.projectiles.set_step(&s.mass, s.stable.dt);
+        if !m.contacts.is_empty() {
+            s.op.surfaces = contact::SurfaceContact::new(m, &s.mass);
+            s.op.surfaces.start(m)?;
+        }
         s.op.ties.update_slaves(&mut s.state.x, &mut s.state.v, None);
         s.check_slave_velocities(m)?;
         Ok(s)
@@ -447,8 +454,11 @@ impl Solver {
         Ok(())
     }
 
-    /// Mass scaling (when asked), then the step: fixed, target or safety × stable.
-    fn set_time_step(&mut self) -> Result<()> {
+    /// Mass scaling (when asked), then the step: fixed, target or safety × stable. With
+    /// contact of penalty factor κ_c the step is Δt_stable √(s² − κ_c/2) instead of
+    /// s Δt_stable: a node's highest frequency then satisfies ω Δt ≤ 2s with the contact
+    /// springs (k ≤ κ_c m/Δt² on each side of a pair) added to its elements.
+    fn set_time_step(&mut self, kappa: f64) -> Result<()> {
         let a = self.analysis.clone();
         if a.time_step.is_some() && a.target_time_step.is_some() {
             return Err(WeftError::input("both time_step and target_time_step are set")
@@ -462,7 +472,7 @@ impl Solver {
             *im = if *m > 0.0 { 1.0 / m } else { 0.0 };
         }
         let (dt_stable, node) = self.stable_step();
-        if !dt_stable.is_finite() {
+        if !dt_stable.is_finite() && a.time_step.is_none() {
             return Err(WeftError::input("no element limits the time step (the model has no stiffness)")
                 .expected("at least one truss, or a link with stiffness or damping")
                 .hint("set `time_step` in analysis.parquet for a model of free masses"));
@@ -483,8 +493,24 @@ impl Solver {
                 }
                 dt
             }
-            (None, Some(target)) => target.min(a.dt_safety * dt_stable),
-            (None, None) => a.dt_safety * dt_stable,
+            (None, other) => {
+                let s2 = a.dt_safety * a.dt_safety - 0.5 * kappa;
+                if s2 <= 0.0 {
+                    return Err(WeftError::input(format!(
+                        "the contact penalty factor κ_c = {kappa} leaves no stable step with dt_safety {}",
+                        a.dt_safety
+                    ))
+                    .in_file("contacts.parquet")
+                    .in_column("penalty_scale")
+                    .expected(format!("κ_c = 0.1 × penalty_scale < 2 dt_safety² = {}", 2.0 * a.dt_safety * a.dt_safety))
+                    .hint("lower penalty_scale (1 is LS-DYNA's SOFT = 1 default)"));
+                }
+                let safe = if kappa > 0.0 { dt_stable * s2.sqrt() } else { a.dt_safety * dt_stable };
+                match other {
+                    Some(target) => target.min(safe),
+                    None => safe,
+                }
+            }
         };
         self.stable = StableStep { dt, dt_stable, node, element: self.controlling_element(node) };
         Ok(())
@@ -592,8 +618,10 @@ impl Solver {
             self.op.apply_loads(&self.state);
             let t1 = Instant::now();
             self.op.element_forces(&self.state);
+            let t1c = Instant::now();
             self.op.contact_and_ties(&self.state, &self.mass, dt);
             let t2 = Instant::now();
+            times.contact += t2 - t1c;
             times.loads += t1 - t0;
             times.forces += t2 - t1;
             let dt_next = dt;
@@ -643,7 +671,9 @@ impl Solver {
                 for (row, p) in sampler.cur.proj.iter_mut().zip(&self.op.projectiles.projectiles) {
                     row[3..6].copy_from_slice(&p.v_full);
                 }
-                let contact = contact_e + self.op.projectiles.friction_work;
+                let contact = contact_e
+                    + self.op.projectiles.friction_work
+                    + (self.op.surfaces.stored + self.op.surfaces.dissipated);
                 let w_ext = self.op.loads.work + self.op.projectiles.prescribed_work;
                 let e = self.ledger.book(ke, &el_e, contact, w_ext, self.state.step);
                 sampler.cur.t = self.state.t;

@@ -10,7 +10,7 @@
 //! count.
 
 use super::beam::Rotations;
-use super::contact::ProjectileContact;
+use super::contact::{ProjectileContact, SurfaceContact};
 use super::family::ForceCtx;
 use super::ties::Ties;
 use super::vec3::{add, dot};
@@ -117,6 +117,8 @@ pub struct Operator {
     pub el: Families,
     pub ties: Ties,
     pub projectiles: ProjectileContact,
+    /// Node-to-surface contact between parts (`contacts.parquet`).
+    pub surfaces: SurfaceContact,
     pub loads: LoadSet,
     pub gather: Gather,
     /// External forces at t_n [N].
@@ -136,6 +138,7 @@ impl Operator {
             el,
             ties,
             projectiles,
+            surfaces: SurfaceContact::default(),
             loads: LoadSet::new(loads),
             gather,
             fext: vec![[0.0; 3]; nodes],
@@ -147,7 +150,7 @@ impl Operator {
     /// Whether `fcon` can be non-zero.
     #[inline]
     pub fn has_fcon(&self) -> bool {
-        !self.projectiles.is_empty() || !self.ties.is_empty()
+        !self.projectiles.is_empty() || !self.ties.is_empty() || !self.surfaces.is_empty()
     }
 
     /// External loads at t_n (and their work).
@@ -161,7 +164,8 @@ impl Operator {
         self.el.forces(&ctx, &mut self.fe);
     }
 
-    /// Forces beside the elements' and the loads': contact, then the tie transfer of the
+    /// Forces beside the elements' and the loads': contact (projectiles, then surfaces),
+    /// then the tie transfer of the
     /// slaves' forces to their masters (so that contact on a slave reaches its masters).
     pub fn contact_and_ties(&mut self, st: &State, mass: &[f64], dt: f64) {
         if !self.has_fcon() {
@@ -173,6 +177,9 @@ impl Operator {
         self.touched.clear();
         if !self.projectiles.is_empty() {
             self.projectiles.forces(&st.x, &st.v, mass, dt, st.dt_prev, &mut self.fcon, &mut self.touched);
+        }
+        if !self.surfaces.is_empty() {
+            self.surfaces.forces(&st.x, &st.v, dt, st.dt_prev, &mut self.fcon, &mut self.touched);
         }
         let (fext, fe, gather) = (&self.fext, &self.fe, &self.gather);
         self.ties.transfer(

@@ -1,0 +1,640 @@
+//! General contact: slave nodes against master surfaces — membrane faces offset by
+//! ± half their nodal thickness (LS-DYNA's shell contact thickness), or truss and beam
+//! segments with a radius — with penalty forces and Coulomb friction.
+//!
+//! Glossary: s a slave node, x_s its position, t_s its contact thickness; F a master face
+//! (2 nodes: a segment, 3: a triangle, 4: a quad), q = Σ_a w_a x_a the closest point of
+//! its mid-surface to x_s, d = |x_s − q|, n = (x_s − q)/d the normal from the face to the
+//! node, t_F = Σ_a w_a t_a the face thickness at q; g = (t_s + t_F)/2 − d − g₀ the
+//! penetration (g₀: the depth at which a node started inside, see below); m* = min(m_s,
+//! m_F) with m_F the mean nodal mass of the face; κ_c = 0.1 × penalty_scale.
+//!
+//! Phases, after the DESIGN notes §11 and LS-DYNA's contact:
+//! - **broad phase** ([`Grid`]): the faces' bounding boxes, inflated by
+//!   r = t_s,max/2 + t_F,max/2 + skin, in a uniform grid whose cell is the largest
+//!   inflated box (each face in ≤ 8 cells); each slave's candidates are the faces of its
+//!   cell whose box contains it (never a face it belongs to). Rebuilt only when some
+//!   node has moved more than skin/2 since the last build, so a pair that can touch is
+//!   never missed and the cost is amortised (Teschner et al., *Optimized spatial hashing
+//!   for collision detection of deformable objects*, VMV 2003).
+//! - **narrow phase** (pure kernels [`closest_on_face`], [`pair_force`]): per slave, the
+//!   candidate of largest penetration (ties: the first in face order); normal force
+//!   f_n = k g with k = κ_c m*/Δt² (LS-DYNA's SOFT = 1 idea: the contact spring alone has
+//!   ω Δt ≤ √(2κ_c), so it does not cut the step; the step is still reduced by
+//!   √(s² − κ_c/2)/s as a guard, see `Solver::set_time_step`); one geometry evaluation gives the
+//!   force and the stored energy ½ k g².
+//! - **friction**: Coulomb with an elastic stick spring of the normal stiffness k
+//!   (Wriggers, *Computational Contact Mechanics*, §5.2, return mapping): trial
+//!   f_t* = P_t f_t^{old} − k Δu_t with Δu_t the tangential slip increment of the slave
+//!   over the face over the last step; slip when |f_t*| > μ f_n, then f_t = μ f_n f_t*/|f_t*|
+//!   and the dissipated work μ f_n (|f_t*| − μ f_n)/k; μ = μ_d + (μ_s − μ_d) e^{−d_c|v_t|}.
+//!   The stored stick energy |f_t|²/(2k) is part of the contact energy; what is stored
+//!   when a pair opens is dissipated.
+//! - **initial penetration**: a slave inside at t = 0 (g > 0 with g₀ = 0) is recorded with
+//!   its depth g₀ (the force acts only beyond it, and g₀ shrinks as the node leaves), or
+//!   stops the run when the definition says `error`.
+//! - **determinism**: slaves are processed in parallel fixed chunks, each writing only its
+//!   own result slot; the results are scattered onto the nodes serially in slave order,
+//!   so 1 and N threads give bit-identical forces.
+
+use rayon::prelude::*;
+
+use super::PENALTY_FACTOR;
+use crate::error::{Result, WeftError};
+use crate::model::contacts::{InitialPenetration, Slave};
+use crate::model::{ElementKind, Model};
+use crate::solver::vec3::{add, cross, dot, sub};
+
+/// Slaves per parallel chunk of the narrow phase.
+const SLAVE_CHUNK: usize = 512;
+
+/// Closest point of the mid-surface of a face (`n` = 2, 3 or 4 nodes) to `p`: the weights
+/// of its nodes. Quads average the two diagonal splits, so the result has no handedness.
+#[inline]
+pub fn closest_on_face(p: &[f64; 3], x: &[[f64; 3]; 4], n: usize) -> [f64; 4] {
+    match n {
+        2 => {
+            let e = sub(&x[1], &x[0]);
+            let ee = dot(&e, &e);
+            let t = if ee > 0.0 { (dot(&sub(p, &x[0]), &e) / ee).clamp(0.0, 1.0) } else { 0.0 };
+            [1.0 - t, t, 0.0, 0.0]
+        }
+        3 => {
+            let w = super::closest_on_triangle(p, &x[0], &x[1], &x[2]);
+            [w[0], w[1], w[2], 0.0]
+        }
+        _ => {
+            let a = super::closest_on_triangle(p, &x[0], &x[1], &x[2]);
+            let b = super::closest_on_triangle(p, &x[0], &x[2], &x[3]);
+            let c = super::closest_on_triangle(p, &x[1], &x[2], &x[3]);
+            let d = super::closest_on_triangle(p, &x[1], &x[3], &x[0]);
+            // Split 0-2: triangles (0,1,2), (0,2,3); split 1-3: (1,2,3), (1,3,0). Each split
+            // takes its nearer triangle; the two splits are averaged.
+            let q = |w: [f64; 3], i: [usize; 3]| -> ([f64; 4], f64) {
+                let mut ww = [0.0; 4];
+                for k in 0..3 {
+                    ww[i[k]] = w[k];
+                }
+                let qp: [f64; 3] = std::array::from_fn(|dd| (0..4).map(|k| ww[k] * x[k][dd]).sum());
+                let r = sub(p, &qp);
+                (ww, dot(&r, &r))
+            };
+            let (wa, da) = q(a, [0, 1, 2]);
+            let (wb, db) = q(b, [0, 2, 3]);
+            let (wc, dc) = q(c, [1, 2, 3]);
+            let (wd, dd) = q(d, [1, 3, 0]);
+            let s1 = if da <= db { wa } else { wb };
+            let s2 = if dc <= dd { wc } else { wd };
+            std::array::from_fn(|k| 0.5 * (s1[k] + s2[k]))
+        }
+    }
+}
+
+/// What one slave's contact gives at one step.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct PairOut {
+    /// Face index (u32::MAX: no contact).
+    pub face: u32,
+    pub w: [f64; 4],
+    /// Force on the slave [N] (the face nodes get −w_a f).
+    pub f: [f64; 3],
+    /// Stored energy ½ k g² + |f_t|²/(2k) [J].
+    pub stored: f64,
+    /// Friction work dissipated this step [J].
+    pub dissipated: f64,
+}
+
+/// Per-slave history.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct SlaveState {
+    /// Tangential (stick spring) force [N].
+    pub ft: [f64; 3],
+    /// Penalty of the last contact [N/m].
+    pub k: f64,
+    /// Initial penetration still being tracked [m].
+    pub g0: f64,
+}
+
+/// Friction coefficients of a definition.
+#[derive(Debug, Clone, Copy)]
+pub struct Friction {
+    pub mu_s: f64,
+    pub mu_d: f64,
+    pub decay: f64,
+}
+
+/// Normal and friction force of a slave in contact: the return-mapped tangential force
+/// and the pair's output. `g` > 0 the penetration, `n` the normal, `k` the penalty,
+/// `vt` the tangential relative velocity over the last step Δt^{n−½}.
+#[inline]
+pub fn pair_force(g: f64, n: &[f64; 3], k: f64, vt: &[f64; 3], dt_prev: f64, fr: &Friction, st: &mut SlaveState) -> ([f64; 3], f64, f64) {
+    let fnorm = k * g;
+    let mut stored = 0.5 * k * g * g;
+    let mut diss = 0.0;
+    let mut ft = [0.0; 3];
+    if fr.mu_s > 0.0 {
+        // Old tangential force, in the current tangent plane.
+        let o = st.ft;
+        let on = dot(&o, n);
+        let mut trial = [o[0] - on * n[0], o[1] - on * n[1], o[2] - on * n[2]];
+        for d in 0..3 {
+            trial[d] -= k * vt[d] * dt_prev;
+        }
+        let vtm = dot(vt, vt).sqrt();
+        let mu = fr.mu_d + (fr.mu_s - fr.mu_d) * (-fr.decay * vtm).exp();
+        let limit = mu * fnorm;
+        let tm = dot(&trial, &trial).sqrt();
+        if tm > limit {
+            let r = if tm > 0.0 { limit / tm } else { 0.0 };
+            ft = [trial[0] * r, trial[1] * r, trial[2] * r];
+            diss = limit * (tm - limit) / k;
+        } else {
+            ft = trial;
+        }
+        stored += dot(&ft, &ft) / (2.0 * k);
+    }
+    st.ft = ft;
+    st.k = k;
+    ([n[0] * fnorm + ft[0], n[1] * fnorm + ft[1], n[2] * fnorm + ft[2]], stored, diss)
+}
+
+/// A recorded initial penetration.
+#[derive(Debug, Clone)]
+pub struct InitialPen {
+    pub contact_id: i64,
+    pub node: usize,
+    pub element: i64,
+    pub depth: f64,
+}
+
+/// One direction of one contact definition: slaves against a master surface.
+#[derive(Debug, Clone)]
+pub struct Side {
+    pub contact_id: i64,
+    pub row: usize,
+    pub slaves: Vec<u32>,
+    pub slave_t: Vec<f64>,
+    slave_m: Vec<f64>,
+    /// Face nodes (unused entries 0), node count per face (2, 3 or 4).
+    pub faces: Vec<[u32; 4]>,
+    pub nf: usize,
+    face_t: Vec<[f64; 4]>,
+    face_m: Vec<f64>,
+    pub face_id: Vec<i64>,
+    friction: Friction,
+    kappa: f64,
+    on_initial: InitialPenetration,
+    /// Inflation of the face boxes beyond the skin: t_s,max/2 + t_F,max/2 [m].
+    reach: f64,
+    /// Candidates per slave (CSR), from the last broad phase.
+    cand_ptr: Vec<u32>,
+    cand: Vec<u32>,
+    pub state: Vec<SlaveState>,
+    pub out: Vec<PairOut>,
+}
+
+/// Nodal contact thickness from a part's elements (None = all parts): membranes their
+/// nodal thickness, trusses the diameter √(4A/π), beams the section height; the mean over
+/// a node's elements.
+fn nodal_thickness(m: &Model, part: Option<usize>) -> Vec<f64> {
+    let nn = m.num_nodes();
+    let (mut sum, mut cnt) = (vec![0.0; nn], vec![0u32; nn]);
+    for (kind, b) in &m.elements {
+        let npe = kind.nodes_per_element();
+        for e in 0..b.len() {
+            if part.is_some_and(|p| p != b.part[e]) {
+                continue;
+            }
+            let p = &m.parts[b.part[e]].props;
+            for a in 0..npe {
+                let t = match kind {
+                    ElementKind::Tri | ElementKind::Quad => {
+                        if b.thickness.is_empty() { p.thickness.unwrap_or(0.0) } else { b.thickness[npe * e + a] }
+                    }
+                    ElementKind::Truss => (4.0 * p.area.unwrap_or(0.0) / std::f64::consts::PI).sqrt(),
+                    ElementKind::Beam => p.height.unwrap_or(0.0),
+                    _ => continue,
+                };
+                let n = b.nodes[npe * e + a];
+                sum[n] += t;
+                cnt[n] += 1;
+            }
+        }
+    }
+    (0..nn).map(|i| if cnt[i] > 0 { sum[i] / cnt[i] as f64 } else { 0.0 }).collect()
+}
+
+/// The nodes of a part's elements, sorted.
+fn part_nodes(m: &Model, part: usize) -> Vec<u32> {
+    let kind = m.parts[part].kind;
+    let mut v: Vec<u32> = match m.elements.get(&kind) {
+        Some(b) => {
+            let npe = kind.nodes_per_element();
+            (0..b.len()).filter(|&e| b.part[e] == part).flat_map(|e| b.nodes[npe * e..npe * e + npe].iter().map(|&n| n as u32)).collect()
+        }
+        None => vec![],
+    };
+    v.sort_unstable();
+    v.dedup();
+    v
+}
+
+impl Side {
+    fn new(m: &Model, row: usize, slave: &Slave, master: usize, mass: &[f64]) -> Side {
+        let d = &m.contacts[row];
+        let slaves: Vec<u32> = match slave {
+            Slave::Part(p) => part_nodes(m, *p),
+            Slave::Set(s) => {
+                let mut v: Vec<u32> = m.node_sets[s].iter().map(|&n| n as u32).collect();
+                v.sort_unstable();
+                v.dedup();
+                v
+            }
+        };
+        let st = nodal_thickness(m, match slave { Slave::Part(p) => Some(*p), Slave::Set(_) => None });
+        let slave_t: Vec<f64> = slaves.iter().map(|&s| d.slave_thickness.unwrap_or(st[s as usize])).collect();
+        let kind = m.parts[master].kind;
+        let b = &m.elements[&kind];
+        let npe = kind.nodes_per_element();
+        let mt = nodal_thickness(m, Some(master));
+        let (mut faces, mut face_t, mut face_m, mut face_id) = (vec![], vec![], vec![], vec![]);
+        for e in 0..b.len() {
+            if b.part[e] != master {
+                continue;
+            }
+            let mut f = [0u32; 4];
+            let mut t = [0.0; 4];
+            let mut msum = 0.0;
+            for a in 0..npe {
+                let n = b.nodes[npe * e + a];
+                f[a] = n as u32;
+                t[a] = d.master_thickness.unwrap_or(match kind {
+                    ElementKind::Tri | ElementKind::Quad if !b.thickness.is_empty() => b.thickness[npe * e + a],
+                    _ => mt[n],
+                });
+                msum += mass[n];
+            }
+            faces.push(f);
+            face_t.push(t);
+            face_m.push(msum / npe as f64);
+            face_id.push(b.id[e]);
+        }
+        let ts_max = slave_t.iter().cloned().fold(0.0, f64::max);
+        let tf_max = face_t.iter().flatten().cloned().fold(0.0, f64::max);
+        Side {
+            contact_id: d.id,
+            row,
+            slave_m: slaves.iter().map(|&s| mass[s as usize]).collect(),
+            state: vec![SlaveState::default(); slaves.len()],
+            out: vec![PairOut { face: u32::MAX, ..Default::default() }; slaves.len()],
+            slaves,
+            slave_t,
+            faces,
+            nf: npe,
+            face_t,
+            face_m,
+            face_id,
+            friction: Friction { mu_s: d.static_friction, mu_d: d.dynamic_friction, decay: d.friction_decay },
+            kappa: PENALTY_FACTOR * d.penalty_scale,
+            on_initial: d.initial_penetration,
+            reach: 0.5 * (ts_max + tf_max),
+            cand_ptr: vec![],
+            cand: vec![],
+        }
+    }
+
+    /// Mean of the largest extent of the faces [m].
+    fn mean_face_size(&self, x: &[[f64; 3]]) -> f64 {
+        if self.faces.is_empty() {
+            return 0.0;
+        }
+        let mut s = 0.0;
+        for f in &self.faces {
+            let (lo, hi) = bbox(f, self.nf, x);
+            s += (0..3).map(|d| hi[d] - lo[d]).fold(0.0, f64::max);
+        }
+        s / self.faces.len() as f64
+    }
+
+    /// Broad phase: candidates of every slave at the positions `x`.
+    fn build(&mut self, x: &[[f64; 3]], skin: f64) {
+        let r = self.reach + skin;
+        let nf = self.nf;
+        let boxes: Vec<([f64; 3], [f64; 3])> = self
+            .faces
+            .iter()
+            .map(|f| {
+                let (lo, hi) = bbox(f, nf, x);
+                ([lo[0] - r, lo[1] - r, lo[2] - r], [hi[0] + r, hi[1] + r, hi[2] + r])
+            })
+            .collect();
+        let h = boxes.iter().map(|(lo, hi)| (0..3).map(|d| hi[d] - lo[d]).fold(0.0, f64::max)).fold(0.0, f64::max).max(1e-12);
+        let cell = |p: &[f64; 3]| -> [i64; 3] { std::array::from_fn(|d| (p[d] / h).floor() as i64) };
+        let key = |c: [i64; 3]| -> u64 {
+            let m = |v: i64| ((v + (1 << 20)) as u64) & ((1 << 21) - 1);
+            (m(c[0]) << 42) | (m(c[1]) << 21) | m(c[2])
+        };
+        let mut entries: Vec<(u64, u32)> = Vec::with_capacity(8 * boxes.len());
+        for (fi, (lo, hi)) in boxes.iter().enumerate() {
+            let (a, b) = (cell(lo), cell(hi));
+            for i in a[0]..=b[0] {
+                for j in a[1]..=b[1] {
+                    for k in a[2]..=b[2] {
+                        entries.push((key([i, j, k]), fi as u32));
+                    }
+                }
+            }
+        }
+        entries.par_sort_unstable();
+        // Candidates: count, then fill, each in parallel over fixed slave chunks.
+        let faces = &self.faces;
+        let slaves = &self.slaves;
+        let candidates = |si: usize, mut f: &mut dyn FnMut(u32)| {
+            let s = slaves[si];
+            let p = &x[s as usize];
+            let k = key(cell(p));
+            let start = entries.partition_point(|e| e.0 < k);
+            for e in &entries[start..] {
+                if e.0 != k {
+                    break;
+                }
+                let (lo, hi) = &boxes[e.1 as usize];
+                if (0..3).all(|d| p[d] >= lo[d] && p[d] <= hi[d]) && !faces[e.1 as usize][..nf].contains(&s) {
+                    (&mut f)(e.1);
+                }
+            }
+        };
+        let ns = slaves.len();
+        let mut counts = vec![0u32; ns];
+        counts.par_chunks_mut(SLAVE_CHUNK).enumerate().for_each(|(ci, c)| {
+            for (j, cj) in c.iter_mut().enumerate() {
+                candidates(ci * SLAVE_CHUNK + j, &mut |_| *cj += 1);
+            }
+        });
+        let mut ptr = Vec::with_capacity(ns + 1);
+        ptr.push(0u32);
+        for c in &counts {
+            let last = *ptr.last().unwrap();
+            ptr.push(last + c);
+        }
+        let mut cand = vec![0u32; *ptr.last().unwrap() as usize];
+        {
+            // Split the candidate array at the chunk boundaries.
+            let mut parts = Vec::with_capacity(ns.div_ceil(SLAVE_CHUNK));
+            let mut rest: &mut [u32] = &mut cand;
+            for c0 in (0..ns).step_by(SLAVE_CHUNK) {
+                let c1 = (c0 + SLAVE_CHUNK).min(ns);
+                let (a, b) = std::mem::take(&mut rest).split_at_mut((ptr[c1] - ptr[c0]) as usize);
+                parts.push((c0, c1, a));
+                rest = b;
+            }
+            parts.into_par_iter().for_each(|(c0, c1, out)| {
+                let mut k = 0;
+                for si in c0..c1 {
+                    candidates(si, &mut |f| {
+                        out[k] = f;
+                        k += 1;
+                    });
+                }
+            });
+        }
+        self.cand_ptr = ptr;
+        self.cand = cand;
+    }
+
+    /// Narrow phase and friction for every slave, in parallel chunks, into `out`.
+    /// `initial`: report penetrations instead of pushing (setup).
+    fn narrow(&mut self, x: &[[f64; 3]], v: &[[f64; 3]], dt: f64, dt_prev: f64, initial: bool) {
+        let (faces, nf, face_t, face_m) = (&self.faces, self.nf, &self.face_t, &self.face_m);
+        let (slaves, slave_t, slave_m) = (&self.slaves, &self.slave_t, &self.slave_m);
+        let (cand_ptr, cand) = (&self.cand_ptr, &self.cand);
+        let (fr, kappa) = (self.friction, self.kappa);
+        let dt2 = dt * dt;
+        let body = |(ci, (outs, sts)): (usize, (&mut [PairOut], &mut [SlaveState]))| {
+            for (j, (o, st)) in outs.iter_mut().zip(sts.iter_mut()).enumerate() {
+                let si = ci * SLAVE_CHUNK + j;
+                let s = slaves[si] as usize;
+                let p = x[s];
+                // The candidate of largest raw penetration.
+                let mut best: Option<(u32, [f64; 4], f64, [f64; 3])> = None;
+                for &fi in &cand[cand_ptr[si] as usize..cand_ptr[si + 1] as usize] {
+                    let f = &faces[fi as usize];
+                    let xf: [[f64; 3]; 4] = std::array::from_fn(|a| if a < nf { x[f[a] as usize] } else { [0.0; 3] });
+                    let w = closest_on_face(&p, &xf, nf);
+                    let q: [f64; 3] = std::array::from_fn(|d| (0..nf).map(|a| w[a] * xf[a][d]).sum());
+                    let tf: f64 = (0..nf).map(|a| w[a] * face_t[fi as usize][a]).sum();
+                    let r = sub(&p, &q);
+                    let dist = dot(&r, &r).sqrt();
+                    let g = 0.5 * (slave_t[si] + tf) - dist;
+                    if best.as_ref().map_or(true, |b| g > b.2) {
+                        let n = if dist > 0.0 {
+                            [r[0] / dist, r[1] / dist, r[2] / dist]
+                        } else {
+                            let c = cross(&sub(&xf[1], &xf[0]), &sub(&xf[nf - 1], &xf[0]));
+                            let cn = dot(&c, &c).sqrt();
+                            if cn > 0.0 { [c[0] / cn, c[1] / cn, c[2] / cn] } else { [0.0, 0.0, 1.0] }
+                        };
+                        best = Some((fi, w, g, n));
+                    }
+                }
+                let mut out = PairOut { face: u32::MAX, ..Default::default() };
+                let g_raw = best.as_ref().map_or(f64::NEG_INFINITY, |b| b.2);
+                if initial {
+                    st.g0 = g_raw.max(0.0);
+                    if let Some(b) = &best {
+                        out.face = if g_raw > 0.0 { b.0 } else { u32::MAX };
+                    }
+                    *o = out;
+                    continue;
+                }
+                // The tracked initial penetration shrinks as the node leaves.
+                if g_raw < st.g0 {
+                    st.g0 = g_raw.max(0.0);
+                }
+                let g = g_raw - st.g0;
+                match best {
+                    Some((fi, w, _, n)) if g > 0.0 => {
+                        let f = &faces[fi as usize];
+                        let ms = slave_m[si];
+                        let mf = face_m[fi as usize];
+                        let mstar = if ms > 0.0 { ms.min(mf) } else { mf };
+                        let k = kappa * mstar / dt2;
+                        let vf: [f64; 3] = std::array::from_fn(|d| (0..nf).map(|a| w[a] * v[f[a] as usize][d]).sum());
+                        let vr = sub(&v[s], &vf);
+                        let vn = dot(&vr, &n);
+                        let vt = [vr[0] - vn * n[0], vr[1] - vn * n[1], vr[2] - vn * n[2]];
+                        let (force, stored, diss) = pair_force(g, &n, k, &vt, dt_prev, &fr, st);
+                        out = PairOut { face: fi, w, f: force, stored, dissipated: diss };
+                    }
+                    _ => {
+                        // Open: what the stick spring stored is dissipated.
+                        if st.k > 0.0 {
+                            out.dissipated = dot(&st.ft, &st.ft) / (2.0 * st.k);
+                        }
+                        st.ft = [0.0; 3];
+                        st.k = 0.0;
+                    }
+                }
+                *o = out;
+            }
+        };
+        if self.slaves.len() <= SLAVE_CHUNK {
+            self.out.chunks_mut(SLAVE_CHUNK).zip(self.state.chunks_mut(SLAVE_CHUNK)).enumerate().for_each(body);
+        } else {
+            self.out.par_chunks_mut(SLAVE_CHUNK).zip(self.state.par_chunks_mut(SLAVE_CHUNK)).enumerate().for_each(body);
+        }
+    }
+}
+
+fn bbox(f: &[u32; 4], nf: usize, x: &[[f64; 3]]) -> ([f64; 3], [f64; 3]) {
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for &n in &f[..nf] {
+        for d in 0..3 {
+            lo[d] = lo[d].min(x[n as usize][d]);
+            hi[d] = hi[d].max(x[n as usize][d]);
+        }
+    }
+    (lo, hi)
+}
+
+/// Every contact definition of a model, and the broad phase they share.
+#[derive(Debug, Clone, Default)]
+pub struct SurfaceContact {
+    pub sides: Vec<Side>,
+    /// Nodes that take part (slaves and face nodes), sorted.
+    nodes: Vec<u32>,
+    /// Their positions at the last broad phase.
+    x_ref: Vec<[f64; 3]>,
+    /// Skin of the broad phase [m].
+    pub skin: f64,
+    /// Largest κ_c of the definitions (stable-step guard).
+    pub kappa_max: f64,
+    /// Broad-phase builds so far.
+    pub builds: u64,
+    /// Friction work dissipated so far [J].
+    pub dissipated: f64,
+    /// Stored energy at the last force evaluation [J].
+    pub stored: f64,
+    pub initial: Vec<InitialPen>,
+}
+
+impl SurfaceContact {
+    /// The definitions of `m`, sides built with the nodal masses `mass`.
+    pub fn new(m: &Model, mass: &[f64]) -> SurfaceContact {
+        let mut sides = Vec::new();
+        for (row, d) in m.contacts.iter().enumerate() {
+            sides.push(Side::new(m, row, &d.slave, d.master, mass));
+            if d.two_way {
+                if let Slave::Part(p) = d.slave {
+                    sides.push(Side::new(m, row, &Slave::Part(d.master), p, mass));
+                }
+            }
+        }
+        let mut nodes: Vec<u32> = sides.iter().flat_map(|s| s.slaves.iter().copied().chain(s.faces.iter().flat_map(|f| f[..s.nf].to_vec()))).collect();
+        nodes.sort_unstable();
+        nodes.dedup();
+        // Skin: half the mean face size of the finest surface.
+        let skin = sides.iter().map(|s| s.mean_face_size(&m.coords)).filter(|&h| h > 0.0).fold(f64::INFINITY, f64::min);
+        let skin = if skin.is_finite() { 0.5 * skin } else { 0.0 };
+        let kappa_max = sides.iter().map(|s| s.kappa).fold(0.0, f64::max);
+        SurfaceContact { sides, nodes, x_ref: vec![], skin, kappa_max, builds: 0, dissipated: 0.0, stored: 0.0, initial: vec![] }
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.sides.is_empty()
+    }
+
+    /// Broad phase for every side at `x`.
+    fn rebuild(&mut self, x: &[[f64; 3]]) {
+        for s in &mut self.sides {
+            s.build(x, self.skin);
+        }
+        self.x_ref.clear();
+        self.x_ref.extend(self.nodes.iter().map(|&n| x[n as usize]));
+        self.builds += 1;
+    }
+
+    /// Whether some node moved more than skin/2 since the last broad phase.
+    fn stale(&self, x: &[[f64; 3]]) -> bool {
+        let lim = 0.25 * self.skin * self.skin;
+        self.nodes
+            .par_chunks(4096)
+            .zip(self.x_ref.par_chunks(4096))
+            .any(|(ns, xr)| ns.iter().zip(xr).any(|(&n, r)| {
+                let d = sub(&x[n as usize], r);
+                dot(&d, &d) > lim
+            }))
+    }
+
+    /// Setup at the reference positions: the broad phase, and the nodes that start
+    /// inside a surface (recorded, or an error when their definition says so).
+    pub fn start(&mut self, m: &Model) -> Result<()> {
+        self.rebuild(&m.coords);
+        let zero = vec![[0.0; 3]; m.num_nodes()];
+        for s in &mut self.sides {
+            s.narrow(&m.coords, &zero, 1.0, 0.0, true);
+            for (si, o) in s.out.iter().enumerate() {
+                if o.face == u32::MAX {
+                    continue;
+                }
+                let node = s.slaves[si] as usize;
+                let pen = InitialPen { contact_id: s.contact_id, node, element: s.face_id[o.face as usize], depth: s.state[si].g0 };
+                if s.on_initial == InitialPenetration::Error {
+                    let kind = m.parts[m.contacts[s.row].master].kind;
+                    return Err(WeftError::input(format!(
+                        "node `{}` starts {:.3e} m inside the surface of {} `{}` (contact `{}`)",
+                        m.node_id[node],
+                        pen.depth,
+                        kind.name(),
+                        pen.element,
+                        s.contact_id
+                    ))
+                    .in_file("contacts.parquet")
+                    .in_column("initial_penetration")
+                    .at_row(s.row)
+                    .expected("no slave node closer to a face than half their thicknesses at t = 0")
+                    .hint("move the node out, lower the thicknesses, or set initial_penetration to `track`"));
+                }
+                self.initial.push(pen);
+            }
+        }
+        Ok(())
+    }
+
+    /// Contact forces at x^n into `fcon` (nodes touched pushed on `touched`); the stored
+    /// energy and the dissipated work are booked.
+    #[allow(clippy::too_many_arguments)]
+    pub fn forces(&mut self, x: &[[f64; 3]], v: &[[f64; 3]], dt: f64, dt_prev: f64, fcon: &mut [[f64; 3]], touched: &mut Vec<usize>) {
+        if self.stale(x) {
+            self.rebuild(x);
+        }
+        let mut stored = 0.0;
+        for s in &mut self.sides {
+            s.narrow(x, v, dt, dt_prev, false);
+            // Scatter in slave order: bit-identical for any thread count.
+            for (si, o) in s.out.iter().enumerate() {
+                self.dissipated += o.dissipated;
+                if o.face == u32::MAX {
+                    continue;
+                }
+                stored += o.stored;
+                let sl = s.slaves[si] as usize;
+                add(&mut fcon[sl], &o.f);
+                touched.push(sl);
+                let f = &s.faces[o.face as usize];
+                for a in 0..s.nf {
+                    let n = f[a] as usize;
+                    add(&mut fcon[n], &[-o.w[a] * o.f[0], -o.w[a] * o.f[1], -o.w[a] * o.f[2]]);
+                    touched.push(n);
+                }
+            }
+        }
+        self.stored = stored;
+    }
+
+    /// Slaves in contact after the last force evaluation.
+    pub fn active(&self) -> usize {
+        self.sides.iter().map(|s| s.out.iter().filter(|o| o.face != u32::MAX).count()).sum()
+    }
+}
