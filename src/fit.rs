@@ -21,6 +21,8 @@
 //!   sequential, so the result and the trace (ordered by start, then evaluation) do not
 //!   depend on the thread count; only the wall times do.
 
+pub mod stage;
+
 use std::sync::Mutex;
 use std::time::Instant;
 
