@@ -4,4 +4,5 @@
 pub mod grid;
 pub mod rod;
 pub mod square;
+pub mod weave;
 pub mod zones;
