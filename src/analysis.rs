@@ -1,6 +1,9 @@
 //! Measure-and-match analyses on `history.parquet`: wave speeds along a line of nodes
 //! (the paper's §3) and the displacement mismatch T between two models (its eq. 2).
 
+pub mod error;
+pub mod wavespeed;
+
 use std::collections::HashMap;
 use std::path::Path;
 

@@ -70,6 +70,13 @@ pub enum WeftError {
     },
     #[error("Parquet error on `{}`: {message}", .path.display())]
     Parquet { path: PathBuf, message: String },
+    /// An error with what was being done when it happened, displayed as
+    /// `context: error` (as an anyhow context chain prints).
+    #[error("{context}: {error}")]
+    Context {
+        context: String,
+        error: Box<WeftError>,
+    },
 }
 
 fn loc_suffix(at: &Location) -> String {
@@ -101,6 +108,13 @@ impl WeftError {
             at: Location::default(),
             expected: None,
             hint: None,
+        }
+    }
+    /// Say what was being done when the error happened.
+    pub fn context(self, context: impl Into<String>) -> Self {
+        WeftError::Context {
+            context: context.into(),
+            error: Box::new(self),
         }
     }
     pub fn io(path: impl Into<PathBuf>, source: std::io::Error) -> Self {

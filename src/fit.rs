@@ -21,6 +21,8 @@
 //!   sequential, so the result and the trace (ordered by start, then evaluation) do not
 //!   depend on the thread count; only the wall times do.
 
+pub mod stage;
+
 use std::sync::Mutex;
 use std::time::Instant;
 
@@ -29,88 +31,19 @@ use serde::Serialize;
 
 use crate::analysis::{mismatch, Series};
 use crate::error::{Result, WeftError};
-use crate::model::{ElementKind, Model, PartProps};
+use crate::model::{props, Model, PartProps};
 use crate::solver::output::MemorySink;
 use crate::solver::Solver;
 
 /// T scored by an evaluation whose solve failed: above any real T (which lies in [0, 2]).
 pub const FAILED_T: f64 = 4.0;
 
-/// Numeric part properties a fit can set, with the kinds they apply to.
-const PROPERTIES: &[(&str, &[ElementKind])] = &[
-    ("youngs_modulus", &[ElementKind::Truss, ElementKind::Beam]),
-    (
-        "density",
-        &[
-            ElementKind::Truss,
-            ElementKind::Beam,
-            ElementKind::Tri,
-            ElementKind::Quad,
-        ],
-    ),
-    ("area", &[ElementKind::Truss]),
-    ("prestrain", &[ElementKind::Truss]),
-    ("kx", &[ElementKind::Link]),
-    ("ky", &[ElementKind::Link]),
-    ("kz", &[ElementKind::Link]),
-    ("cx", &[ElementKind::Link]),
-    ("cy", &[ElementKind::Link]),
-    ("cz", &[ElementKind::Link]),
-    ("slip_force", &[ElementKind::Link]),
-    ("mass", &[ElementKind::PointMass]),
-    ("youngs_modulus_1", &[ElementKind::Tri, ElementKind::Quad]),
-    ("youngs_modulus_2", &[ElementKind::Tri, ElementKind::Quad]),
-    ("poisson_ratio_12", &[ElementKind::Tri, ElementKind::Quad]),
-    ("shear_modulus_12", &[ElementKind::Tri, ElementKind::Quad]),
-    ("thickness", &[ElementKind::Tri, ElementKind::Quad]),
-    ("hourglass", &[ElementKind::Quad]),
-    ("material_angle", &[ElementKind::Tri, ElementKind::Quad]),
-    ("width", &[ElementKind::Beam]),
-    ("height", &[ElementKind::Beam]),
-    ("poisson_ratio", &[ElementKind::Beam]),
-];
-
-/// Short names researchers write, and the property each stands for.
-const ALIASES: &[(&str, &str)] = &[
-    ("E", "youngs_modulus"),
-    ("rho", "density"),
-    ("A", "area"),
-    ("E1", "youngs_modulus_1"),
-    ("E2", "youngs_modulus_2"),
-    ("nu12", "poisson_ratio_12"),
-    ("G12", "shear_modulus_12"),
-    ("G", "shear_modulus_12"),
-    ("s", "thickness"),
-    ("b", "width"),
-    ("h", "height"),
-];
-
+/// The value slot of a numeric part property (see [`crate::model::props`]).
 fn slot<'a>(p: &'a mut PartProps, name: &str) -> Option<&'a mut Option<f64>> {
-    Some(match name {
-        "youngs_modulus" => &mut p.youngs_modulus,
-        "density" => &mut p.density,
-        "area" => &mut p.area,
-        "prestrain" => &mut p.prestrain,
-        "kx" => &mut p.kx,
-        "ky" => &mut p.ky,
-        "kz" => &mut p.kz,
-        "cx" => &mut p.cx,
-        "cy" => &mut p.cy,
-        "cz" => &mut p.cz,
-        "slip_force" => &mut p.slip_force,
-        "mass" => &mut p.mass,
-        "youngs_modulus_1" => &mut p.youngs_modulus_1,
-        "youngs_modulus_2" => &mut p.youngs_modulus_2,
-        "poisson_ratio_12" => &mut p.poisson_ratio_12,
-        "shear_modulus_12" => &mut p.shear_modulus_12,
-        "thickness" => &mut p.thickness,
-        "hourglass" => &mut p.hourglass,
-        "material_angle" => &mut p.material_angle,
-        "width" => &mut p.width,
-        "height" => &mut p.height,
-        "poisson_ratio" => &mut p.poisson_ratio,
-        _ => return None,
-    })
+    match props::property(name)?.access {
+        props::Access::F64 { slot, .. } => Some(slot(p)),
+        props::Access::Bool { .. } => None,
+    }
 }
 
 /// One part property a parameter sets: value × factor.
@@ -213,11 +146,7 @@ pub fn parse_param(spec: &str, m: &Model) -> Result<Parameter> {
         let (part, prop) = name
             .split_once('.')
             .ok_or_else(|| bad_param(spec, format!("`{name}` is not of the form PART.PROPERTY")))?;
-        let prop = ALIASES
-            .iter()
-            .find(|a| a.0 == prop)
-            .map(|a| a.1)
-            .unwrap_or(prop);
+        let prop = props::resolve_alias(prop);
         let pi = m.parts.iter().position(|p| p.name == part).ok_or_else(|| {
             bad_param(spec, format!("the model has no part named `{part}`")).hint(format!(
                 "parts: {}",
@@ -229,11 +158,7 @@ pub fn parse_param(spec: &str, m: &Model) -> Result<Parameter> {
             ))
         })?;
         let kind = m.parts[pi].kind;
-        let applies: Vec<&str> = PROPERTIES
-            .iter()
-            .filter(|(_, ks)| ks.contains(&kind))
-            .map(|(n, _)| *n)
-            .collect();
+        let applies: Vec<&str> = props::fittable(kind).map(|p| p.name).collect();
         if !applies.contains(&prop) {
             return Err(bad_param(
                 spec,

@@ -4,9 +4,11 @@
 //! Layout: [`model`] (the model and its folder of tables), [`solver`] (explicit central
 //! difference, element kernels, output sinks), [`simulate`] (the stage behind
 //! `weft-simulate`), [`generate`] (canonical models behind `weft-weave`), [`table`]
-//! (validated Parquet I/O with provenance), [`error`] (typed errors).
+//! (validated Parquet I/O with provenance), [`error`] (typed errors), [`cli`] (what the
+//! stage binaries share: `main`, error printing, progress).
 
 pub mod analysis;
+pub mod cli;
 pub mod error;
 pub mod fit;
 pub mod generate;

@@ -3,12 +3,10 @@
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use anyhow::Context;
 use clap::Parser;
-use weft::analysis::{components, mismatch, read_series};
-use weft::table::{batch, write_table, Col, Provenance};
+use weft::analysis::error;
 
-#[derive(Parser, serde::Serialize)]
+#[derive(Parser)]
 #[command(
     name = "weft-error",
     version,
@@ -53,69 +51,30 @@ struct Cli {
 }
 
 fn main() -> ExitCode {
-    match run() {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("error: {e:#}");
-            ExitCode::FAILURE
-        }
-    }
+    weft::cli::main(run)
 }
 
-fn run() -> anyhow::Result<()> {
+fn run() -> anyhow::Result<ExitCode> {
     let cli = Cli::parse();
-    let comps = components(&cli.components)?;
-    let q =
-        read_series(&cli.reference_model, &cli.reference_history, &cli.set).context("reference")?;
-    let p = read_series(
-        &cli.model,
-        &cli.history,
-        cli.candidate_set.as_deref().unwrap_or(&cli.set),
-    )
-    .context("candidate")?;
-    let r = mismatch(&q, &p, &comps, cli.tolerance, cli.static_mode)?;
-    let prov = Provenance::new("error", serde_json::to_value(&cli)?)
-        .with_input(&cli.reference_history)?
-        .with_input(&cli.history)?;
-    write_table(
-        &cli.out_dir.join("error.parquet"),
-        &batch(vec![
-            Col::I64("node_id", r.per_node.iter().map(|x| x.0).collect()),
-            Col::F64("x", q.x0.iter().map(|x| x[0]).collect()),
-            Col::F64("y", q.x0.iter().map(|x| x[1]).collect()),
-            Col::F64("z", q.x0.iter().map(|x| x[2]).collect()),
-            Col::I64(
-                "candidate_node_id",
-                r.per_node.iter().map(|x| x.1).collect(),
-            ),
-            Col::OptF64(
-                "peak_relative_error",
-                r.per_node
-                    .iter()
-                    .map(|x| x.2.is_finite().then_some(x.2))
-                    .collect(),
-            ),
-        ]),
-        &prov,
-    )?;
-    write_table(
-        &cli.out_dir.join("error_summary.parquet"),
-        &batch(vec![
-            Col::F64("T", vec![r.t_value]),
-            Col::F64("max_peak_relative_error", vec![r.max_peak_relative_error]),
-            Col::I64("nodes", vec![r.per_node.len() as i64]),
-            Col::I64("samples", vec![r.samples as i64]),
-            Col::Str("components", vec![cli.components.clone()]),
-            Col::Bool("static", vec![cli.static_mode]),
-        ]),
-        &prov,
-    )?;
+    let r = error::run(&error::Config {
+        reference_model: cli.reference_model,
+        reference_history: cli.reference_history,
+        model: cli.model,
+        history: cli.history,
+        set: cli.set,
+        candidate_set: cli.candidate_set,
+        components: cli.components,
+        tolerance: cli.tolerance,
+        static_mode: cli.static_mode,
+        out_dir: cli.out_dir,
+    })?;
+    let m = &r.mismatch;
     eprintln!(
         "weft-error: T = {:.6e} over {} nodes and {} samples; max peak relative error {:.3e}",
-        r.t_value,
-        r.per_node.len(),
-        r.samples,
-        r.max_peak_relative_error
+        m.t_value,
+        m.per_node.len(),
+        m.samples,
+        m.max_peak_relative_error
     );
-    Ok(())
+    Ok(ExitCode::SUCCESS)
 }

@@ -5,8 +5,7 @@ use std::process::ExitCode;
 
 use anyhow::Context;
 use clap::Parser;
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-
+use weft::cli::Progress;
 use weft::simulate::{run, Config};
 
 #[derive(Parser)]
@@ -65,16 +64,10 @@ struct Cli {
 }
 
 fn main() -> ExitCode {
-    match main_inner() {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("error: {e:#}");
-            ExitCode::FAILURE
-        }
-    }
+    weft::cli::main(run_cli)
 }
 
-fn main_inner() -> anyhow::Result<()> {
+fn run_cli() -> anyhow::Result<ExitCode> {
     let cli = Cli::parse();
     let cfg = Config {
         model: cli.model.clone(),
@@ -90,32 +83,13 @@ fn main_inner() -> anyhow::Result<()> {
         max_energy_error: cli.max_energy_error,
         static_solve: cli.static_solve,
     };
-    // Under `weft run`, report progress as `weft-progress <fraction>` lines on stderr.
-    let protocol = std::env::var_os("WEFT_PROGRESS").is_some();
-    let bar = if cli.quiet || protocol {
-        ProgressBar::hidden()
-    } else {
-        let b = ProgressBar::with_draw_target(Some(1000), ProgressDrawTarget::stderr());
-        b.set_style(
-            ProgressStyle::with_template(
-                "{spinner} simulate [{bar:40}] {percent:>3}% {elapsed_precise} eta {eta}",
-            )
-            .expect("valid template"),
-        );
-        b
-    };
-    let mut last = -1.0;
-    let res = run(&cfg, &mut |f| {
-        if protocol {
-            if f - last >= 0.01 || f >= 1.0 {
-                eprintln!("weft-progress {f:.4}");
-                last = f;
-            }
-        } else {
-            bar.set_position((f * 1000.0) as u64)
-        }
-    });
-    bar.finish_and_clear();
+    let progress = Progress::new(
+        cli.quiet,
+        1000,
+        "{spinner} simulate [{bar:40}] {percent:>3}% {elapsed_precise} eta {eta}",
+    );
+    let res = run(&cfg, &mut progress.fraction());
+    progress.finish();
     let r = res.with_context(|| {
         format!(
             "simulate `{}` failed; no new tables were written to `{}`",
@@ -125,7 +99,7 @@ fn main_inner() -> anyhow::Result<()> {
     })?;
     if cli.static_solve {
         eprintln!("  wrote {}/{{history,summary}}.parquet", r.out.display());
-        return Ok(());
+        return Ok(ExitCode::SUCCESS);
     }
     let s = &r.stats;
     eprintln!(
@@ -152,5 +126,5 @@ fn main_inner() -> anyhow::Result<()> {
         "  wrote {}/{{history,energy,summary}}.parquet",
         r.out.display()
     );
-    Ok(())
+    Ok(ExitCode::SUCCESS)
 }

@@ -3,12 +3,10 @@
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use anyhow::Context;
 use clap::Parser;
-use weft::analysis::{components, read_series, wave_speeds, Level};
-use weft::table::{batch, write_table, Col, Provenance};
+use weft::analysis::wavespeed;
 
-#[derive(Parser, serde::Serialize)]
+#[derive(Parser)]
 #[command(
     name = "weft-wavespeed",
     version,
@@ -45,51 +43,26 @@ struct Cli {
 }
 
 fn main() -> ExitCode {
-    match run() {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("error: {e:#}");
-            ExitCode::FAILURE
-        }
-    }
+    weft::cli::main(run)
 }
 
-fn run() -> anyhow::Result<()> {
+fn run() -> anyhow::Result<ExitCode> {
     let cli = Cli::parse();
-    let comp = components(&cli.component)?;
-    anyhow::ensure!(
-        comp.len() == 1,
-        "--component takes one component, got `{}`",
-        cli.component
-    );
-    let level = match cli.level {
-        Some(a) => Level::Absolute(a),
-        None => Level::Relative(cli.relative_level),
-    };
-    let s = read_series(&cli.model, &cli.history, &cli.set)
-        .context("cannot read the node set's history")?;
-    let w = wave_speeds(&s, comp[0], level);
-    let reached = w.arrival.iter().filter(|a| a.is_some()).count();
-    let prov =
-        Provenance::new("wavespeed", serde_json::to_value(&cli)?).with_input(&cli.history)?;
-    write_table(
-        &cli.out,
-        &batch(vec![
-            Col::I64("node_id", w.node_id.clone()),
-            Col::I64("order", (0..w.node_id.len() as i64).collect()),
-            Col::F64("position", w.position.clone()),
-            Col::Bool("reached", w.arrival.iter().map(|a| a.is_some()).collect()),
-            Col::OptF64("arrival_time", w.arrival.clone()),
-            Col::OptF64("segment_speed", w.segment_speed.clone()),
-            Col::OptF64("node_speed", w.node_speed.clone()),
-        ]),
-        &prov,
-    )?;
+    let r = wavespeed::run(&wavespeed::Config {
+        model: cli.model,
+        history: cli.history,
+        set: cli.set,
+        component: cli.component,
+        relative_level: cli.relative_level,
+        level: cli.level,
+        out: cli.out.clone(),
+    })?;
+    let n = r.speeds.node_id.len();
     eprintln!(
-        "weft-wavespeed: {} nodes, {reached} reached, {} never -> {}",
-        w.node_id.len(),
-        w.node_id.len() - reached,
+        "weft-wavespeed: {n} nodes, {} reached, {} never -> {}",
+        r.reached,
+        n - r.reached,
         cli.out.display()
     );
-    Ok(())
+    Ok(ExitCode::SUCCESS)
 }

@@ -3,17 +3,13 @@
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use anyhow::Context;
 use clap::{Parser, Subcommand};
 
-use weft::generate::rod::{build, RodParams};
-use weft::generate::square::{girder, membrane, GirderParams, LoadCase, MembraneParams, Square};
-use weft::generate::zones::{
-    combined, woven_reduced, Centre, CombinedParams, MembraneProps, WovenParams,
-};
-use weft::model::io::write_model;
+use weft::generate::rod::RodParams;
+use weft::generate::square::{GirderParams, LoadCase, MembraneParams, Square};
+use weft::generate::weave::{self, Spec};
+use weft::generate::zones::{Centre, CombinedParams, MembraneProps, WovenParams};
 use weft::model::ProjectileShape;
-use weft::table::Provenance;
 
 #[derive(Parser)]
 #[command(
@@ -329,29 +325,13 @@ struct RodArgs {
     tension_only: bool,
 }
 
-/// Write a model folder with its provenance (the stage and its parameters).
-fn save<P: serde::Serialize>(
-    m: &weft::model::Model,
-    out: &std::path::Path,
-    stage: &str,
-    p: &P,
-) -> anyhow::Result<()> {
-    let prov = Provenance::new(stage, serde_json::to_value(p)?);
-    write_model(m, out, &prov).with_context(|| format!("cannot write model `{}`", out.display()))
-}
-
 fn main() -> ExitCode {
-    match run() {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("error: {e:#}");
-            ExitCode::FAILURE
-        }
-    }
+    weft::cli::main(run)
 }
 
-fn run() -> anyhow::Result<()> {
+fn run() -> anyhow::Result<ExitCode> {
     let cli = Cli::parse();
+    let mut warn = |w: &str| eprintln!("warning: {w}");
     match cli.model {
         Model::Girder(a) => {
             let p = GirderParams {
@@ -364,11 +344,7 @@ fn run() -> anyhow::Result<()> {
                 full_edge_rods: a.full_edge_rods,
                 clamp_rotations: a.clamp == Clamp::BuiltIn,
             };
-            let (m, warnings) = girder(&p).context("cannot build the girder")?;
-            for w in warnings {
-                eprintln!("warning: {w}");
-            }
-            save(&m, &a.square.out, "weave girder", &p)?;
+            let m = weave::run(&Spec::Girder(p.clone()), &a.square.out, &mut warn)?;
             eprintln!(
                 "weft-weave girder: {} nodes, {} {} rods, b = {:.3e} m, h = {:.3e} m -> {}",
                 m.num_nodes(),
@@ -411,8 +387,7 @@ fn run() -> anyhow::Result<()> {
                 end_time: end,
                 output_interval: a.output_interval.unwrap_or(end / 100.0),
             };
-            let m = combined(&p).context("cannot build the combined model")?;
-            save(&m, &a.out, "weave combined", &p)?;
+            let m = weave::run(&Spec::Combined(p.clone()), &a.out, &mut warn)?;
             eprintln!(
                 "weft-weave combined: {} nodes, {} elements, {} ties -> {}",
                 m.num_nodes(),
@@ -448,8 +423,7 @@ fn run() -> anyhow::Result<()> {
                 output_interval: a.output_interval,
                 ..d
             };
-            let m = woven_reduced(&p).context("cannot build the reduced woven model")?;
-            save(&m, &a.out, "weave woven-reduced", &p)?;
+            let m = weave::run(&Spec::WovenReduced(p.clone()), &a.out, &mut warn)?;
             eprintln!(
                 "weft-weave woven-reduced: {} nodes, {} elements, {} ties -> {}",
                 m.num_nodes(),
@@ -468,8 +442,7 @@ fn run() -> anyhow::Result<()> {
                 density: a.density.unwrap_or(d.density),
                 ..d
             };
-            let m = membrane(&p).context("cannot build the membrane")?;
-            save(&m, &a.square.out, "weave membrane", &p)?;
+            let m = weave::run(&Spec::Membrane(p.clone()), &a.square.out, &mut warn)?;
             eprintln!(
                 "weft-weave membrane: {} nodes, {} quads, s = {:.3e} m, ρ = {:.1} kg/m³, G = {:.3e} Pa -> {}",
                 m.num_nodes(),
@@ -494,8 +467,7 @@ fn run() -> anyhow::Result<()> {
                 output_interval: a.output_interval,
                 tension_only: a.tension_only,
             };
-            let m = build(&p).context("cannot build the rod model")?;
-            save(&m, &a.out, "weave rod", &p)?;
+            let m = weave::run(&Spec::Rod(p.clone()), &a.out, &mut warn)?;
             eprintln!(
                 "weft-weave rod: {} nodes, {} trusses, c = {:.1} m/s, T_F = {:.3e} s -> {}",
                 m.num_nodes(),
@@ -506,5 +478,5 @@ fn run() -> anyhow::Result<()> {
             );
         }
     }
-    Ok(())
+    Ok(ExitCode::SUCCESS)
 }

@@ -97,13 +97,7 @@ enum DagFormat {
 }
 
 fn main() -> ExitCode {
-    match main_inner() {
-        Ok(code) => code,
-        Err(e) => {
-            eprintln!("error: {e:#}");
-            ExitCode::FAILURE
-        }
-    }
+    weft::cli::main(main_inner)
 }
 
 fn find_pipeline(p: Option<PathBuf>) -> anyhow::Result<PathBuf> {

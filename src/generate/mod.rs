@@ -5,4 +5,5 @@ pub mod grid;
 pub mod layers;
 pub mod rod;
 pub mod square;
+pub mod weave;
 pub mod zones;

@@ -112,28 +112,7 @@ fn read_model_inner(dir: &Path) -> Result<Model> {
     let ids = t.i64("part_id", PARTS)?;
     let names = t.str("name", PARTS)?;
     let kinds = t.str("kind", PARTS)?;
-    let f = |c: &str| -> Result<Vec<Option<f64>>> {
-        Ok(t.f64_opt(c)?.unwrap_or_else(|| vec![None; ids.len()]))
-    };
-    let (e, rho, area) = (f("youngs_modulus")?, f("density")?, f("area")?);
-    let (kx, ky, kz) = (f("kx")?, f("ky")?, f("kz")?);
-    let (cx, cy, cz) = (f("cx")?, f("cy")?, f("cz")?);
-    let (slip, mass) = (f("slip_force")?, f("mass")?);
-    let (e1, e2, nu12, g12) = (
-        f("youngs_modulus_1")?,
-        f("youngs_modulus_2")?,
-        f("poisson_ratio_12")?,
-        f("shear_modulus_12")?,
-    );
-    let (thick, hg, angle) = (f("thickness")?, f("hourglass")?, f("material_angle")?);
-    let (width, height, nu) = (f("width")?, f("height")?, f("poisson_ratio")?);
-    let prestrain = f("prestrain")?;
-    let no_comp = t
-        .bool_opt("no_compression")?
-        .unwrap_or_else(|| vec![None; ids.len()]);
-    let tension_only = t
-        .bool_opt("tension_only")?
-        .unwrap_or_else(|| vec![None; ids.len()]);
+    let mut part_props = props::read_columns(&t, ids.len())?.into_iter();
     for row in 0..ids.len() {
         let kind = ElementKind::parse(&kinds[row]).ok_or_else(|| {
             t.value_error(
@@ -152,32 +131,7 @@ fn read_model_inner(dir: &Path) -> Result<Model> {
             id: ids[row],
             name: names[row].clone(),
             kind,
-            props: PartProps {
-                youngs_modulus: e[row],
-                density: rho[row],
-                area: area[row],
-                tension_only: tension_only[row],
-                kx: kx[row],
-                ky: ky[row],
-                kz: kz[row],
-                cx: cx[row],
-                cy: cy[row],
-                cz: cz[row],
-                slip_force: slip[row],
-                mass: mass[row],
-                youngs_modulus_1: e1[row],
-                youngs_modulus_2: e2[row],
-                poisson_ratio_12: nu12[row],
-                shear_modulus_12: g12[row],
-                thickness: thick[row],
-                no_compression: no_comp[row],
-                hourglass: hg[row],
-                material_angle: angle[row],
-                width: width[row],
-                height: height[row],
-                poisson_ratio: nu[row],
-                prestrain: prestrain[row],
-            },
+            props: part_props.next().expect("one per row"),
         };
         validate_part(&part).map_err(|err| err.in_file(&t.path).at_row(row))?;
         m.parts.push(part);
@@ -612,49 +566,16 @@ fn write_tables(m: &Model, dir: &Path, prov: &Provenance) -> Result<()> {
         prov,
     )?;
     let p = &m.parts;
-    let pc = |f: fn(&PartProps) -> Option<f64>| p.iter().map(|x| f(&x.props)).collect::<Vec<_>>();
-    write_table(
-        &dir.join("parts.parquet"),
-        &batch(vec![
-            Col::I64("part_id", p.iter().map(|x| x.id).collect()),
-            Col::Str("name", p.iter().map(|x| x.name.clone()).collect()),
-            Col::Str(
-                "kind",
-                p.iter().map(|x| x.kind.name().to_string()).collect(),
-            ),
-            Col::OptF64("youngs_modulus", pc(|q| q.youngs_modulus)),
-            Col::OptF64("density", pc(|q| q.density)),
-            Col::OptF64("area", pc(|q| q.area)),
-            Col::OptBool(
-                "tension_only",
-                p.iter().map(|x| x.props.tension_only).collect(),
-            ),
-            Col::OptF64("kx", pc(|q| q.kx)),
-            Col::OptF64("ky", pc(|q| q.ky)),
-            Col::OptF64("kz", pc(|q| q.kz)),
-            Col::OptF64("cx", pc(|q| q.cx)),
-            Col::OptF64("cy", pc(|q| q.cy)),
-            Col::OptF64("cz", pc(|q| q.cz)),
-            Col::OptF64("slip_force", pc(|q| q.slip_force)),
-            Col::OptF64("mass", pc(|q| q.mass)),
-            Col::OptF64("youngs_modulus_1", pc(|q| q.youngs_modulus_1)),
-            Col::OptF64("youngs_modulus_2", pc(|q| q.youngs_modulus_2)),
-            Col::OptF64("poisson_ratio_12", pc(|q| q.poisson_ratio_12)),
-            Col::OptF64("shear_modulus_12", pc(|q| q.shear_modulus_12)),
-            Col::OptF64("thickness", pc(|q| q.thickness)),
-            Col::OptBool(
-                "no_compression",
-                p.iter().map(|x| x.props.no_compression).collect(),
-            ),
-            Col::OptF64("hourglass", pc(|q| q.hourglass)),
-            Col::OptF64("material_angle", pc(|q| q.material_angle)),
-            Col::OptF64("width", pc(|q| q.width)),
-            Col::OptF64("height", pc(|q| q.height)),
-            Col::OptF64("poisson_ratio", pc(|q| q.poisson_ratio)),
-            Col::OptF64("prestrain", pc(|q| q.prestrain)),
-        ]),
-        prov,
-    )?;
+    let mut cols = vec![
+        Col::I64("part_id", p.iter().map(|x| x.id).collect()),
+        Col::Str("name", p.iter().map(|x| x.name.clone()).collect()),
+        Col::Str(
+            "kind",
+            p.iter().map(|x| x.kind.name().to_string()).collect(),
+        ),
+    ];
+    cols.extend(props::columns(p.iter().map(|x| &x.props)));
+    write_table(&dir.join("parts.parquet"), &batch(cols), prov)?;
     for (kind, b) in &m.elements {
         if b.is_empty() {
             continue;

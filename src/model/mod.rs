@@ -8,6 +8,9 @@
 
 pub mod contacts;
 pub mod io;
+pub mod props;
+
+pub use props::PartProps;
 
 use std::collections::{BTreeMap, HashMap};
 use std::sync::Arc;
@@ -62,63 +65,6 @@ impl ElementKind {
     }
     pub fn parse(s: &str) -> Option<Self> {
         Self::ALL.into_iter().find(|k| k.name() == s)
-    }
-}
-
-/// Part properties. Which ones apply depends on the part's element kind (see
-/// `docs/tables.md`); the others stay `None`.
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct PartProps {
-    /// Young's modulus E [Pa] (truss).
-    pub youngs_modulus: Option<f64>,
-    /// Mass density ρ [kg/m³] (truss).
-    pub density: Option<f64>,
-    /// Cross-section area A [m²] (truss).
-    pub area: Option<f64>,
-    /// Truss carries no compression when true.
-    pub tension_only: Option<bool>,
-    /// Truss initial strain ε₀ (pretension): the reference length is the geometric length
-    /// over (1 + ε₀), so the truss starts with the force E·A·ε₀. Null = 0.
-    pub prestrain: Option<f64>,
-    /// Link spring stiffnesses along global x, y, z [N/m].
-    pub kx: Option<f64>,
-    pub ky: Option<f64>,
-    pub kz: Option<f64>,
-    /// Link dashpot coefficients along global x, y, z [N·s/m].
-    pub cx: Option<f64>,
-    pub cy: Option<f64>,
-    pub cz: Option<f64>,
-    /// Link friction slider: tangential (x–y) force limit [N]; `None` = no slider.
-    pub slip_force: Option<f64>,
-    /// Point mass [kg].
-    pub mass: Option<f64>,
-    /// Membrane: Young's moduli along material directions 1 and 2 [Pa].
-    pub youngs_modulus_1: Option<f64>,
-    pub youngs_modulus_2: Option<f64>,
-    /// Membrane: Poisson's ratio ν₁₂ (null = 0).
-    pub poisson_ratio_12: Option<f64>,
-    /// Membrane: in-plane shear modulus G₁₂ [Pa].
-    pub shear_modulus_12: Option<f64>,
-    /// Membrane thickness s [m].
-    pub thickness: Option<f64>,
-    /// Membrane carries no compressive stress when true.
-    pub no_compression: Option<bool>,
-    /// Quad hourglass coefficient κ (null = 0.1).
-    pub hourglass: Option<f64>,
-    /// Angle of material direction 1 from the projected global x, about the normal [rad].
-    pub material_angle: Option<f64>,
-    /// Beam section width b (in the plane of the girder) [m].
-    pub width: Option<f64>,
-    /// Beam section height h (out of the plane) [m].
-    pub height: Option<f64>,
-    /// Beam Poisson's ratio for G = E/(2(1+ν)) (null = 0.3).
-    pub poisson_ratio: Option<f64>,
-}
-
-impl PartProps {
-    /// Hourglass coefficient κ; 0.1, LS-DYNA's default, when not given.
-    pub fn hourglass_coefficient(&self) -> f64 {
-        self.hourglass.unwrap_or(0.1)
     }
 }
 
@@ -754,6 +700,8 @@ impl Model {
     }
 }
 
+/// A value > 0 that one property needs because of another (a friction slider's
+/// tangential stiffness).
 fn require_pos(p: &Part, col: &str, v: Option<f64>, unit: &str) -> Result<()> {
     match v {
         Some(x) if x > 0.0 && x.is_finite() => Ok(()),
@@ -775,81 +723,27 @@ fn require_pos(p: &Part, col: &str, v: Option<f64>, unit: &str) -> Result<()> {
     }
 }
 
-fn require_nonneg(p: &Part, col: &str, v: Option<f64>, unit: &str) -> Result<()> {
-    match v {
-        Some(x) if x < 0.0 || !x.is_finite() => Err(WeftError::input(format!(
-            "part `{}` ({}) has {col} = `{x}`",
-            p.name,
-            p.kind.name()
-        ))
-        .in_column(col)
-        .expected(format!("a value ≥ 0 {unit}, or null for 0"))),
-        _ => Ok(()),
-    }
-}
-
-/// Check the properties a part's kind needs.
+/// Check the properties a part's kind needs: each against its rule in
+/// [`props::PROPERTIES`], in table order, then the checks that involve two properties.
 pub fn validate_part(p: &Part) -> Result<()> {
+    for prop in props::PROPERTIES {
+        prop.check(p)?;
+    }
     let q = &p.props;
     match p.kind {
-        ElementKind::Truss => {
-            require_pos(p, "youngs_modulus", q.youngs_modulus, "in Pa")?;
-            require_pos(p, "density", q.density, "in kg/m³")?;
-            require_pos(p, "area", q.area, "in m²")?;
-            if let Some(e0) = q.prestrain {
-                if !(e0 > -0.5 && e0 < 0.5) {
-                    return Err(WeftError::input(format!(
-                        "part `{}` has prestrain = `{e0}`",
-                        p.name
-                    ))
-                    .in_column("prestrain")
-                    .expected("a small strain, −0.5 < ε₀ < 0.5"));
-                }
-            }
-        }
-        ElementKind::Link => {
-            for (c, v) in [("kx", q.kx), ("ky", q.ky), ("kz", q.kz)] {
-                require_nonneg(p, c, v, "in N/m")?;
-            }
-            for (c, v) in [("cx", q.cx), ("cy", q.cy), ("cz", q.cz)] {
-                require_nonneg(p, c, v, "in N·s/m")?;
-            }
-            if q.slip_force.is_some() {
-                require_pos(p, "slip_force", q.slip_force, "in N")?;
-                for (c, v) in [("kx", q.kx), ("ky", q.ky)] {
-                    require_pos(
-                        p,
-                        c,
-                        v,
-                        "in N/m (a friction slider needs tangential stiffness)",
-                    )?;
-                }
-            }
-        }
-        ElementKind::PointMass => require_pos(p, "mass", q.mass, "in kg")?,
-        ElementKind::Beam => {
-            require_pos(p, "youngs_modulus", q.youngs_modulus, "in Pa")?;
-            require_pos(p, "density", q.density, "in kg/m³")?;
-            require_pos(p, "width", q.width, "in m")?;
-            require_pos(p, "height", q.height, "in m")?;
-            let nu = q.poisson_ratio.unwrap_or(0.3);
-            if !(nu > -1.0 && nu < 0.5) {
-                return Err(WeftError::input(format!(
-                    "part `{}` has poisson_ratio = `{nu}`",
-                    p.name
-                ))
-                .in_column("poisson_ratio")
-                .expected("−1 < ν < 0.5"));
+        ElementKind::Link if q.slip_force.is_some() => {
+            for (c, v) in [("kx", q.kx), ("ky", q.ky)] {
+                require_pos(
+                    p,
+                    c,
+                    v,
+                    "in N/m (a friction slider needs tangential stiffness)",
+                )?;
             }
         }
         ElementKind::Tri | ElementKind::Quad => {
-            require_pos(p, "youngs_modulus_1", q.youngs_modulus_1, "in Pa")?;
-            require_pos(p, "youngs_modulus_2", q.youngs_modulus_2, "in Pa")?;
-            require_pos(p, "shear_modulus_12", q.shear_modulus_12, "in Pa")?;
-            require_pos(p, "thickness", q.thickness, "in m")?;
-            require_pos(p, "density", q.density, "in kg/m³")?;
-            require_nonneg(p, "hourglass", q.hourglass, "")?;
             let nu = q.poisson_ratio_12.unwrap_or(0.0);
+            // Both moduli are required, hence checked > 0 above.
             let (e1, e2) = (q.youngs_modulus_1.unwrap(), q.youngs_modulus_2.unwrap());
             if !(nu.is_finite() && nu * nu * e2 / e1 < 1.0 && nu > -1.0) {
                 return Err(WeftError::input(format!(
@@ -862,15 +756,8 @@ pub fn validate_part(p: &Part) -> Result<()> {
                     e2 / e1
                 )));
             }
-            if q.material_angle.is_some_and(|a| !a.is_finite()) {
-                return Err(WeftError::input(format!(
-                    "part `{}` has a non-finite material_angle",
-                    p.name
-                ))
-                .in_column("material_angle")
-                .expected("an angle in rad"));
-            }
         }
+        _ => {}
     }
     Ok(())
 }

@@ -1,0 +1,388 @@
+//! The `fit` stage behind `weft-fit`: read the cases, parse the parameters, minimise T,
+//! and write `fit_trace.parquet`, `fit_result.parquet` and the fitted models.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use arrow_array::RecordBatch;
+use serde::Serialize;
+
+use super::{fit, parse_param, Case, Evaluation, FitResult, Method, Objective, Options, Problem};
+use crate::analysis::{components, read_series, Level};
+use crate::error::{Result, WeftError};
+use crate::model::io::{read_model, write_model};
+use crate::table::{batch, write_table, Col, Provenance};
+
+/// What a fit matches (`--objective`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum ObjectiveKind {
+    // No doc comments here: clap would print them in `weft-fit --help`'s value list.
+    // The paper's T over the compared components.
+    Displacement,
+    // Wave arrival times along the ordered node set.
+    Arrival,
+}
+
+/// Settings of one fit, as `weft-fit`'s flags give them (and as its tables' provenance
+/// records them). Cases are given by `reference_model`, `reference_history` and `model`
+/// in the same order.
+#[derive(Debug, Clone, Serialize)]
+pub struct Config {
+    pub reference_model: Vec<PathBuf>,
+    pub reference_history: Vec<PathBuf>,
+    pub model: Vec<PathBuf>,
+    /// Case names (empty: the candidate model folders' names).
+    pub case_name: Vec<String>,
+    /// `PART.PROPERTY[,...]:LOWER:UPPER[:log|lin][:INITIAL]` specs.
+    pub params: Vec<String>,
+    pub set: String,
+    pub candidate_set: Option<String>,
+    pub components: String,
+    pub tolerance: f64,
+    pub objective: ObjectiveKind,
+    pub arrival_component: String,
+    pub relative_level: f64,
+    pub static_mode: bool,
+    pub method: Method,
+    pub starts: usize,
+    pub max_evaluations: usize,
+    pub xtol: f64,
+    pub ftol: f64,
+    pub initial_step: f64,
+    /// `NAME=VALUE`: values to compare fitted parameters with.
+    pub expected: Vec<String>,
+    /// Worker threads (0: all cores).
+    pub threads: usize,
+    /// The caller shows no progress; the stage does not use it, the provenance records it.
+    pub quiet: bool,
+    pub out: PathBuf,
+}
+
+/// What a fit reports back to the binary.
+#[derive(Debug, Clone)]
+pub struct Report {
+    pub problem: Problem,
+    pub result: FitResult,
+    /// Per parameter, the value given with `expected`.
+    pub expected: Vec<Option<f64>>,
+    /// Solver runs: evaluations × cases.
+    pub solver_runs: usize,
+    pub wall_seconds: f64,
+}
+
+fn check(ok: bool, what: String) -> Result<()> {
+    if ok {
+        Ok(())
+    } else {
+        Err(WeftError::input(what))
+    }
+}
+
+/// Evaluations a fit may make at most: the length of its progress.
+pub fn budget(c: &Config) -> u64 {
+    (c.starts * c.max_evaluations) as u64
+}
+
+/// Run the stage. `on_eval` sees every evaluation as it completes (progress).
+pub fn run(c: &Config, on_eval: &(dyn Fn(&Evaluation) + Sync)) -> Result<Report> {
+    let n = c.model.len();
+    check(
+        c.reference_model.len() == n && c.reference_history.len() == n,
+        format!(
+            "{} --reference-model, {} --reference-history and {} --model given; expected as many of each, one per case \
+             (hint: repeat the three options in the same order for every case)",
+            c.reference_model.len(),
+            c.reference_history.len(),
+            n
+        ),
+    )?;
+    check(
+        c.case_name.is_empty() || c.case_name.len() == n,
+        format!(
+            "{} --case-name for {n} cases; expected none or one per case",
+            c.case_name.len()
+        ),
+    )?;
+    check(
+        c.starts >= 1 && c.max_evaluations >= 2,
+        format!(
+            "--starts {} and --max-evaluations {}: expected at least 1 start and 2 evaluations",
+            c.starts, c.max_evaluations
+        ),
+    )?;
+    let comps = components(&c.components)?;
+    check(
+        comps.iter().all(|&k| k < 3),
+        format!(
+            "--components `{}`: a fit compares displacements; expected some of ux, uy, uz",
+            c.components
+        ),
+    )?;
+    let objective = match c.objective {
+        ObjectiveKind::Displacement => Objective::Displacement,
+        ObjectiveKind::Arrival => {
+            let k = components(&c.arrival_component)?;
+            check(
+                k.len() == 1,
+                format!(
+                    "--arrival-component takes one component, got `{}`",
+                    c.arrival_component
+                ),
+            )?;
+            check(
+                c.relative_level > 0.0 && c.relative_level <= 1.0,
+                format!(
+                    "--relative-level {}: expected a fraction of the peak in (0, 1]",
+                    c.relative_level
+                ),
+            )?;
+            Objective::Arrival {
+                component: k[0],
+                level: Level::Relative(c.relative_level),
+            }
+        }
+    };
+    let mut cases = vec![];
+    let mut prov_inputs: Vec<PathBuf> = vec![];
+    for k in 0..n {
+        let reference = read_series(&c.reference_model[k], &c.reference_history[k], &c.set)
+            .map_err(|e| e.context(format!("reference of case {}", k + 1)))?;
+        let model = read_model(&c.model[k])
+            .map_err(|e| e.context(format!("candidate model of case {}", k + 1)))?;
+        prov_inputs.push(c.reference_history[k].clone());
+        prov_inputs.extend(parquet_files(&c.model[k])?);
+        cases.push(Case {
+            name: case_name(c, k),
+            reference,
+            model,
+            set: c.candidate_set.clone().unwrap_or_else(|| c.set.clone()),
+        });
+    }
+    // Parameters are parsed against the first candidate; every case must have the parts.
+    let params = c
+        .params
+        .iter()
+        .map(|s| parse_param(s, &cases[0].model))
+        .collect::<Result<Vec<_>>>()?;
+    for case in &cases[1..] {
+        for s in &c.params {
+            parse_param(s, &case.model).map_err(|e| e.context(format!("case `{}`", case.name)))?;
+        }
+    }
+    let mut expected = vec![None; params.len()];
+    for e in &c.expected {
+        let (name, value) = e.split_once('=').ok_or_else(|| {
+            WeftError::input(format!(
+                "--expected `{e}`: expected NAME=VALUE, NAME one of the --param names"
+            ))
+        })?;
+        let k = params
+            .iter()
+            .position(|p| p.name == name.trim())
+            .ok_or_else(|| {
+                WeftError::input(format!(
+                    "--expected `{e}`: no fitted parameter is named `{name}` (expected one of {})",
+                    params
+                        .iter()
+                        .map(|p| format!("`{}`", p.name))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ))
+            })?;
+        let v: f64 = value
+            .trim()
+            .parse()
+            .ok()
+            .filter(|v: &f64| v.is_finite())
+            .ok_or_else(|| {
+                WeftError::input(format!(
+                    "--expected `{e}`: `{value}` is not a finite number"
+                ))
+            })?;
+        expected[k] = Some(v);
+    }
+    let problem = Problem {
+        cases,
+        params,
+        components: comps,
+        tolerance: c.tolerance,
+        static_mode: c.static_mode,
+        objective,
+    };
+    let opts = Options {
+        method: c.method,
+        starts: c.starts,
+        max_evaluations: c.max_evaluations,
+        xtol: c.xtol,
+        ftol: c.ftol,
+        initial_step: c.initial_step,
+        ..Default::default()
+    };
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(c.threads)
+        .build()
+        .map_err(|e| WeftError::input(format!("cannot start the worker threads: {e}")))?;
+
+    let t0 = Instant::now();
+    let result = pool
+        .install(|| fit(&problem, &opts, on_eval))
+        .map_err(|e| e.context("the fit failed; nothing was written"))?;
+    let wall_seconds = t0.elapsed().as_secs_f64();
+
+    let mut prov = Provenance::new("fit", serde_json::to_value(c).expect("config serialises"));
+    for p in &prov_inputs {
+        prov = prov.with_input(p)?;
+    }
+    let report = Report {
+        solver_runs: result.evaluations.len() * problem.cases.len(),
+        problem,
+        result,
+        expected,
+        wall_seconds,
+    };
+    write_table(
+        &c.out.join("fit_trace.parquet"),
+        &trace_table(&report),
+        &prov,
+    )?;
+    write_table(
+        &c.out.join("fit_result.parquet"),
+        &result_table(&report, c),
+        &prov,
+    )?;
+    for (k, case) in report.problem.cases.iter().enumerate() {
+        let m = report.problem.model_at(k, &report.result.x);
+        let dir = c.out.join("models").join(&case.name);
+        write_model(&m, &dir, &prov)
+            .map_err(|e| e.context(format!("cannot write the fitted model `{}`", dir.display())))?;
+    }
+    Ok(report)
+}
+
+/// Case `k`'s name: as given, else its candidate folder's name (numbered when two
+/// candidates share a folder name).
+fn case_name(c: &Config, k: usize) -> String {
+    c.case_name.get(k).cloned().unwrap_or_else(|| {
+        let base = c.model[k]
+            .file_name()
+            .map(|s| s.to_string_lossy().to_string())
+            .unwrap_or_else(|| format!("case{}", k + 1));
+        if c.model
+            .iter()
+            .filter(|m| m.file_name() == c.model[k].file_name())
+            .count()
+            > 1
+        {
+            format!("{base}-{}", k + 1)
+        } else {
+            base
+        }
+    })
+}
+
+/// `fit_trace.parquet`: one row per evaluation, ordered by start, then evaluation:
+/// `evaluation`, `start`, `start_evaluation`, one column per parameter (its name),
+/// `T`, `best_T` (the running minimum), `wall_seconds`, `error` (null when it ran).
+pub fn trace_table(r: &Report) -> RecordBatch {
+    let ev = &r.result.evaluations;
+    let mut running = f64::INFINITY;
+    let mut cols = vec![
+        Col::I64("evaluation", (0..ev.len() as i64).collect()),
+        Col::I64("start", ev.iter().map(|e| e.start as i64).collect()),
+        Col::I64(
+            "start_evaluation",
+            ev.iter().map(|e| e.index as i64).collect(),
+        ),
+    ];
+    for (i, p) in r.problem.params.iter().enumerate() {
+        cols.push(Col::F64Named(
+            p.name.clone(),
+            ev.iter().map(|e| e.x[i]).collect(),
+        ));
+    }
+    cols.push(Col::F64("T", ev.iter().map(|e| e.t).collect()));
+    cols.push(Col::F64(
+        "best_T",
+        ev.iter()
+            .map(|e| {
+                running = running.min(e.t);
+                running
+            })
+            .collect(),
+    ));
+    cols.push(Col::F64(
+        "wall_seconds",
+        ev.iter().map(|e| e.seconds).collect(),
+    ));
+    cols.push(Col::OptStr(
+        "error",
+        ev.iter().map(|e| e.error.clone()).collect(),
+    ));
+    batch(cols)
+}
+
+/// `fit_result.parquet`: one row per parameter: `name`, `value`, `lower`, `upper`,
+/// `scale`, `initial`, `at_bound`, `expected`, `relative_difference`, and the fit's
+/// `T`, `T_initial`, `evaluations`, `solver_runs`, `method`, `static`, `wall_seconds`
+/// repeated on every row.
+pub fn result_table(r: &Report, c: &Config) -> RecordBatch {
+    let params = &r.problem.params;
+    let x = &r.result.x;
+    let np = params.len();
+    let rep = |v: f64| vec![v; np];
+    batch(vec![
+        Col::Str("name", params.iter().map(|p| p.name.clone()).collect()),
+        Col::F64("value", x.clone()),
+        Col::F64("lower", params.iter().map(|p| p.lower).collect()),
+        Col::F64("upper", params.iter().map(|p| p.upper).collect()),
+        Col::Str(
+            "scale",
+            params
+                .iter()
+                .map(|p| if p.log { "log" } else { "lin" }.to_string())
+                .collect(),
+        ),
+        Col::F64("initial", params.iter().map(|p| p.initial).collect()),
+        Col::Bool(
+            "at_bound",
+            params
+                .iter()
+                .zip(x)
+                .map(|(p, &v)| {
+                    let z = p.unit(v);
+                    !(1e-6..=1.0 - 1e-6).contains(&z)
+                })
+                .collect(),
+        ),
+        Col::OptF64("expected", r.expected.clone()),
+        Col::OptF64(
+            "relative_difference",
+            r.expected
+                .iter()
+                .zip(x)
+                .map(|(e, v)| e.map(|e| (v - e) / e))
+                .collect(),
+        ),
+        Col::F64("T", rep(r.result.t)),
+        Col::F64("T_initial", rep(r.result.t_initial)),
+        Col::I64("evaluations", vec![r.result.evaluations.len() as i64; np]),
+        Col::I64("solver_runs", vec![r.solver_runs as i64; np]),
+        Col::Str("method", vec![format!("{:?}", c.method).to_lowercase(); np]),
+        Col::Bool("static", vec![c.static_mode; np]),
+        Col::F64("wall_seconds", rep(r.wall_seconds)),
+    ])
+}
+
+/// The model's tables, sorted: the inputs the provenance records.
+fn parquet_files(dir: &Path) -> Result<Vec<PathBuf>> {
+    let mut v = vec![];
+    for e in std::fs::read_dir(dir).map_err(|e| WeftError::io(dir, e))? {
+        let p = e.map_err(|e| WeftError::io(dir, e))?.path();
+        if p.extension().is_some_and(|x| x == "parquet") {
+            v.push(p);
+        }
+    }
+    v.sort();
+    Ok(v)
+}

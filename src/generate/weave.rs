@@ -1,0 +1,70 @@
+//! The `weave` stage behind `weft-weave`: build one canonical model from its generator's
+//! parameters and write it as a model folder whose tables record those parameters.
+
+use std::path::Path;
+
+use super::rod::{build, RodParams};
+use super::square::{girder, membrane, GirderParams, MembraneParams};
+use super::zones::{combined, woven_reduced, CombinedParams, WovenParams};
+use crate::error::Result;
+use crate::model::io::write_model;
+use crate::model::Model;
+use crate::table::Provenance;
+
+/// Which model, with its generator's parameters.
+#[derive(Debug, Clone)]
+pub enum Spec {
+    Rod(RodParams),
+    Girder(GirderParams),
+    Membrane(MembraneParams),
+    Combined(CombinedParams),
+    WovenReduced(WovenParams),
+}
+
+impl Spec {
+    /// The subcommand's name: `rod`, `girder`, `membrane`, `combined`, `woven-reduced`.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Spec::Rod(_) => "rod",
+            Spec::Girder(_) => "girder",
+            Spec::Membrane(_) => "membrane",
+            Spec::Combined(_) => "combined",
+            Spec::WovenReduced(_) => "woven-reduced",
+        }
+    }
+}
+
+/// Build the model, hand its generator's warnings to `on_warning`, and write it to `out`
+/// with the provenance stage `weave <name>` and the parameters.
+pub fn run(spec: &Spec, out: &Path, on_warning: &mut dyn FnMut(&str)) -> Result<Model> {
+    let what = match spec {
+        Spec::Rod(_) => "the rod model",
+        Spec::Girder(_) => "the girder",
+        Spec::Membrane(_) => "the membrane",
+        Spec::Combined(_) => "the combined model",
+        Spec::WovenReduced(_) => "the reduced woven model",
+    };
+    let built = match spec {
+        Spec::Rod(p) => build(p),
+        Spec::Girder(p) => girder(p).map(|(m, warnings)| {
+            warnings.iter().for_each(|w| on_warning(w));
+            m
+        }),
+        Spec::Membrane(p) => membrane(p),
+        Spec::Combined(p) => combined(p),
+        Spec::WovenReduced(p) => woven_reduced(p),
+    };
+    let m = built.map_err(|e| e.context(format!("cannot build {what}")))?;
+    let parameters = match spec {
+        Spec::Rod(p) => serde_json::to_value(p),
+        Spec::Girder(p) => serde_json::to_value(p),
+        Spec::Membrane(p) => serde_json::to_value(p),
+        Spec::Combined(p) => serde_json::to_value(p),
+        Spec::WovenReduced(p) => serde_json::to_value(p),
+    }
+    .expect("parameters serialise");
+    let prov = Provenance::new(&format!("weave {}", spec.name()), parameters);
+    write_model(&m, out, &prov)
+        .map_err(|e| e.context(format!("cannot write model `{}`", out.display())))?;
+    Ok(m)
+}

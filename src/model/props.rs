@@ -1,0 +1,610 @@
+//! Part properties, each defined once: the [`PartProps`] struct and the descriptor table
+//! [`PROPERTIES`] are generated from the same list by `part_properties!`.
+//!
+//! A property's descriptor gives its column of `parts.parquet` (also its field name and
+//! its name in `weft-fit --param PART.PROPERTY`), its type (float64 or bool, always
+//! nullable), its unit, the element kinds it applies to with the [`Rule`] its value must
+//! satisfy for each, what a null means and why, the short aliases `weft-fit` accepts, and
+//! a one-line meaning. Everything that lists part properties is driven by the table:
+//! reading and writing `parts.parquet` ([`read_columns`], [`columns`]), the checks and
+//! their messages ([`Property::check`], used by [`super::validate_part`]), the properties
+//! and aliases `weft-fit` accepts ([`fittable`], [`resolve_alias`]), and the
+//! `parts.parquet` section of `docs/tables.md` ([`parts_table_markdown`]; the test
+//! `tests/docs_drift.rs` fails when the two differ, and `WEFT_BLESS=1 cargo test --release
+//! --test docs_drift` rewrites the section).
+//!
+//! The table's order is the column order of `parts.parquet` as written.
+
+use super::ElementKind::{self, Beam, Link, PointMass, Quad, Tri, Truss};
+use super::Part;
+use crate::error::{Result, WeftError};
+use crate::table::{Col, Table};
+
+/// What a property's value must satisfy for one element kind.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Rule {
+    /// Must be given, finite and > 0.
+    Required,
+    /// May be null; when given, finite and > 0.
+    Positive,
+    /// May be null; when given, finite and ≥ 0.
+    NonNegative,
+    /// May be null; when given, lo < value < hi. `expected` says so in the property's
+    /// symbols.
+    Open {
+        lo: f64,
+        hi: f64,
+        expected: &'static str,
+    },
+    /// May be null; when given, finite.
+    Finite,
+    /// No check of its own (booleans; ν₁₂, which `validate_part` checks against E₂/E₁).
+    Free,
+}
+
+/// What a null means for an optional property, and why that default.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Null {
+    /// The value or behaviour a null stands for (`0.1`, `false`, `no slider`).
+    pub means: &'static str,
+    /// Why that default.
+    pub reason: &'static str,
+}
+
+/// Get and set one field of [`PartProps`], by the property's type.
+#[derive(Clone, Copy)]
+pub enum Access {
+    F64 {
+        get: fn(&PartProps) -> Option<f64>,
+        slot: fn(&mut PartProps) -> &mut Option<f64>,
+    },
+    Bool {
+        get: fn(&PartProps) -> Option<bool>,
+        slot: fn(&mut PartProps) -> &mut Option<bool>,
+    },
+}
+
+/// One part property (a nullable column of `parts.parquet`).
+#[derive(Clone, Copy)]
+pub struct Property {
+    /// Column name, field name of [`PartProps`], and name in `weft-fit --param`.
+    pub name: &'static str,
+    /// SI unit; empty when dimensionless.
+    pub unit: &'static str,
+    /// Element kinds the property applies to, each with the rule its value obeys.
+    pub kinds: &'static [(ElementKind, Rule)],
+    /// What a null means; `None` when the property is required wherever it applies.
+    pub null: Option<Null>,
+    /// Short names `weft-fit --param` accepts (`E`, `G12`).
+    pub aliases: &'static [&'static str],
+    /// One-line meaning, with its symbol.
+    pub meaning: &'static str,
+    pub access: Access,
+}
+
+impl std::fmt::Debug for Property {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Property")
+            .field("name", &self.name)
+            .field("unit", &self.unit)
+            .field("kinds", &self.kinds)
+            .finish_non_exhaustive()
+    }
+}
+
+/// Declares the part properties once: generates the fields of [`PartProps`] (each an
+/// `Option` of the property's type, documented with its meaning and unit) and the
+/// descriptor table [`PROPERTIES`], in the same order.
+macro_rules! part_properties {
+    ($(
+        $field:ident: $ty:ident {
+            unit: $unit:literal,
+            kinds: [$($kind:ident: $rule:expr),+ $(,)?],
+            null: $null:expr,
+            aliases: [$($alias:literal),* $(,)?],
+            meaning: $meaning:literal $(,)?
+        }
+    ),+ $(,)?) => {
+        /// Part properties. Which ones apply depends on the part's element kind (see
+        /// [`PROPERTIES`] and `docs/tables.md`); the others stay `None`.
+        #[derive(Debug, Clone, Default, PartialEq)]
+        pub struct PartProps {
+            $(
+                #[doc = concat!($meaning, " [", $unit, "]")]
+                pub $field: Option<$ty>,
+            )+
+        }
+
+        /// Every part property, in the column order of `parts.parquet`.
+        pub const PROPERTIES: &[Property] = &[$(
+            Property {
+                name: stringify!($field),
+                unit: $unit,
+                kinds: &[$(($kind, $rule)),+],
+                null: $null,
+                aliases: &[$($alias),*],
+                meaning: $meaning,
+                access: part_properties!(@access $ty $field),
+            },
+        )+];
+    };
+    (@access f64 $field:ident) => {
+        Access::F64 {
+            get: {
+                fn get(p: &PartProps) -> Option<f64> {
+                    p.$field
+                }
+                get
+            },
+            slot: {
+                fn slot(p: &mut PartProps) -> &mut Option<f64> {
+                    &mut p.$field
+                }
+                slot
+            },
+        }
+    };
+    (@access bool $field:ident) => {
+        Access::Bool {
+            get: {
+                fn get(p: &PartProps) -> Option<bool> {
+                    p.$field
+                }
+                get
+            },
+            slot: {
+                fn slot(p: &mut PartProps) -> &mut Option<bool> {
+                    &mut p.$field
+                }
+                slot
+            },
+        }
+    };
+}
+
+const fn null(means: &'static str, reason: &'static str) -> Option<Null> {
+    Some(Null { means, reason })
+}
+
+const NO_SPRING: Option<Null> = null("0", "no spring along that axis");
+const NO_DASHPOT: Option<Null> = null("0", "no dashpot along that axis");
+
+part_properties! {
+    youngs_modulus: f64 {
+        unit: "Pa",
+        kinds: [Truss: Rule::Required, Beam: Rule::Required],
+        null: None,
+        aliases: ["E"],
+        meaning: "Young's modulus E",
+    },
+    density: f64 {
+        unit: "kg/m³",
+        kinds: [Truss: Rule::Required, Tri: Rule::Required, Quad: Rule::Required, Beam: Rule::Required],
+        null: None,
+        aliases: ["rho"],
+        meaning: "mass density ρ",
+    },
+    area: f64 {
+        unit: "m²",
+        kinds: [Truss: Rule::Required],
+        null: None,
+        aliases: ["A"],
+        meaning: "cross-section area A",
+    },
+    tension_only: bool {
+        unit: "",
+        kinds: [Truss: Rule::Free],
+        null: null("false", "a truss carries compression unless told otherwise"),
+        aliases: [],
+        meaning: "true: the truss carries no compressive force",
+    },
+    kx: f64 {
+        unit: "N/m",
+        kinds: [Link: Rule::NonNegative],
+        null: NO_SPRING,
+        aliases: [],
+        meaning: "spring stiffness along global x",
+    },
+    ky: f64 {
+        unit: "N/m",
+        kinds: [Link: Rule::NonNegative],
+        null: NO_SPRING,
+        aliases: [],
+        meaning: "spring stiffness along global y",
+    },
+    kz: f64 {
+        unit: "N/m",
+        kinds: [Link: Rule::NonNegative],
+        null: NO_SPRING,
+        aliases: [],
+        meaning: "spring stiffness along global z",
+    },
+    cx: f64 {
+        unit: "N·s/m",
+        kinds: [Link: Rule::NonNegative],
+        null: NO_DASHPOT,
+        aliases: [],
+        meaning: "dashpot coefficient along global x",
+    },
+    cy: f64 {
+        unit: "N·s/m",
+        kinds: [Link: Rule::NonNegative],
+        null: NO_DASHPOT,
+        aliases: [],
+        meaning: "dashpot coefficient along global y",
+    },
+    cz: f64 {
+        unit: "N·s/m",
+        kinds: [Link: Rule::NonNegative],
+        null: NO_DASHPOT,
+        aliases: [],
+        meaning: "dashpot coefficient along global z",
+    },
+    slip_force: f64 {
+        unit: "N",
+        kinds: [Link: Rule::Positive],
+        null: null("no slider", "a link slips only where a friction slider is asked for"),
+        aliases: [],
+        meaning: "friction slider: the tangential (x–y) force at which the link slips; needs `kx`, `ky` > 0",
+    },
+    mass: f64 {
+        unit: "kg",
+        kinds: [PointMass: Rule::Required],
+        null: None,
+        aliases: [],
+        meaning: "the point mass",
+    },
+    youngs_modulus_1: f64 {
+        unit: "Pa",
+        kinds: [Tri: Rule::Required, Quad: Rule::Required],
+        null: None,
+        aliases: ["E1"],
+        meaning: "Young's modulus E₁ along material direction 1",
+    },
+    youngs_modulus_2: f64 {
+        unit: "Pa",
+        kinds: [Tri: Rule::Required, Quad: Rule::Required],
+        null: None,
+        aliases: ["E2"],
+        meaning: "Young's modulus E₂ along material direction 2",
+    },
+    poisson_ratio_12: f64 {
+        unit: "",
+        kinds: [Tri: Rule::Free, Quad: Rule::Free],
+        null: null("0", "no coupling of the two material directions"),
+        aliases: ["nu12"],
+        meaning: "Poisson's ratio ν₁₂ (ν₂₁ = ν₁₂E₂/E₁); needs −1 < ν₁₂ and ν₁₂²E₂/E₁ < 1",
+    },
+    shear_modulus_12: f64 {
+        unit: "Pa",
+        kinds: [Tri: Rule::Required, Quad: Rule::Required],
+        null: None,
+        aliases: ["G12", "G"],
+        meaning: "in-plane shear modulus G₁₂",
+    },
+    thickness: f64 {
+        unit: "m",
+        kinds: [Tri: Rule::Required, Quad: Rule::Required],
+        null: None,
+        aliases: ["s"],
+        meaning: "membrane thickness s",
+    },
+    no_compression: bool {
+        unit: "",
+        kinds: [Tri: Rule::Free, Quad: Rule::Free],
+        null: null("false", "a membrane carries compression unless told otherwise"),
+        aliases: [],
+        meaning: "true: compressive principal stresses are dropped (wrinkling)",
+    },
+    hourglass: f64 {
+        unit: "",
+        kinds: [Quad: Rule::NonNegative],
+        null: null("0.1", "LS-DYNA's default"),
+        aliases: [],
+        meaning: "hourglass coefficient κ of the one-point quad",
+    },
+    material_angle: f64 {
+        unit: "rad",
+        kinds: [Tri: Rule::Finite, Quad: Rule::Finite],
+        null: null("0", "material direction 1 along the projected global x"),
+        aliases: [],
+        meaning: "angle of material direction 1 from global x projected on the element, about its normal",
+    },
+    width: f64 {
+        unit: "m",
+        kinds: [Beam: Rule::Required],
+        null: None,
+        aliases: ["b"],
+        meaning: "section width b, along the local e₂ (in the plane of a girder)",
+    },
+    height: f64 {
+        unit: "m",
+        kinds: [Beam: Rule::Required],
+        null: None,
+        aliases: ["h"],
+        meaning: "section height h, along the local e₃ (global z unless the beam is parallel to z, then global y)",
+    },
+    poisson_ratio: f64 {
+        unit: "",
+        kinds: [Beam: Rule::Open { lo: -1.0, hi: 0.5, expected: "−1 < ν < 0.5" }],
+        null: null("0.3", "a typical structural metal's"),
+        aliases: [],
+        meaning: "Poisson's ratio ν for the shear modulus G = E/(2(1 + ν)) in torsion",
+    },
+    prestrain: f64 {
+        unit: "",
+        kinds: [Truss: Rule::Open { lo: -0.5, hi: 0.5, expected: "a small strain, −0.5 < ε₀ < 0.5" }],
+        null: null("0", "an unstressed truss"),
+        aliases: [],
+        meaning: "initial strain ε₀ (pretension): unstressed length = geometric length/(1 + ε₀), so the truss starts with the force E·A·ε₀",
+    },
+}
+
+impl PartProps {
+    /// Hourglass coefficient κ; 0.1, LS-DYNA's default, when not given (the `hourglass`
+    /// descriptor's null; a unit test holds the two equal).
+    pub fn hourglass_coefficient(&self) -> f64 {
+        self.hourglass.unwrap_or(0.1)
+    }
+}
+
+/// The descriptor of a property by column name.
+pub fn property(name: &str) -> Option<&'static Property> {
+    PROPERTIES.iter().find(|p| p.name == name)
+}
+
+/// The property an alias (`G12`) stands for; a name that is no alias comes back as is.
+pub fn resolve_alias(name: &str) -> &str {
+    PROPERTIES
+        .iter()
+        .find(|p| p.aliases.contains(&name))
+        .map(|p| p.name)
+        .unwrap_or(name)
+}
+
+/// The numeric properties of a kind's parts, which `weft-fit` can set, in table order.
+pub fn fittable(kind: ElementKind) -> impl Iterator<Item = &'static Property> {
+    PROPERTIES
+        .iter()
+        .filter(move |p| matches!(p.access, Access::F64 { .. }) && p.rule(kind).is_some())
+}
+
+impl Property {
+    /// The rule for a kind's parts; `None` when the property does not apply to it.
+    pub fn rule(&self, kind: ElementKind) -> Option<Rule> {
+        self.kinds.iter().find(|k| k.0 == kind).map(|k| k.1)
+    }
+
+    /// The numeric default a null stands for, when it is a number.
+    pub fn null_value(&self) -> Option<f64> {
+        self.null.and_then(|n| n.means.parse().ok())
+    }
+
+    /// `in Pa`, or nothing when dimensionless: the unit as error messages write it.
+    fn in_unit(&self) -> String {
+        if self.unit.is_empty() {
+            String::new()
+        } else {
+            format!(" in {}", self.unit)
+        }
+    }
+
+    /// Check a part's value of this property against the rule for the part's kind.
+    /// Errors name the part, its kind, the column and the value; the caller adds the
+    /// file and row.
+    pub fn check(&self, p: &Part) -> Result<()> {
+        let Some(rule) = self.rule(p.kind) else {
+            return Ok(());
+        };
+        let Access::F64 { get, .. } = self.access else {
+            return Ok(());
+        };
+        let v = get(&p.props);
+        let col = self.name;
+        let bad = |x: f64| {
+            WeftError::input(format!(
+                "part `{}` ({}) has {col} = `{x}`",
+                p.name,
+                p.kind.name()
+            ))
+            .in_column(col)
+        };
+        let or_null = |s: String| match self.null {
+            Some(n) => format!("{s}, or null for {}", n.means),
+            None => s,
+        };
+        match (rule, v) {
+            (Rule::Required, None) => Err(WeftError::input(format!(
+                "part `{}` ({}) has no {col}",
+                p.name,
+                p.kind.name()
+            ))
+            .in_column(col)
+            .expected(format!("a value > 0{}", self.in_unit()))
+            .hint(format!("every {} part needs `{col}`", p.kind.name()))),
+            (Rule::Required | Rule::Positive, Some(x)) if !(x > 0.0 && x.is_finite()) => {
+                Err(bad(x).expected(or_null(format!("a value > 0{}", self.in_unit()))))
+            }
+            (Rule::NonNegative, Some(x)) if x < 0.0 || !x.is_finite() => {
+                Err(bad(x).expected(or_null(format!("a value ≥ 0{}", self.in_unit()))))
+            }
+            (Rule::Open { lo, hi, expected }, Some(x)) if !(x > lo && x < hi) => {
+                Err(bad(x).expected(expected))
+            }
+            (Rule::Finite, Some(x)) if !x.is_finite() => {
+                Err(bad(x).expected(format!("a finite value{}", self.in_unit())))
+            }
+            _ => Ok(()),
+        }
+    }
+
+    /// What the rule asks, for the docs: `required, > 0`, `≥ 0`.
+    fn rule_text(rule: Rule) -> String {
+        match rule {
+            Rule::Required => "required, > 0".into(),
+            Rule::Positive => "> 0".into(),
+            Rule::NonNegative => "≥ 0".into(),
+            Rule::Open { expected, .. } => expected.into(),
+            Rule::Finite => "finite".into(),
+            Rule::Free => String::new(),
+        }
+    }
+}
+
+/// Read the property columns of `parts.parquet` (an absent column is all null), one
+/// [`PartProps`] per row.
+pub fn read_columns(t: &Table, rows: usize) -> Result<Vec<PartProps>> {
+    let mut out = vec![PartProps::default(); rows];
+    for p in PROPERTIES {
+        match p.access {
+            Access::F64 { slot, .. } => {
+                if let Some(col) = t.f64_opt(p.name)? {
+                    for (q, v) in out.iter_mut().zip(col) {
+                        *slot(q) = v;
+                    }
+                }
+            }
+            Access::Bool { slot, .. } => {
+                if let Some(col) = t.bool_opt(p.name)? {
+                    for (q, v) in out.iter_mut().zip(col) {
+                        *slot(q) = v;
+                    }
+                }
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// The property columns of `parts.parquet`, every one, in table order.
+pub fn columns<'a>(props: impl Iterator<Item = &'a PartProps> + Clone) -> Vec<Col> {
+    PROPERTIES
+        .iter()
+        .map(|p| match p.access {
+            Access::F64 { get, .. } => Col::OptF64(p.name, props.clone().map(get).collect()),
+            Access::Bool { get, .. } => Col::OptBool(p.name, props.clone().map(get).collect()),
+        })
+        .collect()
+}
+
+/// The column table of `parts.parquet` for `docs/tables.md`: the three identifying
+/// columns, then one row per property.
+pub fn parts_table_markdown() -> String {
+    let mut s = String::from(
+        "| column | type | unit | kinds | meaning |\n\
+         |---|---|---|---|---|\n\
+         | `part_id` | int64 | – | all | unique part id |\n\
+         | `name` | string | – | all | part name (used by later stages to address properties, e.g. `links.kx`) |\n",
+    );
+    let kinds = ElementKind::ALL.map(|k| format!("`{}`", k.name()));
+    let (last, rest) = kinds.split_last().expect("kinds");
+    s += &format!(
+        "| `kind` | string | – | all | element kind: {} or {last} |\n",
+        rest.join(", ")
+    );
+    for p in PROPERTIES {
+        let ty = match p.access {
+            Access::F64 { .. } => "float64, nullable",
+            Access::Bool { .. } => "bool, nullable",
+        };
+        let unit = if p.unit.is_empty() { "–" } else { p.unit };
+        let kinds: Vec<&str> = ElementKind::ALL
+            .into_iter()
+            .filter(|k| p.rule(*k).is_some())
+            .map(|k| k.name())
+            .collect();
+        // One rule text when every kind has the same rule, else one per kind.
+        let texts: Vec<(ElementKind, String)> = p
+            .kinds
+            .iter()
+            .map(|(k, r)| (*k, Property::rule_text(*r)))
+            .collect();
+        let mut notes = vec![];
+        if texts.iter().all(|t| t.1 == texts[0].1) {
+            if !texts[0].1.is_empty() {
+                notes.push(texts[0].1.clone());
+            }
+        } else {
+            notes.extend(
+                texts
+                    .iter()
+                    .filter(|t| !t.1.is_empty())
+                    .map(|(k, t)| format!("{}: {t}", k.name())),
+            );
+        }
+        if let Some(n) = p.null {
+            notes.push(format!("null = {}: {}", n.means, n.reason));
+        }
+        let mut meaning = p.meaning.to_string();
+        if !notes.is_empty() {
+            meaning += &format!(" ({})", notes.join("; "));
+        }
+        if !p.aliases.is_empty() {
+            meaning += &format!(
+                "; weft-fit alias {}",
+                p.aliases
+                    .iter()
+                    .map(|a| format!("`{a}`"))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            );
+        }
+        s += &format!(
+            "| `{}` | {ty} | {unit} | {} | {meaning} |\n",
+            p.name,
+            kinds.join(", ")
+        );
+    }
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_and_aliases_are_unique() {
+        let mut seen = std::collections::HashSet::new();
+        for p in PROPERTIES {
+            assert!(seen.insert(p.name), "`{}` twice", p.name);
+            for a in p.aliases {
+                assert!(seen.insert(a), "alias `{a}` twice");
+            }
+            assert!(!p.kinds.is_empty(), "`{}` applies to no kind", p.name);
+        }
+    }
+
+    #[test]
+    fn accessors_reach_their_own_field() {
+        for (k, p) in PROPERTIES.iter().enumerate() {
+            let mut q = PartProps::default();
+            match p.access {
+                Access::F64 { get, slot } => {
+                    *slot(&mut q) = Some(k as f64 + 0.5);
+                    assert_eq!(get(&q), Some(k as f64 + 0.5), "{}", p.name);
+                }
+                Access::Bool { get, slot } => {
+                    *slot(&mut q) = Some(true);
+                    assert_eq!(get(&q), Some(true), "{}", p.name);
+                }
+            }
+            // Exactly one field was set.
+            let set = PROPERTIES
+                .iter()
+                .filter(|o| match o.access {
+                    Access::F64 { get, .. } => get(&q).is_some(),
+                    Access::Bool { get, .. } => get(&q).is_some(),
+                })
+                .count();
+            assert_eq!(set, 1, "{}", p.name);
+        }
+    }
+
+    #[test]
+    fn defaults_used_in_code_match_the_table() {
+        assert_eq!(
+            property("hourglass").unwrap().null_value(),
+            Some(PartProps::default().hourglass_coefficient())
+        );
+    }
+}
