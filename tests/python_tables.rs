@@ -87,6 +87,7 @@ fn a_model_with_every_feature_opens_in_pandas_and_polars() {
         "ties.parquet",
         "symmetry.parquet",
         "projectile.parquet",
+        "contacts.parquet",
     ] {
         assert!(model.join(t).exists(), "{t}");
     }

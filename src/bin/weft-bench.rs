@@ -29,6 +29,16 @@ struct Cli {
     /// and `weft status` over sweeps of the sizes in --instances.
     #[arg(long)]
     pipeline: bool,
+    /// Benchmark contact instead: two crossing layers of bands pressed together, at the
+    /// node counts in --contact-nodes; prints the contact cost per node per step.
+    #[arg(long)]
+    contact: bool,
+    /// Node counts for the contact benchmark.
+    #[arg(long, value_delimiter = ',', default_values_t = vec![1000usize, 10_000, 100_000])]
+    contact_nodes: Vec<usize>,
+    /// Node-steps per contact measurement (sets the number of steps).
+    #[arg(long, default_value_t = 2e7)]
+    node_steps: f64,
     /// Sweep sizes for the pipeline benchmark.
     #[arg(long, value_delimiter = ',', default_values_t = vec![1000usize, 10_000])]
     instances: Vec<usize>,
@@ -186,10 +196,73 @@ fn chain(kind: ElementKind, n: usize) -> Model {
     m
 }
 
+/// Contact: two crossing layers of bands (`generate::layers`), two-way node-to-surface
+/// contact with friction, every free node of the upper layer pressed down.
+fn bench_contact(nodes: &[usize], threads: &[usize], node_steps: f64) -> anyhow::Result<()> {
+    use weft::generate::layers::{crossing_bands, CrossingBands};
+    println!("nodes,threads,node_steps_total,contact_seconds,total_seconds,contact_ns_per_node_step,builds,active_end,bit_identical");
+    for &n in nodes {
+        // The same physical time (300 steps) at every size, so that every size is in
+        // the same contact state; small models are run several times.
+        let mut m = crossing_bands(&CrossingBands::with_nodes(n));
+        let nn = m.num_nodes();
+        let dt = Solver::new(&m)?.stable.dt;
+        let steps = 300u64;
+        let reps = ((node_steps / (nn as f64 * steps as f64)).ceil() as usize).max(1);
+        m.analysis.end_time = dt * steps as f64;
+        m.analysis.output_interval = m.analysis.end_time;
+        let mut base: Option<(f64, Vec<[f64; 3]>)> = None;
+        for &t in threads {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(t).build()?;
+            let (mut c, mut total) = (0.0, 0.0);
+            let mut last = None;
+            for _ in 0..reps {
+                let mut s = Solver::new(&m)?;
+                let mut sink = MemorySink::default();
+                let stats = pool.install(|| s.run(&mut sink, &mut |_| {}))?;
+                c += stats.times.contact.as_secs_f64();
+                total += (stats.times.forces + stats.times.update + stats.times.loads).as_secs_f64();
+                last = Some((s, stats));
+            }
+            let (s, stats) = last.expect("one run");
+            let per = 1e9 * c / (nn as f64 * (stats.steps as usize * reps) as f64);
+            let rep = s.op.surfaces.report(&s.node_id);
+            let same = base.as_ref().map(|b| b.1 == s.state.x);
+            let speedup = base.as_ref().map(|b| format!(" (contact speed-up {:.2})", b.0 / c)).unwrap_or_default();
+            println!(
+                "{nn},{t},{},{c:.3},{total:.3},{per:.2},{},{},{}",
+                stats.steps as usize * reps,
+                rep.builds,
+                rep.active,
+                same.map_or("".into(), |b| b.to_string())
+            );
+            eprintln!(
+                "  contact {nn:>7} nodes, {t} thread(s): {per:.1} ns per node per step (search + forces), {} steps × {reps}, {} builds, {} slaves in contact, contact {:.0} % of the step{speedup}{}",
+                stats.steps,
+                rep.builds,
+                rep.active,
+                100.0 * c / total,
+                match same {
+                    Some(true) => ", bit-identical to 1 thread",
+                    Some(false) => ", DIFFERS from 1 thread",
+                    None => "",
+                }
+            );
+            if base.is_none() {
+                base = Some((c, s.state.x.clone()));
+            }
+        }
+    }
+    Ok(())
+}
+
 fn main() -> anyhow::Result<()> {
     let cli = Cli::parse();
     if cli.pipeline {
         return bench_pipeline(&cli.instances);
+    }
+    if cli.contact {
+        return bench_contact(&cli.contact_nodes, &cli.threads, cli.node_steps);
     }
     println!("kind,elements,threads,steps,seconds,element_updates_per_second");
     for kind in [ElementKind::Truss, ElementKind::Link] {

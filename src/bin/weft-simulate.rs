@@ -122,6 +122,18 @@ fn run_cli() -> anyhow::Result<ExitCode> {
         s.times.output.as_secs_f64(),
         s.element_updates_per_second()
     );
+    if let Some(c) = &r.contact {
+        eprintln!(
+            "  contact: {} definitions, {} slave nodes against {} faces or segments, {} broad-phase builds (skin {:.3e} m, {:.3} s), {} slaves in contact at the end, friction work {:.4e} J",
+            c.definitions, c.slaves, c.faces, c.builds, c.skin, s.times.contact.as_secs_f64(), c.active, c.friction_work
+        );
+        if let Some((cid, node, el, depth)) = c.deepest {
+            eprintln!(
+                "  contact: {} nodes started inside a surface and are tracked, not pushed out; deepest node `{node}` by {depth:.3e} m (element `{el}`, contact `{cid}`)",
+                c.initial_penetrations
+            );
+        }
+    }
     eprintln!(
         "  wrote {}/{{history,energy,summary}}.parquet",
         r.out.display()

@@ -5,4 +5,4 @@ pub mod projectile;
 pub mod surface;
 
 pub use projectile::*;
-pub use surface::SurfaceContact;
+pub use surface::{ContactReport, SurfaceContact};

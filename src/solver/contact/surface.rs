@@ -46,7 +46,7 @@ use crate::model::{ElementKind, Model};
 use crate::solver::vec3::{add, cross, dot, sub};
 
 /// Slaves per parallel chunk of the narrow phase.
-const SLAVE_CHUNK: usize = 512;
+const SLAVE_CHUNK: usize = 256;
 
 /// Closest point of the mid-surface of a face (`n` = 2, 3 or 4 nodes) to `p`: the weights
 /// of its nodes. Quads average the two diagonal splits, so the result has no handedness.
@@ -165,6 +165,26 @@ pub struct InitialPen {
     pub node: usize,
     pub element: i64,
     pub depth: f64,
+}
+
+/// What a run's contact did.
+#[derive(Debug, Clone, Default)]
+pub struct ContactReport {
+    pub definitions: usize,
+    /// Slave nodes and master faces over all sides (a two-way definition counts twice).
+    pub slaves: usize,
+    pub faces: usize,
+    /// Broad-phase builds.
+    pub builds: u64,
+    /// Slaves in contact at the end.
+    pub active: usize,
+    pub initial_penetrations: usize,
+    /// Deepest initial penetration: (contact id, node id, element id, depth [m]).
+    pub deepest: Option<(i64, i64, i64, f64)>,
+    /// Friction work dissipated [J].
+    pub friction_work: f64,
+    /// Broad-phase skin [m].
+    pub skin: f64,
 }
 
 /// One direction of one contact definition: slaves against a master surface.
@@ -409,6 +429,8 @@ impl Side {
         let (slaves, slave_t, slave_m) = (&self.slaves, &self.slave_t, &self.slave_m);
         let (cand_ptr, cand) = (&self.cand_ptr, &self.cand);
         let (fr, kappa) = (self.friction, self.kappa);
+        // Largest face thickness: no face farther than (t_s + this)/2 can touch.
+        let face_t_max = self.reach * 2.0 - self.slave_t.iter().cloned().fold(0.0, f64::max);
         let dt2 = dt * dt;
         let body = |(ci, (outs, sts)): (usize, (&mut [PairOut], &mut [SlaveState]))| {
             for (j, (o, st)) in outs.iter_mut().zip(sts.iter_mut()).enumerate() {
@@ -417,9 +439,24 @@ impl Side {
                 let p = x[s];
                 // The candidate of largest raw penetration.
                 let mut best: Option<(u32, [f64; 4], f64, [f64; 3])> = None;
+                let reach = 0.5 * (slave_t[si] + face_t_max);
                 for &fi in &cand[cand_ptr[si] as usize..cand_ptr[si + 1] as usize] {
                     let f = &faces[fi as usize];
                     let xf: [[f64; 3]; 4] = std::array::from_fn(|a| if a < nf { x[f[a] as usize] } else { [0.0; 3] });
+                    // Cheap rejection: the distance to the face's current bounding box.
+                    let mut d2 = 0.0;
+                    for d in 0..3 {
+                        let (mut lo, mut hi) = (xf[0][d], xf[0][d]);
+                        for xa in &xf[1..nf] {
+                            lo = lo.min(xa[d]);
+                            hi = hi.max(xa[d]);
+                        }
+                        let e = (lo - p[d]).max(p[d] - hi).max(0.0);
+                        d2 += e * e;
+                    }
+                    if d2 > reach * reach {
+                        continue;
+                    }
                     let w = closest_on_face(&p, &xf, nf);
                     let q: [f64; 3] = std::array::from_fn(|d| (0..nf).map(|a| w[a] * xf[a][d]).sum());
                     let tf: f64 = (0..nf).map(|a| w[a] * face_t[fi as usize][a]).sum();
@@ -534,9 +571,10 @@ impl SurfaceContact {
         let mut nodes: Vec<u32> = sides.iter().flat_map(|s| s.slaves.iter().copied().chain(s.faces.iter().flat_map(|f| f[..s.nf].to_vec()))).collect();
         nodes.sort_unstable();
         nodes.dedup();
-        // Skin: half the mean face size of the finest surface.
+        // Skin: a quarter of the mean face size of the finest surface (a larger skin
+        // means fewer rebuilds but more candidates per slave).
         let skin = sides.iter().map(|s| s.mean_face_size(&m.coords)).filter(|&h| h > 0.0).fold(f64::INFINITY, f64::min);
-        let skin = if skin.is_finite() { 0.5 * skin } else { 0.0 };
+        let skin = if skin.is_finite() { 0.25 * skin } else { 0.0 };
         let kappa_max = sides.iter().map(|s| s.kappa).fold(0.0, f64::max);
         SurfaceContact { sides, nodes, x_ref: vec![], skin, kappa_max, builds: 0, dissipated: 0.0, stored: 0.0, initial: vec![] }
     }
@@ -631,6 +669,22 @@ impl SurfaceContact {
             }
         }
         self.stored = stored;
+    }
+
+    /// A summary for reports.
+    pub fn report(&self, node_id: &[i64]) -> ContactReport {
+        let deepest = self.initial.iter().max_by(|a, b| a.depth.total_cmp(&b.depth));
+        ContactReport {
+            definitions: self.sides.iter().map(|s| s.row).collect::<std::collections::BTreeSet<_>>().len(),
+            slaves: self.sides.iter().map(|s| s.slaves.len()).sum(),
+            faces: self.sides.iter().map(|s| s.faces.len()).sum(),
+            builds: self.builds,
+            active: self.active(),
+            initial_penetrations: self.initial.len(),
+            deepest: deepest.map(|p| (p.contact_id, node_id[p.node], p.element, p.depth)),
+            friction_work: self.dissipated,
+            skin: self.skin,
+        }
     }
 
     /// Slaves in contact after the last force evaluation.
