@@ -341,7 +341,7 @@ impl Table {
             ),
             DataType::Boolean => matches!(a.data_type(), DataType::Boolean),
             _ => false,
-        };
+        } || a.data_type() == &DataType::Null; // all nulls (pandas/pyarrow write a column of None so)
         if !ok {
             return Err(self
                 .err(col, format!("column `{col}` has type {}", a.data_type()))

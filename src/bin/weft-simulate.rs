@@ -124,8 +124,8 @@ fn run_cli() -> anyhow::Result<ExitCode> {
     );
     if let Some(c) = &r.contact {
         eprintln!(
-            "  contact: {} definitions, {} slave nodes against {} faces or segments, {} broad-phase builds (skin {:.3e} m, {:.3} s), {} slaves in contact at the end, friction work {:.4e} J",
-            c.definitions, c.slaves, c.faces, c.builds, c.skin, s.times.contact.as_secs_f64(), c.active, c.friction_work
+            "  contact: {} definitions, {} slave nodes against {} faces or segments; {} broad-phase builds (skin {:.3e} m) {:.3} s, narrow phase {:.3} s; {} slaves in contact at the end, friction work {:.4e} J",
+            c.definitions, c.slaves, c.faces, c.builds, c.skin, c.build_seconds, c.narrow_seconds, c.active, c.friction_work
         );
         if let Some((cid, node, el, depth)) = c.deepest {
             eprintln!(

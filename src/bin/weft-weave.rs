@@ -44,6 +44,91 @@ enum Model {
     /// crossing by a link (springs, dashpots, optional friction slider), inside a graded
     /// equivalent membrane tied to the yarn ends, hit by a rigid projectile.
     WovenReduced(WovenArgs),
+    /// The yarn-level plain-weave patch (the paper's §2 reference): every yarn a band of
+    /// orthotropic membrane quads with the lenticular nodal thickness, warp along x and
+    /// weft along y crimped over and under each other, yarn–yarn contact with friction
+    /// within and between layers, a round-nosed 9 mm, 8 g projectile at 400 m/s.
+    /// Quarter model (symmetry planes x = 0, y = 0) unless --full. Node sets: axis_x,
+    /// axis_x_weft, diagonal, diagonal_weft (centre-line nodes at the crossings), edge.
+    Woven(WovenBandArgs),
+}
+
+#[derive(clap::Args)]
+struct WovenBandArgs {
+    /// Output model folder.
+    #[arg(long)]
+    out: PathBuf,
+    /// Yarns per side: of the quarter (the middle yarn counted once) or, with --full, of
+    /// the whole patch (even).
+    #[arg(long, default_value_t = 10)]
+    yarns: usize,
+    /// The whole patch instead of the quarter.
+    #[arg(long)]
+    full: bool,
+    /// Yarn spacing p [m].
+    #[arg(long, default_value_t = 1e-3)]
+    spacing: f64,
+    /// Yarn width w [m].
+    #[arg(long, default_value_t = 0.8e-3)]
+    width: f64,
+    /// Yarn thickness h [m] (lenticular section: area ≈ (2/3)wh).
+    #[arg(long, default_value_t = 0.124e-3)]
+    thickness: f64,
+    /// Crimp amplitude a [m] (default: crossing yarns just touch).
+    #[arg(long)]
+    crimp_amplitude: Option<f64>,
+    /// Quads per spacing along a yarn (even, ≥ 4).
+    #[arg(long, default_value_t = 4)]
+    per_spacing: usize,
+    /// Quads across a yarn's width (even, ≥ 2).
+    #[arg(long, default_value_t = 2)]
+    across: usize,
+    /// Yarn Young's modulus along the yarn [Pa] (aramid, Kevlar 29 class).
+    #[arg(long, default_value_t = 80e9)]
+    modulus: f64,
+    /// Yarn modulus across its width [Pa] (a bundle of filaments: small).
+    #[arg(long, default_value_t = 1.6e9)]
+    transverse_modulus: f64,
+    /// Yarn in-plane shear modulus [Pa].
+    #[arg(long, default_value_t = 0.8e9)]
+    shear_modulus: f64,
+    /// Yarn density [kg/m³].
+    #[arg(long, default_value_t = 1440.0)]
+    density: f64,
+    /// Yarn–yarn Coulomb friction coefficient.
+    #[arg(long, default_value_t = 0.15)]
+    friction: f64,
+    /// Fabric layers.
+    #[arg(long, default_value_t = 1)]
+    layers: usize,
+    /// Clearance between layers [m].
+    #[arg(long, default_value_t = 0.01e-3)]
+    layer_gap: f64,
+    /// Yarn ends at the patch edge: clamped (all nodes held), pinned (centre-line node
+    /// held) or free.
+    #[arg(long, value_enum, default_value_t = weft::generate::woven::Edge::Clamped)]
+    edge: weft::generate::woven::Edge,
+    /// Projectile nose shape.
+    #[arg(long, value_enum, default_value_t = weft::model::ProjectileShape::Round)]
+    projectile_shape: weft::model::ProjectileShape,
+    /// Projectile radius [m].
+    #[arg(long, default_value_t = 4.5e-3)]
+    projectile_radius: f64,
+    /// Projectile mass [kg] (of the whole projectile; a quarter model carries a quarter).
+    #[arg(long, default_value_t = 8e-3)]
+    projectile_mass: f64,
+    /// Impact velocity [m/s].
+    #[arg(long, default_value_t = 400.0)]
+    projectile_velocity: f64,
+    /// Projectile–yarn friction coefficient.
+    #[arg(long, default_value_t = 0.1)]
+    projectile_friction: f64,
+    /// Simulated time [s].
+    #[arg(long, default_value_t = 6e-5)]
+    end_time: f64,
+    /// Output interval [s].
+    #[arg(long, default_value_t = 1e-6)]
+    output_interval: f64,
 }
 
 #[derive(clap::Args)]
@@ -331,7 +416,10 @@ fn main() -> ExitCode {
 
 fn run() -> anyhow::Result<ExitCode> {
     let cli = Cli::parse();
-    let mut warn = |w: &str| eprintln!("warning: {w}");
+    let mut warn = |w: &str| match w.strip_prefix("note: ") {
+        Some(n) => eprintln!("note: {n}"),
+        None => eprintln!("warning: {w}"),
+    };
     match cli.model {
         Model::Girder(a) => {
             let p = GirderParams {
@@ -429,6 +517,41 @@ fn run() -> anyhow::Result<ExitCode> {
                 m.num_nodes(),
                 m.num_elements(),
                 m.ties.len(),
+                a.out.display()
+            );
+        }
+        Model::Woven(a) => {
+            let p = weft::generate::woven::WovenBandParams {
+                yarns: a.yarns,
+                quarter: !a.full,
+                spacing: a.spacing,
+                width: a.width,
+                thickness: a.thickness,
+                crimp_amplitude: a.crimp_amplitude,
+                per_spacing: a.per_spacing,
+                across: a.across,
+                modulus: a.modulus,
+                transverse_modulus: a.transverse_modulus,
+                shear_modulus: a.shear_modulus,
+                density: a.density,
+                friction: a.friction,
+                layers: a.layers,
+                layer_gap: a.layer_gap,
+                edge: a.edge,
+                projectile_shape: a.projectile_shape,
+                projectile_radius: a.projectile_radius,
+                projectile_mass: a.projectile_mass,
+                projectile_velocity: a.projectile_velocity,
+                projectile_friction: a.projectile_friction,
+                end_time: a.end_time,
+                output_interval: a.output_interval,
+            };
+            let m = weave::run(&Spec::Woven(p), &a.out, &mut warn)?;
+            eprintln!(
+                "weft-weave woven: {} nodes, {} band quads, {} contact definitions -> {}",
+                m.num_nodes(),
+                m.num_elements(),
+                m.contacts.len(),
                 a.out.display()
             );
         }

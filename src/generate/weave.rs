@@ -5,6 +5,7 @@ use std::path::Path;
 
 use super::rod::{build, RodParams};
 use super::square::{girder, membrane, GirderParams, MembraneParams};
+use super::woven::{woven, WovenBandParams};
 use super::zones::{combined, woven_reduced, CombinedParams, WovenParams};
 use crate::error::Result;
 use crate::model::io::write_model;
@@ -19,6 +20,7 @@ pub enum Spec {
     Membrane(MembraneParams),
     Combined(CombinedParams),
     WovenReduced(WovenParams),
+    Woven(WovenBandParams),
 }
 
 impl Spec {
@@ -30,6 +32,7 @@ impl Spec {
             Spec::Membrane(_) => "membrane",
             Spec::Combined(_) => "combined",
             Spec::WovenReduced(_) => "woven-reduced",
+            Spec::Woven(_) => "woven",
         }
     }
 }
@@ -43,6 +46,7 @@ pub fn run(spec: &Spec, out: &Path, on_warning: &mut dyn FnMut(&str)) -> Result<
         Spec::Membrane(_) => "the membrane",
         Spec::Combined(_) => "the combined model",
         Spec::WovenReduced(_) => "the reduced woven model",
+        Spec::Woven(_) => "the yarn-level woven patch",
     };
     let built = match spec {
         Spec::Rod(p) => build(p),
@@ -53,6 +57,17 @@ pub fn run(spec: &Spec, out: &Path, on_warning: &mut dyn FnMut(&str)) -> Result<
         Spec::Membrane(p) => membrane(p),
         Spec::Combined(p) => combined(p),
         Spec::WovenReduced(p) => woven_reduced(p),
+        Spec::Woven(p) => woven(p).map(|(m, info)| {
+            on_warning(&format!(
+                "note: lenticular section {:.4e} m², nodal thickness scaled by {:.4} so that the bands carry it exactly; crimp amplitude {:.4e} m (crimp {:.3} %); areal density {:.1} g/m² per layer",
+                info.area,
+                info.thickness_scale,
+                info.crimp_amplitude,
+                100.0 * info.crimp,
+                1e3 * info.areal_density
+            ));
+            m
+        }),
     };
     let m = built.map_err(|e| e.context(format!("cannot build {what}")))?;
     let parameters = match spec {
@@ -61,6 +76,7 @@ pub fn run(spec: &Spec, out: &Path, on_warning: &mut dyn FnMut(&str)) -> Result<
         Spec::Membrane(p) => serde_json::to_value(p),
         Spec::Combined(p) => serde_json::to_value(p),
         Spec::WovenReduced(p) => serde_json::to_value(p),
+        Spec::Woven(p) => serde_json::to_value(p),
     }
     .expect("parameters serialise");
     let prov = Provenance::new(&format!("weave {}", spec.name()), parameters);

@@ -185,6 +185,10 @@ pub struct ContactReport {
     pub friction_work: f64,
     /// Broad-phase skin [m].
     pub skin: f64,
+    /// Wall time of the broad phase (with the staleness check) and of the narrow phase
+    /// with the scatter [s].
+    pub build_seconds: f64,
+    pub narrow_seconds: f64,
 }
 
 /// One direction of one contact definition: slaves against a master surface.
@@ -547,8 +551,11 @@ pub struct SurfaceContact {
     pub skin: f64,
     /// Largest κ_c of the definitions (stable-step guard).
     pub kappa_max: f64,
-    /// Broad-phase builds so far.
+    /// Broad-phase builds so far, and the wall time of the builds and of the narrow
+    /// phase with the scatter.
     pub builds: u64,
+    pub build_time: std::time::Duration,
+    pub narrow_time: std::time::Duration,
     /// Friction work dissipated so far [J].
     pub dissipated: f64,
     /// Stored energy at the last force evaluation [J].
@@ -576,7 +583,7 @@ impl SurfaceContact {
         let skin = sides.iter().map(|s| s.mean_face_size(&m.coords)).filter(|&h| h > 0.0).fold(f64::INFINITY, f64::min);
         let skin = if skin.is_finite() { 0.25 * skin } else { 0.0 };
         let kappa_max = sides.iter().map(|s| s.kappa).fold(0.0, f64::max);
-        SurfaceContact { sides, nodes, x_ref: vec![], skin, kappa_max, builds: 0, dissipated: 0.0, stored: 0.0, initial: vec![] }
+        SurfaceContact { sides, nodes, x_ref: vec![], skin, kappa_max, builds: 0, dissipated: 0.0, stored: 0.0, initial: vec![], ..Default::default() }
     }
 
     pub fn is_empty(&self) -> bool {
@@ -644,9 +651,12 @@ impl SurfaceContact {
     /// energy and the dissipated work are booked.
     #[allow(clippy::too_many_arguments)]
     pub fn forces(&mut self, x: &[[f64; 3]], v: &[[f64; 3]], dt: f64, dt_prev: f64, fcon: &mut [[f64; 3]], touched: &mut Vec<usize>) {
+        let t0 = std::time::Instant::now();
         if self.stale(x) {
             self.rebuild(x);
         }
+        let t1 = std::time::Instant::now();
+        self.build_time += t1 - t0;
         let mut stored = 0.0;
         for s in &mut self.sides {
             s.narrow(x, v, dt, dt_prev, false);
@@ -669,6 +679,7 @@ impl SurfaceContact {
             }
         }
         self.stored = stored;
+        self.narrow_time += t1.elapsed();
     }
 
     /// A summary for reports.
@@ -684,6 +695,8 @@ impl SurfaceContact {
             deepest: deepest.map(|p| (p.contact_id, node_id[p.node], p.element, p.depth)),
             friction_work: self.dissipated,
             skin: self.skin,
+            build_seconds: self.build_time.as_secs_f64(),
+            narrow_seconds: self.narrow_time.as_secs_f64(),
         }
     }
 

@@ -1,0 +1,404 @@
+//! `woven`: the yarn-level plain-weave patch (the paper's §2 reference model; Barauskas &
+//! Abraitienė, IJIE 34(7), 2007): every yarn a band of orthotropic membrane quads whose
+//! nodal thickness follows the lenticular cross-section, warp along x, weft along y,
+//! crimped over and under each other, yarn–yarn contact with friction within and between
+//! layers, a rigid projectile against the band faces.
+//!
+//! Glossary: p yarn spacing; w, h yarn width and thickness; R = (w² + h²)/(4h) the radius
+//! of the two circular arcs of the lenticular section; t(y) = 2(√(R² − y²) − R + h/2) the
+//! thickness at distance y from the band's centre line (0 at the edges, h at the centre);
+//! A = 2[R² acos((R − h/2)/R) − (R − h/2)√(R² − (R − h/2)²)] its exact area (≈ (2/3)wh);
+//! a the crimp amplitude: the warp at y_j = jp follows z = (−1)^j a cos(πx/p), the weft at
+//! x_i = ip follows z = −(−1)^i a cos(πy/p), so that they alternate over and under at
+//! every crossing (a plain weave, symmetric about x = 0 and y = 0: the quarter model has
+//! symmetry planes there, through the centre lines of the middle yarns).
+//!
+//! Discretisation: `per_spacing` quads per spacing along, `across` quads across the width.
+//! A one-point quad takes the mean of its nodal thicknesses, which under-integrates the
+//! lenticular profile (by 25 % with 2 quads across, 6 % with 4): the nodal thicknesses are
+//! scaled by A/A_h so that the band's area, hence its mass and axial stiffness E·A, are
+//! exact; the contact envelope is then that much thicker at the centre line (reported as
+//! `thickness_scale`). Crimp: by default a = t_c/2 + 1 nm, with t_c the (scaled) centre
+//! thickness, so that crossing yarns just touch at their centre lines; a larger
+//! `crimp_amplitude` leaves a gap that a formed weave would close.
+//!
+//! What is not here yet: forming the weave by contact equilibrium and residual tension
+//! (the yarns start stress-free in the geometric crimp).
+
+use serde::Serialize;
+
+use crate::error::{Result, WeftError};
+use crate::model::contacts::{ContactDef, Slave};
+use crate::model::{Analysis, ElementKind, Model, PartProps, ProjectileShape, ProjectileSpec, SymmetryPlane};
+
+/// Edge condition of the yarn ends at the patch edge.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum Edge {
+    /// Every node of a yarn end held in x, y and z.
+    Clamped,
+    /// Only the centre-line node of a yarn end held (the band can turn about it).
+    Pinned,
+    /// Nothing held.
+    Free,
+}
+
+/// Parameters of the yarn-level patch; every default is a documented aramid plain weave
+/// (DESIGN.md §9, §12).
+#[derive(Debug, Clone, Serialize)]
+pub struct WovenBandParams {
+    /// Yarns per side: of the quarter (the middle yarn, on the symmetry plane, counted
+    /// once) or of the full patch (even).
+    pub yarns: usize,
+    /// Quarter model with symmetry planes x = 0, y = 0.
+    pub quarter: bool,
+    /// Yarn spacing p [m]: 1 mm, the reduced model's (10 yarns/cm; DESIGN §9: ≈ 8.5).
+    pub spacing: f64,
+    /// Yarn width w [m] and thickness h [m]: 0.8 mm × 0.124 mm, a lenticular area of
+    /// 6.6·10⁻⁸ m², the reduced model's yarn area (190 g/m² with p = 1 mm).
+    pub width: f64,
+    pub thickness: f64,
+    /// Crimp amplitude a [m] (None: crossing yarns just touch).
+    pub crimp_amplitude: Option<f64>,
+    /// Quads per spacing along a yarn (≥ 4) and across its width (≥ 2, even).
+    pub per_spacing: usize,
+    pub across: usize,
+    /// Yarn material: E along the yarn [Pa] (Kevlar 29 class, 70–90 GPa), E across and
+    /// the in-plane shear modulus [Pa] (a bundle of filaments: small; assumed E/50 and
+    /// E/100), density [kg/m³].
+    pub modulus: f64,
+    pub transverse_modulus: f64,
+    pub shear_modulus: f64,
+    pub density: f64,
+    /// Yarn–yarn Coulomb friction (DESIGN §9: 0.1–0.2).
+    pub friction: f64,
+    /// Layers, and the clearance between them [m].
+    pub layers: usize,
+    pub layer_gap: f64,
+    pub edge: Edge,
+    /// Projectile: 9 mm, 8 g, round-nosed at 400 m/s (DESIGN §9: 360–430 m/s); friction
+    /// against the yarns.
+    pub projectile_shape: ProjectileShape,
+    pub projectile_radius: f64,
+    pub projectile_mass: f64,
+    pub projectile_velocity: f64,
+    pub projectile_friction: f64,
+    /// Simulated time [s] (the paper's Fig. 4: 6·10⁻⁵ s) and output interval [s].
+    pub end_time: f64,
+    pub output_interval: f64,
+}
+
+impl Default for WovenBandParams {
+    fn default() -> Self {
+        WovenBandParams {
+            yarns: 10,
+            quarter: true,
+            spacing: 1e-3,
+            width: 0.8e-3,
+            thickness: 0.124e-3,
+            crimp_amplitude: None,
+            per_spacing: 4,
+            across: 2,
+            modulus: 80e9,
+            transverse_modulus: 1.6e9,
+            shear_modulus: 0.8e9,
+            density: 1440.0,
+            friction: 0.15,
+            layers: 1,
+            layer_gap: 0.01e-3,
+            edge: Edge::Clamped,
+            projectile_shape: ProjectileShape::Round,
+            projectile_radius: 4.5e-3,
+            projectile_mass: 8e-3,
+            projectile_velocity: 400.0,
+            projectile_friction: 0.1,
+            end_time: 6e-5,
+            output_interval: 1e-6,
+        }
+    }
+}
+
+/// The lenticular section: arc radius R, thickness at y, exact area.
+#[derive(Debug, Clone, Copy)]
+pub struct Lenticular {
+    pub w: f64,
+    pub h: f64,
+    pub r: f64,
+}
+
+impl Lenticular {
+    pub fn new(w: f64, h: f64) -> Lenticular {
+        Lenticular { w, h, r: (w * w + h * h) / (4.0 * h) }
+    }
+    /// t(y) = 2(√(R² − y²) − R + h/2), clamped at 0.
+    pub fn thickness(&self, y: f64) -> f64 {
+        let y = y.abs().min(0.5 * self.w);
+        (2.0 * ((self.r * self.r - y * y).sqrt() - self.r + 0.5 * self.h)).max(0.0)
+    }
+    /// Exact area of the two circular segments of chord w and height h/2.
+    pub fn area(&self) -> f64 {
+        let d = self.r - 0.5 * self.h;
+        2.0 * (self.r * self.r * (d / self.r).acos() - d * (self.r * self.r - d * d).sqrt())
+    }
+}
+
+/// What the generator reports besides the model.
+#[derive(Debug, Clone)]
+pub struct WovenInfo {
+    /// Nodal thickness scale A/A_h (see the module docs).
+    pub thickness_scale: f64,
+    /// Crimp amplitude used [m] and the resulting crimp (path length/spacing − 1).
+    pub crimp_amplitude: f64,
+    pub crimp: f64,
+    /// Exact section area [m²] and areal density of one layer [kg/m²].
+    pub area: f64,
+    pub areal_density: f64,
+}
+
+fn check(p: &WovenBandParams) -> Result<()> {
+    let bad = |name: &str, v: String, exp: &str| Err(WeftError::input(format!("--{name} = `{v}`")).expected(exp.to_string()));
+    for (n, v) in [
+        ("spacing", p.spacing),
+        ("width", p.width),
+        ("thickness", p.thickness),
+        ("modulus", p.modulus),
+        ("transverse-modulus", p.transverse_modulus),
+        ("shear-modulus", p.shear_modulus),
+        ("density", p.density),
+        ("projectile-radius", p.projectile_radius),
+        ("projectile-mass", p.projectile_mass),
+        ("end-time", p.end_time),
+        ("output-interval", p.output_interval),
+    ] {
+        if !(v > 0.0 && v.is_finite()) {
+            return bad(n, v.to_string(), "a finite value > 0");
+        }
+    }
+    if p.yarns == 0 || (!p.quarter && p.yarns % 2 != 0) {
+        return bad("yarns", p.yarns.to_string(), "≥ 1 (quarter), or even ≥ 2 (full patch)");
+    }
+    if p.width >= p.spacing {
+        return Err(WeftError::input(format!("yarn width {} m is not below the spacing {} m", p.width, p.spacing))
+            .expected("w < p: neighbouring yarns would overlap")
+            .hint("lower --width or raise --spacing"));
+    }
+    if p.thickness >= p.width {
+        return Err(WeftError::input(format!("yarn thickness {} m is not below its width {} m", p.thickness, p.width))
+            .expected("h < w: a lenticular section is flatter than a circle"));
+    }
+    if p.per_spacing < 4 || p.per_spacing % 2 != 0 {
+        return bad("per-spacing", p.per_spacing.to_string(), "an even number ≥ 4 (a node at every crossing and midway)");
+    }
+    if p.across < 2 || p.across % 2 != 0 {
+        return bad("across", p.across.to_string(), "an even number ≥ 2 (a node on the centre line)");
+    }
+    if p.layers == 0 {
+        return bad("layers", "0".into(), "≥ 1");
+    }
+    if !(p.friction >= 0.0 && p.projectile_friction >= 0.0 && p.layer_gap >= 0.0) {
+        return bad("friction", format!("{}, {}, gap {}", p.friction, p.projectile_friction, p.layer_gap), "friction and the layer gap ≥ 0");
+    }
+    if !(p.projectile_velocity.is_finite() && p.projectile_velocity >= 0.0) {
+        return bad("projectile-velocity", p.projectile_velocity.to_string(), "a speed ≥ 0 in m/s");
+    }
+    Ok(())
+}
+
+/// The yarn-level patch and what was derived.
+pub fn woven(p: &WovenBandParams) -> Result<(Model, WovenInfo)> {
+    check(p)?;
+    let lens = Lenticular::new(p.width, p.thickness);
+    // Offsets across the band and the trapezoid area of the nodal profile.
+    let na = p.across;
+    let offs: Vec<f64> = (0..=na).map(|k| -0.5 * p.width + p.width * k as f64 / na as f64).collect();
+    let t_raw: Vec<f64> = offs.iter().map(|&y| lens.thickness(y)).collect();
+    let dy = p.width / na as f64;
+    let a_trap: f64 = (0..na).map(|k| 0.5 * dy * (t_raw[k] + t_raw[k + 1])).sum();
+    let scale = lens.area() / a_trap;
+    let t_node: Vec<f64> = t_raw.iter().map(|t| t * scale).collect();
+    let t_centre = t_node[na / 2];
+    let amp = p.crimp_amplitude.unwrap_or(0.5 * t_centre + 1e-9);
+    if amp < 0.5 * t_centre {
+        return Err(WeftError::input(format!("--crimp-amplitude = `{amp}` m is below half the yarns' centre thickness {:.4e} m", 0.5 * t_centre))
+            .expected("a ≥ t_c/2: crossing yarns would start inside each other")
+            .hint("leave --crimp-amplitude out for yarns that just touch"));
+    }
+    // Layer pitch: a layer spans ±(a + t_c/2) about its mid-plane.
+    let pitch = 2.0 * amp + t_centre + p.layer_gap;
+    if p.layers > 1 && p.layer_gap <= 0.0 {
+        return Err(WeftError::input("layers touch: --layer-gap is 0".to_string()).expected("a gap > 0 between layers"));
+    }
+    let k_c = std::f64::consts::PI * amp / p.spacing;
+    // Crimp of z = a cos(πx/p): ∫₀^p √(1 + k² sin²) dx / p − 1, by Simpson's rule.
+    let crimp = {
+        let n = 2000;
+        let f = |x: f64| (1.0 + (k_c * (std::f64::consts::PI * x).sin()).powi(2)).sqrt();
+        let s: f64 = (0..=n).map(|i| {
+            let w = if i == 0 || i == n { 1.0 } else if i % 2 == 1 { 4.0 } else { 2.0 };
+            w * f(i as f64 / n as f64)
+        }).sum();
+        s / (3.0 * n as f64) - 1.0
+    };
+
+    let mut m = Model::default();
+    let (first, last) = if p.quarter { (0i64, p.yarns as i64 - 1) } else { (-(p.yarns as i64) / 2, p.yarns as i64 / 2 - 1) };
+    // Yarn centre lines at j·p (quarter) or (j + ½)·p (full, no yarn on x = 0).
+    let centre = |j: i64| if p.quarter { j as f64 * p.spacing } else { (j as f64 + 0.5) * p.spacing };
+    let sign = |j: i64| if j.rem_euclid(2) == 0 { 1.0 } else { -1.0 };
+    let (lo, hi) = if p.quarter { (0.0, (p.yarns as f64 - 0.5) * p.spacing) } else { (-(p.yarns as f64) * 0.5 * p.spacing, p.yarns as f64 * 0.5 * p.spacing) };
+    let n_along = ((hi - lo) / p.spacing * p.per_spacing as f64).round() as usize;
+    let props = |angle: f64| PartProps {
+        youngs_modulus_1: Some(p.modulus),
+        youngs_modulus_2: Some(p.transverse_modulus),
+        shear_modulus_12: Some(p.shear_modulus),
+        poisson_ratio_12: Some(0.0),
+        density: Some(p.density),
+        thickness: Some(t_centre),
+        material_angle: Some(angle),
+        // A yarn is a bundle of filaments: it buckles rather than carry compression.
+        no_compression: Some(true),
+        ..Default::default()
+    };
+    // Along-index of each crossing: the other family's yarn centre lines.
+    let crossing_at: std::collections::BTreeMap<usize, i64> = (first..=last)
+        .map(|jj| (((centre(jj) - lo) / p.spacing * p.per_spacing as f64).round() as usize, jj))
+        .collect();
+    let (mut nid, mut eid) = (0i64, 0i64);
+    let mut parts = vec![];
+    let mut axis_x = vec![];
+    let mut axis_x_weft = vec![];
+    let mut diagonal = vec![];
+    let mut diagonal_weft = vec![];
+    let mut edge_nodes = vec![];
+    let mut top = f64::NEG_INFINITY;
+    for layer in 0..p.layers {
+        let zl = -(layer as f64) * pitch;
+        let warp = m.add_part(2 * layer as i64 + 1, &format!("warp_{}", layer + 1), ElementKind::Quad, props(0.0));
+        let weft = m.add_part(2 * layer as i64 + 2, &format!("weft_{}", layer + 1), ElementKind::Quad, props(std::f64::consts::FRAC_PI_2));
+        parts.push((warp, weft));
+        for (fam, part) in [(0, warp), (1, weft)] {
+            for j in first..=last {
+                let c = centre(j);
+                // Across offsets: a yarn on a symmetry plane keeps its upper half.
+                let k0 = if p.quarter && j == 0 { na / 2 } else { 0 };
+                let mut idx = vec![vec![usize::MAX; na + 1]; n_along + 1];
+                for i in 0..=n_along {
+                    let s = lo + (hi - lo) * i as f64 / n_along as f64;
+                    // Warp (fam 0) follows (−1)^j a cos(πx/p); weft −(−1)^j a cos(πy/p).
+                    let z = zl + if fam == 0 { sign(j) } else { -sign(j) } * amp * (std::f64::consts::PI * s / p.spacing).cos();
+                    top = top.max(z + 0.5 * t_centre);
+                    for k in k0..=na {
+                        let r = c + offs[k];
+                        let x = if fam == 0 { [s, r, z] } else { [r, s, z] };
+                        nid += 1;
+                        let n = m.add_node(nid, x);
+                        idx[i][k] = n;
+                        let at_edge = (i == n_along) || (!p.quarter && i == 0);
+                        if at_edge {
+                            edge_nodes.push(n);
+                            let hold = match p.edge {
+                                Edge::Clamped => true,
+                                Edge::Pinned => k == na / 2,
+                                Edge::Free => false,
+                            };
+                            if hold {
+                                m.constraints.push((n, [true, true, true]));
+                            }
+                        }
+                    }
+                    // Crossing nodes: the centre-line node at each crossing position.
+                    if let Some(&other) = crossing_at.get(&i) {
+                        if layer == 0 {
+                            let n = idx[i][na / 2];
+                            // The x axis line: the warp j = 0 and the wefts where they cross it.
+                            if fam == 0 && j == 0 {
+                                axis_x.push(n);
+                            }
+                            if fam == 1 && other == 0 {
+                                axis_x_weft.push(n);
+                            }
+                            if other == j {
+                                if fam == 0 { diagonal.push(n) } else { diagonal_weft.push(n) }
+                            }
+                        }
+                    }
+                }
+                for i in 0..n_along {
+                    for k in k0..na {
+                        eid += 1;
+                        let q = if fam == 0 {
+                            [idx[i][k], idx[i + 1][k], idx[i + 1][k + 1], idx[i][k + 1]]
+                        } else {
+                            [idx[i][k], idx[i][k + 1], idx[i + 1][k + 1], idx[i + 1][k]]
+                        };
+                        let t = if fam == 0 {
+                            [t_node[k], t_node[k], t_node[k + 1], t_node[k + 1]]
+                        } else {
+                            [t_node[k], t_node[k + 1], t_node[k + 1], t_node[k]]
+                        };
+                        m.add_element_with_thickness(eid, part, &q, &t);
+                    }
+                }
+            }
+        }
+    }
+    // Contact: warp against weft in each layer, and every yarn of a layer against every
+    // yarn of the next; all two-way, with yarn–yarn friction.
+    let mut cid = 0;
+    let mut contact = |m: &mut Model, a: usize, b: usize| {
+        cid += 1;
+        let mut c = ContactDef::new(cid, Slave::Part(a), b).with_friction(p.friction);
+        c.two_way = true;
+        m.contacts.push(c);
+    };
+    for l in 0..p.layers {
+        let (w, f) = parts[l];
+        contact(&mut m, f, w);
+        if l + 1 < p.layers {
+            let (w2, f2) = parts[l + 1];
+            for a in [w, f] {
+                for b in [w2, f2] {
+                    contact(&mut m, b, a);
+                }
+            }
+        }
+    }
+    if p.quarter {
+        for normal in [0, 1] {
+            m.symmetry.push(SymmetryPlane { normal, position: 0.0, tolerance: 1e-9 });
+        }
+    }
+    let share = if p.quarter { 0.25 } else { 1.0 };
+    m.projectiles.push(ProjectileSpec {
+        id: 1,
+        shape: p.projectile_shape,
+        radius: p.projectile_radius,
+        length: 2.0 * p.projectile_radius,
+        mass: share * p.projectile_mass,
+        tip: [0.0, 0.0, top + 1e-6],
+        axis: [0.0, 0.0, -1.0],
+        velocity: [0.0, 0.0, -p.projectile_velocity],
+        prescribed_velocity: false,
+        contact_stiffness: None,
+        friction: p.projectile_friction,
+        segment_contact: true,
+    });
+    m.node_sets.insert("axis_x".into(), axis_x);
+    m.node_sets.insert("axis_x_weft".into(), axis_x_weft);
+    m.node_sets.insert("diagonal".into(), diagonal);
+    m.node_sets.insert("diagonal_weft".into(), diagonal_weft);
+    edge_nodes.sort_unstable();
+    m.node_sets.insert("edge".into(), edge_nodes);
+    m.analysis = Analysis {
+        end_time: p.end_time,
+        output_interval: p.output_interval,
+        history_sets: vec!["axis_x".into(), "axis_x_weft".into(), "diagonal".into(), "diagonal_weft".into()],
+        ..Analysis::default()
+    };
+    m.validate()?;
+    let area = lens.area();
+    Ok((
+        m,
+        WovenInfo { thickness_scale: scale, crimp_amplitude: amp, crimp, area, areal_density: 2.0 * p.density * area * (1.0 + crimp) / p.spacing },
+    ))
+}

@@ -1,0 +1,274 @@
+//! The yarn-level woven patch (`weft-weave woven`, `generate::woven`): yarns as bands of
+//! orthotropic membranes with the lenticular nodal thickness, in contact.
+//!
+//! Oracles:
+//! - the lenticular section (two circular segments of chord w and height h/2): area
+//!   2[R² acos((R − h/2)/R) − (R − h/2)√(R² − (R − h/2)²)], R = (w² + h²)/(4h) (circular
+//!   segment, e.g. Zwillinger, *CRC Standard Mathematical Tables*, §4.5); a plain weave's
+//!   areal density 2ρA(1 + c)/p with c the crimp of z = a cos(πx/p);
+//! - Smith's transverse impact of a yarn (Smith, McCrackin, Schiefer, Textile Res. J. 28,
+//!   1958): strain ε and kink speed U = c(√(ε(1+ε)) − ε) for V = c√(2ε√(ε(1+ε)) − ε²),
+//!   now for a band of membrane quads instead of trusses;
+//! - energy conservation with yarn–yarn contact and friction in an impact.
+
+mod common;
+use common::rel;
+use weft::generate::woven::{woven, Lenticular, WovenBandParams};
+use weft::model::{Analysis, ElementKind, Model, PartProps, ProjectileShape, ProjectileSpec};
+use weft::solver::{run_in_memory, Solver};
+
+#[test]
+fn lenticular_section_and_areal_density_match_their_closed_forms() {
+    let p = WovenBandParams::default();
+    let lens = Lenticular::new(p.width, p.thickness);
+    // Thickness: h at the centre line, 0 at the edges; area ≈ (2/3)wh (DESIGN §12).
+    assert!(rel(lens.thickness(0.0), p.thickness) < 1e-12);
+    assert!(lens.thickness(0.5 * p.width).abs() < 1e-12);
+    assert!(rel(lens.area(), 2.0 / 3.0 * p.width * p.thickness) < 0.01, "area {}", lens.area());
+    let (m, info) = woven(&p).unwrap();
+    // The band's area, summed from its quads (width × mean nodal thickness), is the exact
+    // lenticular area: the nodal thickness is scaled for it.
+    let b = &m.elements[&ElementKind::Quad];
+    let along = p.spacing / p.per_spacing as f64;
+    let _ = along;
+    // Mass of the quarter against 2ρA(1 + c)/p over the quarter patch [0, (n − ½)p]².
+    let s = Solver::new(&m).unwrap();
+    let side = (p.yarns as f64 - 0.5) * p.spacing;
+    let areal = s.physical_mass / (side * side);
+    let closed = 2.0 * p.density * lens.area() * (1.0 + info.crimp) / p.spacing;
+    println!(
+        "areal density {:.3} g/m² vs closed form {:.3} g/m² ({:.2e}); thickness scale {:.4}, crimp {:.3} %, {} quads",
+        1e3 * areal,
+        1e3 * closed,
+        rel(areal, closed),
+        info.thickness_scale,
+        100.0 * info.crimp,
+        b.len()
+    );
+    // Measured 2.6e-5: flat quads follow the crimped path by chords.
+    assert!(rel(areal, closed) < 1e-3);
+    // Crossing node sets: the warp's centre-line nodes at x = i p on y = 0, and at (i p, i p).
+    let ax = &m.node_sets["axis_x"];
+    assert_eq!(ax.len(), p.yarns);
+    for (i, &n) in ax.iter().enumerate() {
+        let x = m.coords[n];
+        assert!((x[0] - i as f64 * p.spacing).abs() < 1e-12 && x[1].abs() < 1e-12, "{x:?}");
+    }
+    let dg = &m.node_sets["diagonal"];
+    assert_eq!(dg.len(), p.yarns);
+    for (i, &n) in dg.iter().enumerate() {
+        let x = m.coords[n];
+        assert!((x[0] - i as f64 * p.spacing).abs() < 1e-12 && (x[1] - i as f64 * p.spacing).abs() < 1e-12, "{x:?}");
+    }
+    // At every crossing the warp and weft centre lines are one centre thickness apart.
+    let dw = &m.node_sets["diagonal_weft"];
+    for (&a, &b) in dg.iter().zip(dw) {
+        let gap = (m.coords[a][2] - m.coords[b][2]).abs();
+        assert!(rel(gap, 2.0 * info.crimp_amplitude) < 1e-9, "gap {gap}");
+    }
+}
+
+#[test]
+fn impossible_geometry_is_refused_with_the_parameter_named() {
+    let bad = |p: WovenBandParams, frag: &str| {
+        let e = woven(&p).err().expect("an error").to_string();
+        assert!(e.contains(frag), "`{frag}` not in: {e}");
+    };
+    let d = WovenBandParams::default;
+    bad(WovenBandParams { width: 1.2e-3, ..d() }, "not below the spacing");
+    bad(WovenBandParams { thickness: 0.9e-3, ..d() }, "not below its width");
+    bad(WovenBandParams { yarns: 0, ..d() }, "--yarns");
+    bad(WovenBandParams { crimp_amplitude: Some(1e-5), ..d() }, "--crimp-amplitude");
+    bad(WovenBandParams { across: 3, ..d() }, "--across");
+    bad(WovenBandParams { layers: 2, layer_gap: 0.0, ..d() }, "--layer-gap");
+}
+
+/// A straight band of the default section along x on ±half, ends pinned, every node held
+/// in y (a 1-D yarn, as Smith's), hit at the middle by a flat nose at constant V.
+fn band(half: f64, along: f64) -> (Model, usize, usize) {
+    let p = WovenBandParams::default();
+    let lens = Lenticular::new(p.width, p.thickness);
+    let na = 2;
+    let offs: Vec<f64> = (0..=na).map(|k| -0.5 * p.width + p.width * k as f64 / na as f64).collect();
+    let t: Vec<f64> = offs.iter().map(|&y| lens.thickness(y)).collect();
+    let trap: f64 = (0..na).map(|k| 0.25 * p.width * (t[k] + t[k + 1])).sum();
+    let t: Vec<f64> = t.iter().map(|x| x * lens.area() / trap).collect();
+    let mut m = Model::default();
+    let part = m.add_part(
+        1,
+        "yarn",
+        ElementKind::Quad,
+        PartProps {
+            youngs_modulus_1: Some(p.modulus),
+            youngs_modulus_2: Some(p.transverse_modulus),
+            shear_modulus_12: Some(p.shear_modulus),
+            density: Some(p.density),
+            thickness: Some(t[1]),
+            no_compression: Some(true),
+            ..Default::default()
+        },
+    );
+    let n = (2.0 * half / along).round() as usize;
+    let mut idx = vec![[0usize; 3]; n + 1];
+    for i in 0..=n {
+        for k in 0..=na {
+            let node = m.add_node((i * 3 + k) as i64 + 1, [-half + i as f64 * along, offs[k], 0.0]);
+            idx[i][k] = node;
+            m.constraints.push((node, [i == 0 || i == n, true, i == 0 || i == n]));
+        }
+    }
+    for i in 0..n {
+        for k in 0..na {
+            m.add_element_with_thickness(
+                (i * na + k) as i64 + 1,
+                part,
+                &[idx[i][k], idx[i + 1][k], idx[i + 1][k + 1], idx[i][k + 1]],
+                &[t[k], t[k], t[k + 1], t[k + 1]],
+            );
+        }
+    }
+    let centre: Vec<usize> = (0..=n).map(|i| idx[i][1]).collect();
+    m.node_sets.insert("centre".into(), centre);
+    m.analysis.history_sets = vec!["centre".into()];
+    (m, n, part)
+}
+
+/// Smith's theory for a yarn of nominal stress P(ε) (Smith, McCrackin, Schiefer 1958 treat
+/// any stress–strain curve): the longitudinal front leaves the particle velocity
+/// w = ∫₀^ε √(P′(s)/ρ) ds; the kink travels at U_L = √(P/(ρ(1 + ε))) in the material,
+/// U_lab = U_L(1 + ε) − w in the lab, and the transverse velocity behind it is
+/// V = √(2 U_L(1 + ε) w − w²). For P = Eε this is Smith's closed form. A St Venant–
+/// Kirchhoff membrane stretched along its fibres (ν₁₂ = 0) has S = E·(λ² − 1)/2, so
+/// P = λS = E(1 + ε)(ε + ε²/2): 1.5 ε stiffer than linear, a 1 % lower strain at
+/// 300 m/s, which this oracle accounts for.
+fn smith_general(p: impl Fn(f64) -> f64, rho: f64, v: f64) -> (f64, f64) {
+    let dp = |s: f64| (p(s + 1e-9) - p(s - 1e-9)) / 2e-9;
+    let w_of = |e: f64| {
+        let n = 400;
+        (0..=n)
+            .map(|i| {
+                let s = (e * i as f64 / n as f64).max(1e-12);
+                let wt = if i == 0 || i == n { 1.0 } else if i % 2 == 1 { 4.0 } else { 2.0 };
+                wt * (dp(s) / rho).sqrt()
+            })
+            .sum::<f64>()
+            * e
+            / (3.0 * n as f64)
+    };
+    let v_of = |e: f64| {
+        let ul = (p(e) / (rho * (1.0 + e))).sqrt() * (1.0 + e);
+        let w = w_of(e);
+        ((2.0 * ul * w - w * w).max(0.0).sqrt(), ul - w)
+    };
+    let (mut lo, mut hi) = (1e-5, 0.1);
+    for _ in 0..100 {
+        let mid = 0.5 * (lo + hi);
+        if v_of(mid).0 < v { lo = mid } else { hi = mid }
+    }
+    let e = 0.5 * (lo + hi);
+    (e, v_of(e).1)
+}
+
+#[test]
+fn smith_transverse_impact_of_a_band() {
+    let p = WovenBandParams::default();
+    let c = (p.modulus / p.density).sqrt();
+    let v = 300.0;
+    // The general oracle reproduces Smith's closed form for the linear law.
+    let (e_lin, u_lin) = smith_general(|e| p.modulus * e, p.density, v);
+    assert!(rel(e_lin, 0.008947) < 1e-3 && rel(u_lin, c * ((e_lin * (1.0 + e_lin)).sqrt() - e_lin)) < 1e-6, "{e_lin} {u_lin}");
+    let (eps, u_lab) = smith_general(|e| p.modulus * (1.0 + e) * (e + 0.5 * e * e), p.density, v);
+    let (half, along) = (0.16, 1e-4);
+    let (mut m, n, _) = band(half, along);
+    m.projectiles.push(ProjectileSpec {
+        id: 1,
+        shape: ProjectileShape::Flat,
+        radius: 0.6e-3,
+        length: 2e-3,
+        mass: 1.0,
+        tip: [0.0, 0.0, 0.0],
+        axis: [0.0, 0.0, -1.0],
+        velocity: [0.0, 0.0, -v],
+        prescribed_velocity: true,
+        contact_stiffness: None,
+        friction: 0.0,
+        segment_contact: true,
+    });
+    let t_end = 20e-6;
+    m.analysis.end_time = t_end;
+    m.analysis.output_interval = 0.1e-6;
+    let (_s, out, stats) = run_in_memory(&m).unwrap();
+    let mid = n / 2;
+    let node = |x: f64| mid + (x / along).round() as usize;
+    let last = out.u.len() - 1;
+    let (a, b) = (node(0.04), node(0.10));
+    let strain = (out.u[last][b][0] - out.u[last][a][0]) / 0.06;
+    // The kink at time index k: behind it the yarn is straight and inclined, so fit
+    // w = −u_z against the lab position x = X + u_x over the nodes at 20–80 % of the
+    // largest w (x > 0), and take where the line meets w = 0.
+    let kink = |k: usize| -> (f64, f64) {
+        let pts: Vec<(f64, f64)> = (mid..=n)
+            .map(|j| (j as f64 * along - half + out.u[k][j][0], -out.u[k][j][2]))
+            .collect();
+        let wmax = pts.iter().map(|p| p.1).fold(0.0, f64::max);
+        let sel: Vec<&(f64, f64)> = pts.iter().filter(|p| p.1 > 0.2 * wmax && p.1 < 0.8 * wmax).collect();
+        let nn = sel.len() as f64;
+        let (sx, sy) = (sel.iter().map(|p| p.0).sum::<f64>() / nn, sel.iter().map(|p| p.1).sum::<f64>() / nn);
+        let sxy: f64 = sel.iter().map(|p| (p.0 - sx) * (p.1 - sy)).sum();
+        let sxx: f64 = sel.iter().map(|p| (p.0 - sx) * (p.0 - sx)).sum();
+        let slope = sxy / sxx;
+        (out.t[k], sx - sy / slope)
+    };
+    let (ta, xa) = kink(out.t.iter().position(|&t| t >= 0.5 * t_end).unwrap());
+    let (tb, xb) = kink(last);
+    let u = (xb - xa) / (tb - ta);
+    println!(
+        "Smith, band (St Venant–Kirchhoff law): strain {:.5} % vs {:.5} % ({:.2e}), kink speed {u:.1} vs {u_lab:.1} m/s ({:.2e}); linear law: {:.5} %, {u_lin:.1} m/s; energy balance {:.2e}",
+        100.0 * strain,
+        100.0 * eps,
+        rel(strain, eps),
+        rel(u, u_lab),
+        100.0 * e_lin,
+        stats.max_balance_error_relative
+    );
+    // Measured: strain 1.0e-3, kink speed 5.8e-3 (the issue asks 1 %).
+    assert!(rel(strain, eps) < 0.01, "strain {strain} vs Smith {eps}");
+    assert!(rel(u, u_lab) < 0.01, "kink speed {u} vs Smith {u_lab}");
+}
+
+#[test]
+fn a_woven_patch_impact_keeps_its_energy_and_is_thread_independent() {
+    let p = WovenBandParams { yarns: 6, end_time: 6e-6, output_interval: 2e-7, ..WovenBandParams::default() };
+    let (m, _) = woven(&p).unwrap();
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        pool.install(|| {
+            let (s, out, stats) = run_in_memory(&m).unwrap();
+            let rep = s.op.surfaces.report(&s.node_id);
+            (out.u, out.energy, out.projectile, rep, stats)
+        })
+    };
+    let (u1, e1, p1, rep, stats) = run(1);
+    let (u2, e2, p2, _, _) = run(2);
+    let last = e1.last().unwrap();
+    let ke0 = 0.5 * 0.25 * p.projectile_mass * p.projectile_velocity.powi(2);
+    println!(
+        "woven 6×6 quarter, 6 µs: {} slaves in contact, friction work {:.3e} J ({:.2e} of the projectile's energy), contact {:.3e} J, internal {:.3e} J, balance {:.2e}; {} initial penetrations (deepest {:?})",
+        rep.active,
+        rep.friction_work,
+        rep.friction_work / ke0,
+        last.contact,
+        last.internal,
+        stats.max_balance_error_relative,
+        rep.initial_penetrations,
+        rep.deepest
+    );
+    assert!(u1 == u2 && e1 == e2 && p1 == p2, "1 and 2 threads differ");
+    // Measured 3e-4; the issue asks ≤ 1 % with contact and friction.
+    assert!(stats.max_balance_error_relative < 0.01);
+    assert!(rep.friction_work > 0.0 && rep.active > 0);
+    // The projectile has slowed down, by what the fabric took.
+    let vz = p1.last().unwrap().2[5];
+    assert!(vz > -p.projectile_velocity && vz < 0.0, "projectile vz {vz}");
+    let _ = Analysis::default();
+}
