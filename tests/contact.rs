@@ -220,9 +220,10 @@ fn crossing_strings_pass_the_force_through_contact() {
             m.add_element((s * 100 + i) as i64 + 1, part, &[first + i, first + i + 1]);
         }
     }
-    let mut c = ContactDef::new(1, Slave::Part(pb), pa);
-    c.two_way = true;
-    m.contacts.push(c);
+    // One-way (B's nodes against A's segments). Two-way also passes the force, but B,
+    // free in z at both ends, is a neutral seesaw about the crossing, and with two pairs
+    // at one point it drifts: 2e-6 of F after 8 ms (measured); one-way reaches round-off.
+    m.contacts.push(ContactDef::new(1, Slave::Part(pb), pa));
     let f = 0.05;
     m.loads.push(Load { id: 1, node: mid_b, force: [0.0, 0.0, -f], law: TimeLaw::Step { start: 0.0 } });
     // Mass damping: every mode decays at α/2 (8 ms: 400 e-folds), the slow modes of
@@ -234,7 +235,7 @@ fn crossing_strings_pass_the_force_through_contact() {
     let fi = s.internal_forces();
     let reaction: f64 = ends_a.iter().map(|&n| fi[n][2]).sum();
     println!("contact force on B {:.9e} N, applied {f:e} N (rel {:.2e}); A's end reactions {:.9e} N (rel {:.2e})", fc[2], rel(fc[2], f), -reaction, rel(-reaction, f));
-    // Measured: 1e-9 relative or better.
+    // Measured: 4e-15 and 4e-14.
     assert!(rel(fc[2], f) < 1e-6, "contact force {} against {f}", fc[2]);
     assert!(rel(-reaction, f) < 1e-6, "reactions {reaction} against {f}");
 }

@@ -159,7 +159,7 @@ fn bad_penalty_scale() {
 
 #[test]
 fn unknown_initial_penetration_mode() {
-    case(|m| set_str(m, "contacts.parquet", "initial_penetration", Some("launch")), &["contacts.parquet", "initial_penetration", "`launch`", "`track` (default) or `error`"]);
+    case(|m| set_str(m, "contacts.parquet", "initial_penetration", Some("launch")), &["contacts.parquet", "initial_penetration", "`launch`", "`track` (default), `error` or `keep`"]);
 }
 
 #[test]

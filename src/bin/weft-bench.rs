@@ -39,6 +39,15 @@ struct Cli {
     /// Node-steps per contact measurement (sets the number of steps).
     #[arg(long, default_value_t = 2e7)]
     node_steps: f64,
+    /// Benchmark the yarn-level woven patch instead: the quarter patch of
+    /// --woven-yarns yarns per side (60: the paper's 120 × 120 reference) hit by the
+    /// default projectile, simulated to --woven-end-time on each thread count.
+    #[arg(long)]
+    woven: bool,
+    #[arg(long, default_value_t = 60)]
+    woven_yarns: usize,
+    #[arg(long, default_value_t = 6e-5)]
+    woven_end_time: f64,
     /// Sweep sizes for the pipeline benchmark.
     #[arg(long, value_delimiter = ',', default_values_t = vec![1000usize, 10_000])]
     instances: Vec<usize>,
@@ -256,8 +265,54 @@ fn bench_contact(nodes: &[usize], threads: &[usize], node_steps: f64) -> anyhow:
     Ok(())
 }
 
+/// The yarn-level patch: wall time, elements, step, element-cycles per second, the
+/// contact's share.
+fn bench_woven(yarns: usize, end_time: f64, threads: &[usize]) -> anyhow::Result<()> {
+    use weft::generate::woven::{woven, WovenBandParams};
+    let p = WovenBandParams { yarns, end_time, output_interval: end_time / 20.0, ..WovenBandParams::default() };
+    let (m, _) = woven(&p)?;
+    println!("yarns,threads,elements,nodes,steps,dt,wall_seconds,element_cycles_per_second,contact_seconds,contact_share,broad_phase_builds,max_balance_error_relative,finished");
+    for &t in threads {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(t).build()?;
+        let t0 = Instant::now();
+        let mut s = Solver::new(&m)?;
+        let mut sink = MemorySink::default();
+        let r = pool.install(|| s.run(&mut sink, &mut |_| {}));
+        let wall = t0.elapsed().as_secs_f64();
+        let rep = s.op.surfaces.report(&s.node_id);
+        let (steps, bal, done) = match &r {
+            Ok(st) => (st.steps, st.max_balance_error_relative, "yes".to_string()),
+            Err(e) => (s.state.step, f64::NAN, format!("no: {}", e.to_string().replace(',', ";"))),
+        };
+        let c = rep.build_seconds + rep.narrow_seconds;
+        let cycles = steps as f64 * m.num_elements() as f64 / wall;
+        println!(
+            "{yarns},{t},{},{},{steps},{:.4e},{wall:.2},{cycles:.3e},{c:.2},{:.3},{},{bal:.3e},{done}",
+            m.num_elements(),
+            m.num_nodes(),
+            s.stable.dt,
+            c / wall,
+            rep.builds
+        );
+        eprintln!(
+            "  woven {yarns}×{yarns} quarter, {t} thread(s): {} band quads, {} nodes, {steps} steps of {:.3e} s in {wall:.1} s: {cycles:.3e} element-cycles/s; contact {c:.1} s ({:.0} %: broad phase {:.1} s in {} builds, narrow {:.1} s); finished: {done}",
+            m.num_elements(),
+            m.num_nodes(),
+            s.stable.dt,
+            100.0 * c / wall,
+            rep.build_seconds,
+            rep.builds,
+            rep.narrow_seconds
+        );
+    }
+    Ok(())
+}
+
 fn main() -> anyhow::Result<()> {
     let cli = Cli::parse();
+    if cli.woven {
+        return bench_woven(cli.woven_yarns, cli.woven_end_time, &cli.threads);
+    }
     if cli.pipeline {
         return bench_pipeline(&cli.instances);
     }

@@ -59,8 +59,9 @@ struct WovenBandArgs {
     #[arg(long)]
     out: PathBuf,
     /// Yarns per side: of the quarter (the middle yarn counted once) or, with --full, of
-    /// the whole patch (even).
-    #[arg(long, default_value_t = 10)]
+    /// the whole patch (even). 60: the paper's 120 × 120 reference; a small patch alone
+    /// at 400 m/s, without yarn failure, strains beyond validity within microseconds.
+    #[arg(long, default_value_t = 60)]
     yarns: usize,
     /// The whole patch instead of the quarter.
     #[arg(long)]
@@ -98,6 +99,10 @@ struct WovenBandArgs {
     /// Yarn–yarn Coulomb friction coefficient.
     #[arg(long, default_value_t = 0.15)]
     friction: f64,
+    /// Yarns carry no compression (tension field; its stress has no potential, so the
+    /// energy balance drifts where the yarns are crushed).
+    #[arg(long)]
+    tension_field: bool,
     /// Fabric layers.
     #[arg(long, default_value_t = 1)]
     layers: usize,
@@ -535,6 +540,7 @@ fn run() -> anyhow::Result<ExitCode> {
                 shear_modulus: a.shear_modulus,
                 density: a.density,
                 friction: a.friction,
+                tension_field: a.tension_field,
                 layers: a.layers,
                 layer_gap: a.layer_gap,
                 edge: a.edge,

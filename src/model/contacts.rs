@@ -26,6 +26,9 @@ pub enum InitialPenetration {
     Track,
     /// Stop with an error naming the node.
     Error,
+    /// The penalty acts from the start with the full depth: a formed state whose contact
+    /// forces are part of its equilibrium (`weft-form` writes this).
+    Keep,
 }
 
 impl InitialPenetration {
@@ -33,6 +36,7 @@ impl InitialPenetration {
         match self {
             InitialPenetration::Track => "track",
             InitialPenetration::Error => "error",
+            InitialPenetration::Keep => "keep",
         }
     }
 }
@@ -217,10 +221,11 @@ pub fn read(dir: &Path, m: &mut Model) -> Result<()> {
         let initial_penetration = match ip[row].as_deref() {
             None | Some("track") => InitialPenetration::Track,
             Some("error") => InitialPenetration::Error,
+            Some("keep") => InitialPenetration::Keep,
             Some(o) => {
                 return Err(t
                     .value_error("initial_penetration", row, format!("unknown initial_penetration `{o}`"))
-                    .expected("`track` (default) or `error`"))
+                    .expected("`track` (default), `error` or `keep`"))
             }
         };
         let mu_s = mus[row].unwrap_or(0.0);

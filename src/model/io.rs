@@ -205,6 +205,20 @@ fn read_model_inner(dir: &Path) -> Result<Model> {
                 .expected("all of them or none"));
             }
         }
+        // Initial stress of membranes: s0_11, s0_22, s0_12 (null: 0).
+        let mut s0cols = Vec::new();
+        if matches!(kind, ElementKind::Tri | ElementKind::Quad) {
+            for c in ["s0_11", "s0_22", "s0_12"] {
+                if let Some(v) = t.f64_opt(c)? {
+                    s0cols.push(v);
+                }
+            }
+            if !s0cols.is_empty() && s0cols.len() != 3 {
+                return Err(WeftError::input(format!("{} of the initial stress columns s0_11, s0_22, s0_12 are present", s0cols.len()))
+                    .in_file(&t.path)
+                    .expected("all three or none"));
+            }
+        }
         let mut b = ElementBlock::default();
         for row in 0..eid.len() {
             let part = *part_map.get(&pid[row]).ok_or_else(|| {
@@ -223,6 +237,9 @@ fn read_model_inner(dir: &Path) -> Result<Model> {
             for c in &tcols {
                 let pt = m.parts[part].props.thickness.unwrap_or(0.0);
                 b.thickness.push(c[row].unwrap_or(pt));
+            }
+            if !s0cols.is_empty() {
+                b.stress0.push(std::array::from_fn(|k| s0cols[k][row].unwrap_or(0.0)));
             }
         }
         m.elements.insert(kind, b);
@@ -592,6 +609,11 @@ fn write_tables(m: &Model, dir: &Path, prov: &Provenance) -> Result<()> {
         if !b.thickness.is_empty() {
             for (j, c) in ["t1", "t2", "t3", "t4"].into_iter().take(npe).enumerate() {
                 cols.push(Col::F64(c, b.thickness.iter().skip(j).step_by(npe).copied().collect()));
+            }
+        }
+        if !b.stress0.is_empty() {
+            for (j, c) in ["s0_11", "s0_22", "s0_12"].into_iter().enumerate() {
+                cols.push(Col::F64(c, b.stress0.iter().map(|s| s[j]).collect()));
             }
         }
         write_table(

@@ -89,6 +89,9 @@ pub struct ElementBlock {
     /// element (LS-DYNA's shell nodal thickness); empty when every element has its
     /// part's thickness.
     pub thickness: Vec<f64>,
+    /// Membranes: initial stress [S₁₁, S₂₂, S₁₂] [Pa] in material axes, one per element
+    /// (a formed, pre-stressed state); empty when every element starts unstressed.
+    pub stress0: Vec<[f64; 3]>,
 }
 
 impl ElementBlock {
@@ -364,6 +367,9 @@ impl Model {
         b.nodes.extend_from_slice(nodes);
         if !b.thickness.is_empty() {
             b.thickness.extend(std::iter::repeat_n(t, nodes.len()));
+        }
+        if !b.stress0.is_empty() {
+            b.stress0.push([0.0; 3]);
         }
     }
 
@@ -663,9 +669,29 @@ impl Model {
         validate_analysis(&self.analysis)
     }
 
-    /// Nodal thickness: one finite value > 0 per element node, membranes only.
+    /// Nodal thickness: one finite value > 0 per element node, membranes only; initial
+    /// stress: finite, one per membrane element.
     fn validate_nodal_thickness(&self) -> Result<()> {
         for (kind, b) in &self.elements {
+            if !b.stress0.is_empty() {
+                let file = format!("elements_{}.parquet", kind.name());
+                if !matches!(kind, ElementKind::Tri | ElementKind::Quad) || b.stress0.len() != b.len() {
+                    return Err(WeftError::input(format!("{} elements carry {} initial stresses for {} elements", kind.name(), b.stress0.len(), b.len()))
+                        .in_file(file)
+                        .expected("initial stress columns s0_11, s0_22, s0_12 on tri and quad tables only"));
+                }
+                for (e, s) in b.stress0.iter().enumerate() {
+                    for (c, v) in ["s0_11", "s0_22", "s0_12"].iter().zip(s) {
+                        if !v.is_finite() {
+                            return Err(WeftError::input(format!("{} `{}` has initial stress {c} = `{v}`", kind.name(), b.id[e]))
+                                .in_file(file.clone())
+                                .in_column(*c)
+                                .at_row(e)
+                                .expected("a finite stress in Pa, or null for 0"));
+                        }
+                    }
+                }
+            }
             if b.thickness.is_empty() {
                 continue;
             }

@@ -39,6 +39,9 @@ pub struct Material {
     /// Voigt stiffness [Pa] for [E₁₁, E₂₂, 2E₁₂] → [S₁₁, S₂₂, S₁₂].
     pub d: [[f64; 3]; 3],
     pub no_compression: bool,
+    /// Initial stress S₀ = [S₁₁, S₂₂, S₁₂] [Pa] in material axes (a formed, pre-stressed
+    /// state): S = D E + S₀, stored energy ½ E·D E + S₀·E.
+    pub s0: [f64; 3],
 }
 
 impl Material {
@@ -64,6 +67,7 @@ impl Material {
                 [0.0, 0.0, g12],
             ],
             no_compression,
+            s0: [0.0; 3],
         })
     }
     /// Largest direct modulus, for the hourglass stiffness.
@@ -171,6 +175,11 @@ impl<const N: usize> Reference<N> {
 
 /// Deformation gradient F (3×2 as two columns) and Green strain in Voigt form.
 #[inline(always)]
+/// Green strain [E₁₁, E₂₂, 2E₁₂] in material axes at the positions x.
+pub fn green_strain<const N: usize>(x: &[[f64; 3]; N], r: &Reference<N>) -> [f64; 3] {
+    kinematics(x, r).1
+}
+
 fn kinematics<const N: usize>(x: &[[f64; 3]; N], r: &Reference<N>) -> ([[f64; 3]; 2], [f64; 3]) {
     let mut f = [[0.0; 3]; 2];
     for a in 0..N {
@@ -214,7 +223,7 @@ pub fn stress(m: &Material, e: &[f64; 3]) -> [f64; 3] {
             s = [p1 * nx * nx, p1 * ny * ny, p1 * nx * ny];
         }
     }
-    s
+    [s[0] + m.s0[0], s[1] + m.s0[1], s[2] + m.s0[2]]
 }
 
 /// Internal forces on the nodes [N] (membrane and hourglass).
@@ -317,7 +326,9 @@ pub fn energy<const N: usize>(
 ) -> (f64, f64) {
     let (_, e) = kinematics(x, r);
     let s = stress(m, &e);
-    let w = 0.5 * r.area * thickness * (s[0] * e[0] + s[1] * e[1] + s[2] * e[2]);
+    let s0 = m.s0;
+    let w = 0.5 * r.area * thickness * ((s[0] - s0[0]) * e[0] + (s[1] - s0[1]) * e[1] + (s[2] - s0[2]) * e[2])
+        + r.area * thickness * (s0[0] * e[0] + s0[1] * e[1] + s0[2] * e[2]);
     let mut hg = 0.0;
     if N == 4 && k_hg > 0.0 {
         let (q, n) = hourglass_q(x, r);
@@ -446,6 +457,10 @@ impl<const N: usize> Family for MembraneGroup<N> {
                 p.no_compression.unwrap_or(false),
             )
             .map_err(|err| err.in_file("parts.parquet").in_column("poisson_ratio_12"))?;
+            let mut mat = mat;
+            if !b.stress0.is_empty() {
+                mat.s0 = b.stress0[e];
+            }
             // One-point element: the mean of the nodal thicknesses when they are given.
             let s = if b.thickness.is_empty() {
                 p.thickness.unwrap()

@@ -102,6 +102,8 @@ pub struct PairOut {
     pub stored: f64,
     /// Friction work dissipated this step [J].
     pub dissipated: f64,
+    /// Penetration g (beyond a tracked initial one) [m].
+    pub g: f64,
 }
 
 /// Per-slave history.
@@ -248,6 +250,33 @@ fn nodal_thickness(m: &Model, part: Option<usize>) -> Vec<f64> {
     (0..nn).map(|i| if cnt[i] > 0 { sum[i] / cnt[i] as f64 } else { 0.0 }).collect()
 }
 
+/// The largest total penalty factor that can act on one node: Σ κ_c over the contact
+/// roles it has (slave of a definition, node of a master surface, both in two-way
+/// contact), plus 2 × 0.1 when the model has projectiles (their node and face contact).
+/// The stable-step guard of `Solver::set_time_step` uses it.
+pub fn guard_kappa(m: &Model) -> f64 {
+    if m.contacts.is_empty() {
+        return 0.0;
+    }
+    let mut k = vec![0.0; m.num_nodes()];
+    for d in &m.contacts {
+        let kappa = PENALTY_FACTOR * d.penalty_scale;
+        let slaves: Vec<u32> = match &d.slave {
+            Slave::Part(p) => part_nodes(m, *p),
+            Slave::Set(s) => m.node_sets.get(s).map(|v| v.iter().map(|&n| n as u32).collect()).unwrap_or_default(),
+        };
+        let roles = if d.two_way { 2.0 } else { 1.0 };
+        for n in slaves {
+            k[n as usize] += roles * kappa;
+        }
+        for n in part_nodes(m, d.master) {
+            k[n as usize] += roles * kappa;
+        }
+    }
+    let proj = if m.projectiles.is_empty() { 0.0 } else { 2.0 * PENALTY_FACTOR };
+    k.iter().cloned().fold(0.0, f64::max) + proj
+}
+
 /// The nodes of a part's elements, sorted.
 fn part_nodes(m: &Model, part: usize) -> Vec<u32> {
     let kind = m.parts[part].kind;
@@ -389,38 +418,31 @@ impl Side {
             }
         };
         let ns = slaves.len();
-        let mut counts = vec![0u32; ns];
-        counts.par_chunks_mut(SLAVE_CHUNK).enumerate().for_each(|(ci, c)| {
-            for (j, cj) in c.iter_mut().enumerate() {
-                candidates(ci * SLAVE_CHUNK + j, &mut |_| *cj += 1);
-            }
-        });
+        // One pass: each fixed chunk of slaves collects its candidates, the chunks are
+        // then joined in order.
+        let chunks: Vec<(Vec<u32>, Vec<u32>)> = (0..ns.div_ceil(SLAVE_CHUNK))
+            .into_par_iter()
+            .map(|ci| {
+                let (c0, c1) = (ci * SLAVE_CHUNK, ((ci + 1) * SLAVE_CHUNK).min(ns));
+                let mut counts = Vec::with_capacity(c1 - c0);
+                let mut list = Vec::new();
+                for si in c0..c1 {
+                    let before = list.len();
+                    candidates(si, &mut |f| list.push(f));
+                    counts.push((list.len() - before) as u32);
+                }
+                (counts, list)
+            })
+            .collect();
         let mut ptr = Vec::with_capacity(ns + 1);
         ptr.push(0u32);
-        for c in &counts {
-            let last = *ptr.last().unwrap();
-            ptr.push(last + c);
-        }
-        let mut cand = vec![0u32; *ptr.last().unwrap() as usize];
-        {
-            // Split the candidate array at the chunk boundaries.
-            let mut parts = Vec::with_capacity(ns.div_ceil(SLAVE_CHUNK));
-            let mut rest: &mut [u32] = &mut cand;
-            for c0 in (0..ns).step_by(SLAVE_CHUNK) {
-                let c1 = (c0 + SLAVE_CHUNK).min(ns);
-                let (a, b) = std::mem::take(&mut rest).split_at_mut((ptr[c1] - ptr[c0]) as usize);
-                parts.push((c0, c1, a));
-                rest = b;
+        let mut cand = Vec::with_capacity(chunks.iter().map(|c| c.1.len()).sum());
+        for (counts, list) in chunks {
+            for c in counts {
+                let last = *ptr.last().unwrap();
+                ptr.push(last + c);
             }
-            parts.into_par_iter().for_each(|(c0, c1, out)| {
-                let mut k = 0;
-                for si in c0..c1 {
-                    candidates(si, &mut |f| {
-                        out[k] = f;
-                        k += 1;
-                    });
-                }
-            });
+            cand.extend_from_slice(&list);
         }
         self.cand_ptr = ptr;
         self.cand = cand;
@@ -433,6 +455,7 @@ impl Side {
         let (slaves, slave_t, slave_m) = (&self.slaves, &self.slave_t, &self.slave_m);
         let (cand_ptr, cand) = (&self.cand_ptr, &self.cand);
         let (fr, kappa) = (self.friction, self.kappa);
+        let keep = self.on_initial == InitialPenetration::Keep;
         // Largest face thickness: no face farther than (t_s + this)/2 can touch.
         let face_t_max = self.reach * 2.0 - self.slave_t.iter().cloned().fold(0.0, f64::max);
         let dt2 = dt * dt;
@@ -461,6 +484,27 @@ impl Side {
                     if d2 > reach * reach {
                         continue;
                     }
+                    if nf == 4 {
+                        // One split first: the other differs by at most half the warp
+                        // |x₀ − x₁ + x₂ − x₃|/2, so a face out of reach by more is skipped.
+                        let wa = super::closest_on_triangle(&p, &xf[0], &xf[1], &xf[2]);
+                        let wb = super::closest_on_triangle(&p, &xf[0], &xf[2], &xf[3]);
+                        let da = {
+                            let qa: [f64; 3] = std::array::from_fn(|d| wa[0] * xf[0][d] + wa[1] * xf[1][d] + wa[2] * xf[2][d]);
+                            let r = sub(&p, &qa);
+                            dot(&r, &r)
+                        };
+                        let db = {
+                            let qb: [f64; 3] = std::array::from_fn(|d| wb[0] * xf[0][d] + wb[1] * xf[2][d] + wb[2] * xf[3][d]);
+                            let r = sub(&p, &qb);
+                            dot(&r, &r)
+                        };
+                        let warp: [f64; 3] = std::array::from_fn(|d| xf[0][d] - xf[1][d] + xf[2][d] - xf[3][d]);
+                        let lim = reach + 0.5 * dot(&warp, &warp).sqrt();
+                        if da.min(db) > lim * lim {
+                            continue;
+                        }
+                    }
                     let w = closest_on_face(&p, &xf, nf);
                     let q: [f64; 3] = std::array::from_fn(|d| (0..nf).map(|a| w[a] * xf[a][d]).sum());
                     let tf: f64 = (0..nf).map(|a| w[a] * face_t[fi as usize][a]).sum();
@@ -481,7 +525,7 @@ impl Side {
                 let mut out = PairOut { face: u32::MAX, ..Default::default() };
                 let g_raw = best.as_ref().map_or(f64::NEG_INFINITY, |b| b.2);
                 if initial {
-                    st.g0 = g_raw.max(0.0);
+                    st.g0 = if keep { 0.0 } else { g_raw.max(0.0) };
                     if let Some(b) = &best {
                         out.face = if g_raw > 0.0 { b.0 } else { u32::MAX };
                     }
@@ -505,7 +549,7 @@ impl Side {
                         let vn = dot(&vr, &n);
                         let vt = [vr[0] - vn * n[0], vr[1] - vn * n[1], vr[2] - vn * n[2]];
                         let (force, stored, diss) = pair_force(g, &n, k, &vt, dt_prev, &fr, st);
-                        out = PairOut { face: fi, w, f: force, stored, dissipated: diss };
+                        out = PairOut { face: fi, w, f: force, stored, dissipated: diss, g };
                     }
                     _ => {
                         // Open: what the stick spring stored is dissipated.
@@ -624,6 +668,9 @@ impl SurfaceContact {
                     continue;
                 }
                 let node = s.slaves[si] as usize;
+                if s.on_initial == InitialPenetration::Keep {
+                    continue;
+                }
                 let pen = InitialPen { contact_id: s.contact_id, node, element: s.face_id[o.face as usize], depth: s.state[si].g0 };
                 if s.on_initial == InitialPenetration::Error {
                     let kind = m.parts[m.contacts[s.row].master].kind;
@@ -698,6 +745,25 @@ impl SurfaceContact {
             build_seconds: self.build_time.as_secs_f64(),
             narrow_seconds: self.narrow_time.as_secs_f64(),
         }
+    }
+
+    /// The deepest penetration after the last force evaluation relative to the contact
+    /// distance (t_s + t_F)/2 ≈ g/reach, with its (contact id, slave node, face element).
+    pub fn deepest(&self) -> Option<(f64, f64, i64, usize, i64)> {
+        let mut best: Option<(f64, f64, i64, usize, i64)> = None;
+        for s in &self.sides {
+            for (si, o) in s.out.iter().enumerate() {
+                if o.face == u32::MAX {
+                    continue;
+                }
+                let reach = 0.5 * (s.slave_t[si] + s.face_t[o.face as usize].iter().take(s.nf).cloned().fold(0.0, f64::max));
+                let r = o.g / reach.max(f64::MIN_POSITIVE);
+                if best.as_ref().map_or(true, |b| r > b.0) {
+                    best = Some((r, o.g, s.contact_id, s.slaves[si] as usize, s.face_id[o.face as usize]));
+                }
+            }
+        }
+        best
     }
 
     /// Slaves in contact after the last force evaluation.
