@@ -234,6 +234,18 @@ fn sphere_face(
     dt2: f64,
 ) -> Option<([f64; 3], [f64; 3], f64, f64)> {
     let xs = t.nodes.map(|n| x[n as usize]);
+    // Cheap exact rejection: every point of the triangle is within e = max |x_a − x₀| of
+    // x₀, so |c − x₀| ≥ R + e means no contact.
+    let d0 = [xs[0][0] - c[0], xs[0][1] - c[1], xs[0][2] - c[2]];
+    let r0 = dot(&d0, &d0);
+    let (e1, e2) = (
+        [xs[1][0] - xs[0][0], xs[1][1] - xs[0][1], xs[1][2] - xs[0][2]],
+        [xs[2][0] - xs[0][0], xs[2][1] - xs[0][1], xs[2][2] - xs[0][2]],
+    );
+    let reach = p.radius + dot(&e1, &e1).max(dot(&e2, &e2)).sqrt();
+    if r0 >= reach * reach {
+        return None;
+    }
     let w = closest_on_triangle(c, &xs[0], &xs[1], &xs[2]);
     let q: [f64; 3] = std::array::from_fn(|d| w[0] * xs[0][d] + w[1] * xs[1][d] + w[2] * xs[2][d]);
     let dq = [q[0] - c[0], q[1] - c[1], q[2] - c[2]];
