@@ -217,6 +217,10 @@ pub struct Side {
     cand: Vec<u32>,
     pub state: Vec<SlaveState>,
     pub out: Vec<PairOut>,
+    /// Per fixed chunk of slaves: the slaves in contact (indices), and the stored energy
+    /// and the friction work of the chunk, summed in chunk order.
+    chunk_active: Vec<Vec<u32>>,
+    chunk_sums: Vec<[f64; 2]>,
 }
 
 /// Nodal contact thickness from a part's elements (None = all parts): membranes their
@@ -353,6 +357,8 @@ impl Side {
             reach: 0.5 * (ts_max + tf_max),
             cand_ptr: vec![],
             cand: vec![],
+            chunk_active: vec![],
+            chunk_sums: vec![],
         }
     }
 
@@ -459,7 +465,13 @@ impl Side {
         // Largest face thickness: no face farther than (t_s + this)/2 can touch.
         let face_t_max = self.reach * 2.0 - self.slave_t.iter().cloned().fold(0.0, f64::max);
         let dt2 = dt * dt;
-        let body = |(ci, (outs, sts)): (usize, (&mut [PairOut], &mut [SlaveState]))| {
+        let nchunks = self.slaves.len().div_ceil(SLAVE_CHUNK);
+        self.chunk_active.resize_with(nchunks, Vec::new);
+        self.chunk_sums.resize(nchunks, [0.0; 2]);
+        type Chunk<'c> = (usize, (((&'c mut [PairOut], &'c mut [SlaveState]), &'c mut Vec<u32>), &'c mut [f64; 2]));
+        let body = |(ci, (((outs, sts), active), sums)): Chunk| {
+            active.clear();
+            *sums = [0.0; 2];
             for (j, (o, st)) in outs.iter_mut().zip(sts.iter_mut()).enumerate() {
                 let si = ci * SLAVE_CHUNK + j;
                 let s = slaves[si] as usize;
@@ -560,13 +572,30 @@ impl Side {
                         st.k = 0.0;
                     }
                 }
+                if out.face != u32::MAX {
+                    active.push(si as u32);
+                    sums[0] += out.stored;
+                }
+                sums[1] += out.dissipated;
                 *o = out;
             }
         };
         if self.slaves.len() <= SLAVE_CHUNK {
-            self.out.chunks_mut(SLAVE_CHUNK).zip(self.state.chunks_mut(SLAVE_CHUNK)).enumerate().for_each(body);
+            self.out
+                .chunks_mut(SLAVE_CHUNK)
+                .zip(self.state.chunks_mut(SLAVE_CHUNK))
+                .zip(self.chunk_active.iter_mut())
+                .zip(self.chunk_sums.iter_mut())
+                .enumerate()
+                .for_each(body);
         } else {
-            self.out.par_chunks_mut(SLAVE_CHUNK).zip(self.state.par_chunks_mut(SLAVE_CHUNK)).enumerate().for_each(body);
+            self.out
+                .par_chunks_mut(SLAVE_CHUNK)
+                .zip(self.state.par_chunks_mut(SLAVE_CHUNK))
+                .zip(self.chunk_active.par_iter_mut())
+                .zip(self.chunk_sums.par_iter_mut())
+                .enumerate()
+                .for_each(body);
         }
     }
 }
@@ -707,13 +736,15 @@ impl SurfaceContact {
         let mut stored = 0.0;
         for s in &mut self.sides {
             s.narrow(x, v, dt, dt_prev, false);
-            // Scatter in slave order: bit-identical for any thread count.
-            for (si, o) in s.out.iter().enumerate() {
-                self.dissipated += o.dissipated;
-                if o.face == u32::MAX {
-                    continue;
-                }
-                stored += o.stored;
+            // Sums in chunk order, and the scatter of the slaves in contact in slave
+            // order: bit-identical for any thread count.
+            for c in &s.chunk_sums {
+                stored += c[0];
+                self.dissipated += c[1];
+            }
+            for &si in s.chunk_active.iter().flatten() {
+                let si = si as usize;
+                let o = &s.out[si];
                 let sl = s.slaves[si] as usize;
                 add(&mut fcon[sl], &o.f);
                 touched.push(sl);
