@@ -171,8 +171,18 @@ impl Operator {
         if !self.has_fcon() {
             return;
         }
-        for &i in &self.touched {
-            self.fcon[i] = [0.0; 3];
+        if self.surfaces.is_empty() {
+            for &i in &self.touched {
+                self.fcon[i] = [0.0; 3];
+            }
+        } else {
+            // Contact between parts touches many nodes: clear them all, in parallel.
+            use rayon::prelude::*;
+            if self.fcon.len() > 16 * 1024 {
+                self.fcon.par_chunks_mut(8 * 1024).for_each(|c| c.fill([0.0; 3]));
+            } else {
+                self.fcon.fill([0.0; 3]);
+            }
         }
         self.touched.clear();
         if !self.projectiles.is_empty() {

@@ -723,7 +723,8 @@ impl SurfaceContact {
         Ok(())
     }
 
-    /// Contact forces at x^n into `fcon` (nodes touched pushed on `touched`); the stored
+    /// Contact forces at x^n added into `fcon` (which the caller has cleared; `touched` is
+    /// left alone); the stored
     /// energy and the dissipated work are booked.
     #[allow(clippy::too_many_arguments)]
     pub fn forces(&mut self, x: &[[f64; 3]], v: &[[f64; 3]], dt: f64, dt_prev: f64, fcon: &mut [[f64; 3]], touched: &mut Vec<usize>) {
@@ -736,26 +737,48 @@ impl SurfaceContact {
         let mut stored = 0.0;
         for s in &mut self.sides {
             s.narrow(x, v, dt, dt_prev, false);
-            // Sums in chunk order, and the scatter of the slaves in contact in slave
-            // order: bit-identical for any thread count.
+            // Sums in chunk order: bit-identical for any thread count.
             for c in &s.chunk_sums {
                 stored += c[0];
                 self.dissipated += c[1];
             }
-            for &si in s.chunk_active.iter().flatten() {
-                let si = si as usize;
-                let o = &s.out[si];
-                let sl = s.slaves[si] as usize;
-                add(&mut fcon[sl], &o.f);
-                touched.push(sl);
-                let f = &s.faces[o.face as usize];
-                for a in 0..s.nf {
-                    let n = f[a] as usize;
-                    add(&mut fcon[n], &[-o.w[a] * o.f[0], -o.w[a] * o.f[1], -o.w[a] * o.f[2]]);
-                    touched.push(n);
+        }
+        // Gather onto the nodes: the nodes are split into one block per thread, and each
+        // block takes the contributions to its nodes in the canonical order (side, slave,
+        // the slave then its face's nodes), so every node's sum is the same whatever the
+        // split: bit-identical for any thread count, and parallel. `fcon` must be zero at
+        // the slaves' and faces' nodes before (the operator clears it).
+        let sides = &self.sides;
+        let active: usize = sides.iter().map(|s| s.chunk_active.iter().map(|a| a.len()).sum::<usize>()).sum();
+        // Small jobs stay on one thread (same sums, no scheduling cost).
+        let blocks = if active < 2048 { 1 } else { rayon::current_num_threads().max(1) };
+        let bs = fcon.len().div_ceil(blocks).max(1);
+        let gather = |(b, block): (usize, &mut [[f64; 3]])| {
+            let (lo, hi) = (b * bs, b * bs + block.len());
+            for s in sides {
+                for &si in s.chunk_active.iter().flatten() {
+                    let si = si as usize;
+                    let o = &s.out[si];
+                    let sl = s.slaves[si] as usize;
+                    if (lo..hi).contains(&sl) {
+                        add(&mut block[sl - lo], &o.f);
+                    }
+                    let f = &s.faces[o.face as usize];
+                    for a in 0..s.nf {
+                        let n = f[a] as usize;
+                        if (lo..hi).contains(&n) {
+                            add(&mut block[n - lo], &[-o.w[a] * o.f[0], -o.w[a] * o.f[1], -o.w[a] * o.f[2]]);
+                        }
+                    }
                 }
             }
+        };
+        if blocks == 1 {
+            gather((0, fcon));
+        } else {
+            fcon.par_chunks_mut(bs).enumerate().for_each(gather);
         }
+        let _ = touched;
         self.stored = stored;
         self.narrow_time += t1.elapsed();
     }
