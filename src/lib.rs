@@ -3,7 +3,8 @@
 //!
 //! Layout: [`model`] (the model and its folder of tables), [`solver`] (explicit central
 //! difference, element kernels, output sinks), [`simulate`] (the stage behind
-//! `weft-simulate`), [`generate`] (canonical models behind `weft-weave`), [`table`]
+//! `weft-simulate`), [`generate`] (canonical models behind `weft-weave`), [`plot`]
+//! (the figures behind `weft-plot`), [`table`]
 //! (validated Parquet I/O with provenance), [`error`] (typed errors), [`cli`] (what the
 //! stage binaries share: `main`, error printing, progress).
 
@@ -14,6 +15,7 @@ pub mod fit;
 pub mod generate;
 pub mod model;
 pub mod pipeline;
+pub mod plot;
 pub mod simulate;
 pub mod solver;
 pub mod table;
