@@ -14,7 +14,7 @@
 mod common;
 use common::rel;
 use weft::generate::woven::{woven, Lenticular, WovenBandParams};
-use weft::model::{Analysis, ElementKind, Model, PartProps, ProjectileShape, ProjectileSpec};
+use weft::model::{ElementKind, Model, PartProps, ProjectileShape, ProjectileSpec};
 use weft::solver::{run_in_memory, Solver};
 
 #[test]
@@ -29,8 +29,6 @@ fn lenticular_section_and_areal_density_match_their_closed_forms() {
     // The band's area, summed from its quads (width × mean nodal thickness), is the exact
     // lenticular area: the nodal thickness is scaled for it.
     let b = &m.elements[&ElementKind::Quad];
-    let along = p.spacing / p.per_spacing as f64;
-    let _ = along;
     // Mass of the quarter against 2ρA(1 + c)/p over the quarter patch [0, (n − ½)p]².
     let s = Solver::new(&m).unwrap();
     let side = (p.yarns as f64 - 0.5) * p.spacing;
@@ -45,8 +43,8 @@ fn lenticular_section_and_areal_density_match_their_closed_forms() {
         100.0 * info.crimp,
         b.len()
     );
-    // Measured 2.6e-5: flat quads follow the crimped path by chords.
-    assert!(rel(areal, closed) < 1e-3);
+    // Measured 8.2e-4: flat quads follow the crimped path by chords (4 per spacing).
+    assert!(rel(areal, closed) < 2e-3);
     // Crossing node sets: the warp's centre-line nodes at x = i p on y = 0, and at (i p, i p).
     let ax = &m.node_sets["axis_x"];
     assert_eq!(ax.len(), p.yarns);
@@ -264,11 +262,10 @@ fn a_woven_patch_impact_keeps_its_energy_and_is_thread_independent() {
         rep.deepest
     );
     assert!(u1 == u2 && e1 == e2 && p1 == p2, "1 and 2 threads differ");
-    // Measured 3e-4; the issue asks ≤ 1 % with contact and friction.
+    // Measured 6.5e-5; the issue asks ≤ 1 % with contact and friction.
     assert!(stats.max_balance_error_relative < 0.01);
     assert!(rep.friction_work > 0.0 && rep.active > 0);
     // The projectile has slowed down, by what the fabric took.
     let vz = p1.last().unwrap().2[5];
     assert!(vz > -p.projectile_velocity && vz < 0.0, "projectile vz {vz}");
-    let _ = Analysis::default();
 }
