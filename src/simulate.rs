@@ -125,7 +125,8 @@ pub fn run(c: &Config, progress: &mut (dyn FnMut(f64) + Send)) -> Result<Report>
         added_mass: sc.added_mass,
         added_fraction: sc.added_fraction,
         out: c.out.clone(),
-        contact: (!solver.op.surfaces.is_empty()).then(|| solver.op.surfaces.report(&solver.node_id)),
+        contact: (!solver.op.surfaces.is_empty())
+            .then(|| solver.op.surfaces.report(&solver.node_id)),
         stats,
     };
     write_summary(&c.out, &report, &solver, &prov)?;
@@ -229,10 +230,25 @@ pub fn write_summary(out: &Path, r: &Report, s: &Solver, prov: &Provenance) -> R
             Col::F64("wall_time_update", vec![st.times.update.as_secs_f64()]),
             Col::F64("wall_time_output", vec![st.times.output.as_secs_f64()]),
             Col::F64("wall_time_contact", vec![st.times.contact.as_secs_f64()]),
-            Col::I64("contact_builds", vec![r.contact.as_ref().map_or(0, |c| c.builds as i64)]),
-            Col::I64("contact_active", vec![r.contact.as_ref().map_or(0, |c| c.active as i64)]),
-            Col::I64("initial_penetrations", vec![r.contact.as_ref().map_or(0, |c| c.initial_penetrations as i64)]),
-            Col::OptF64("max_initial_penetration", vec![r.contact.as_ref().and_then(|c| c.deepest.map(|d| d.3))]),
+            Col::I64(
+                "contact_builds",
+                vec![r.contact.as_ref().map_or(0, |c| c.builds as i64)],
+            ),
+            Col::I64(
+                "contact_active",
+                vec![r.contact.as_ref().map_or(0, |c| c.active as i64)],
+            ),
+            Col::I64(
+                "initial_penetrations",
+                vec![r
+                    .contact
+                    .as_ref()
+                    .map_or(0, |c| c.initial_penetrations as i64)],
+            ),
+            Col::OptF64(
+                "max_initial_penetration",
+                vec![r.contact.as_ref().and_then(|c| c.deepest.map(|d| d.3))],
+            ),
             Col::F64(
                 "element_updates_per_second",
                 vec![st.element_updates_per_second()],

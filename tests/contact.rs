@@ -39,14 +39,21 @@ fn fixed_band(lx: f64, ly: f64, nx: usize, ny: usize, t: f64, rho: f64) -> (Mode
     );
     for j in 0..=ny {
         for i in 0..=nx {
-            let n = m.add_node((j * (nx + 1) + i) as i64 + 1, [lx * i as f64 / nx as f64, ly * j as f64 / ny as f64, 0.0]);
+            let n = m.add_node(
+                (j * (nx + 1) + i) as i64 + 1,
+                [lx * i as f64 / nx as f64, ly * j as f64 / ny as f64, 0.0],
+            );
             m.constraints.push((n, [true, true, true]));
         }
     }
     let at = |i: usize, j: usize| j * (nx + 1) + i;
     for j in 0..ny {
         for i in 0..nx {
-            m.add_element((j * nx + i) as i64 + 1, band, &[at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)]);
+            m.add_element(
+                (j * nx + i) as i64 + 1,
+                band,
+                &[at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)],
+            );
         }
     }
     (m, band)
@@ -55,7 +62,15 @@ fn fixed_band(lx: f64, ly: f64, nx: usize, ny: usize, t: f64, rho: f64) -> (Mode
 /// A point mass `mass` at `x`, in node set `ball`; returns its node.
 fn ball(m: &mut Model, x: [f64; 3], mass: f64) -> usize {
     let n = m.add_node(10_000, x);
-    let p = m.add_part(2, "ball", ElementKind::PointMass, PartProps { mass: Some(mass), ..Default::default() });
+    let p = m.add_part(
+        2,
+        "ball",
+        ElementKind::PointMass,
+        PartProps {
+            mass: Some(mass),
+            ..Default::default()
+        },
+    );
     m.add_element(10_000, p, &[n]);
     m.node_sets.insert("ball".into(), vec![n]);
     n
@@ -79,14 +94,29 @@ fn drop(z0: f64) -> (f64, f64, f64, f64, f64) {
     c.slave_thickness = Some(t);
     m.contacts.push(c);
     let dt = 1e-8;
-    m.analysis = Analysis { end_time: 1.3e-4, output_interval: 2e-9, time_step: Some(dt), history_sets: vec!["ball".into()], ..Analysis::default() };
+    m.analysis = Analysis {
+        end_time: 1.3e-4,
+        output_interval: 2e-9,
+        time_step: Some(dt),
+        history_sets: vec!["ball".into()],
+        ..Analysis::default()
+    };
     let (s, out, _) = run_in_memory(&m).unwrap();
     assert!(s.op.surfaces.builds >= 1);
     let uz = out.series(0, 2);
-    let g_max = uz.iter().map(|u| (t - (z0 + u)).max(0.0)).fold(0.0, f64::max);
+    let g_max = uz
+        .iter()
+        .map(|u| (t - (z0 + u)).max(0.0))
+        .fold(0.0, f64::max);
     let dur = uz.iter().filter(|u| z0 + **u < t).count() as f64 * 2e-9;
     // The band's nodes are far heavier: m* = m, k = κ_c m/Δt².
-    (*out.velocity_series(0, 2).last().unwrap() / v0, g_max, dur, t, 0.1 * mass / (dt * dt))
+    (
+        *out.velocity_series(0, 2).last().unwrap() / v0,
+        g_max,
+        dur,
+        t,
+        0.1 * mass / (dt * dt),
+    )
 }
 
 /// Reference: the half-sine impact of a mass on a linear spring.
@@ -111,14 +141,30 @@ fn mass_dropped_on_a_fixed_band_rebounds_with_its_energy() {
         }
         // Measured: penetration within 1.3 % of the closed form, duration within 1 step.
         assert!(ratio > 0.0, "no rebound");
-        assert!(rel(g_max, g_closed) < 0.05, "penetration {g_max} against {g_closed}");
-        assert!(g_max < 0.01 * t, "penetration {g_max} is over 1 % of the thickness");
-        assert!((dur - half).abs() < 3e-8, "contact lasted {dur} s, half period {half} s");
+        assert!(
+            rel(g_max, g_closed) < 0.05,
+            "penetration {g_max} against {g_closed}"
+        );
+        assert!(
+            g_max < 0.01 * t,
+            "penetration {g_max} is over 1 % of the thickness"
+        );
+        assert!(
+            (dur - half).abs() < 3e-8,
+            "contact lasted {dur} s, half period {half} s"
+        );
     }
     // Measured: 0.98 % at worst with the default κ_c = 0.1 (0.31 % with penalty_scale 0.3,
     // 0.24 % with 0.1): the penalty spring switches on inside a step.
-    println!("kinetic energy after rebound: worst error {:.3} % over 10 phases", 100.0 * worst);
-    assert!(worst < 0.01, "kinetic energy changed by {:.3} %", 100.0 * worst);
+    println!(
+        "kinetic energy after rebound: worst error {:.3} % over 10 phases",
+        100.0 * worst
+    );
+    assert!(
+        worst < 0.01,
+        "kinetic energy changed by {:.3} %",
+        100.0 * worst
+    );
 }
 
 /// Reference: Coulomb friction of a block on a fixed plane.
@@ -142,14 +188,40 @@ fn block_on_band(ratio: f64) -> (f64, f64, f64) {
     let dt = 1e-8;
     // N rises over 2000 contact periods (2π√(m/k) ≈ 20 Δt), so it settles quasi-statically.
     let t_ramp = 4e-5;
-    m.loads.push(Load { id: 1, node: b, force: [0.0, 0.0, -n_force], law: TimeLaw::Ramp { start: 0.0, duration: t_ramp } });
+    m.loads.push(Load {
+        id: 1,
+        node: b,
+        force: [0.0, 0.0, -n_force],
+        law: TimeLaw::Ramp {
+            start: 0.0,
+            duration: t_ramp,
+        },
+    });
     // Near μN the pull rises slowly too (an elastic stick spring under a sudden load
     // would overshoot to twice the load); well above it, a step.
     let t_pull = 5e-5;
-    let law = if ratio < 1.2 { TimeLaw::Ramp { start: t_pull, duration: 2e-5 } } else { TimeLaw::Step { start: t_pull } };
-    m.loads.push(Load { id: 2, node: b, force: [ratio * mu * n_force, 0.0, 0.0], law });
+    let law = if ratio < 1.2 {
+        TimeLaw::Ramp {
+            start: t_pull,
+            duration: 2e-5,
+        }
+    } else {
+        TimeLaw::Step { start: t_pull }
+    };
+    m.loads.push(Load {
+        id: 2,
+        node: b,
+        force: [ratio * mu * n_force, 0.0, 0.0],
+        law,
+    });
     let t_end = 1.5e-4;
-    m.analysis = Analysis { end_time: t_end, output_interval: 1e-6, time_step: Some(dt), history_sets: vec!["ball".into()], ..Analysis::default() };
+    m.analysis = Analysis {
+        end_time: t_end,
+        output_interval: 1e-6,
+        time_step: Some(dt),
+        history_sets: vec!["ball".into()],
+        ..Analysis::default()
+    };
     let (s, out, _) = run_in_memory(&m).unwrap();
     let ux = out.series(0, 0);
     let slip = *ux.last().unwrap();
@@ -166,14 +238,26 @@ fn a_block_slides_at_mu_n_and_sticks_below_it_and_friction_work_is_mu_n_slip() {
     let (stick, _, _) = block_on_band(0.99);
     let (slide, _, _) = block_on_band(1.01);
     println!("F = 0.99 μN: moved {stick:.3e} m (stick spring F/k = {:.3e} m); F = 1.01 μN: slid {slide:.3e} m", 0.99 * mu * n_force / k);
-    assert!(stick.abs() < 2.0 * mu * n_force / k, "the block moved {stick} m under 0.99 μN");
-    assert!(slide > 1e3 * mu * n_force / k, "the block slid only {slide} m under 1.01 μN");
+    assert!(
+        stick.abs() < 2.0 * mu * n_force / k,
+        "the block moved {stick} m under 0.99 μN"
+    );
+    assert!(
+        slide > 1e3 * mu * n_force / k,
+        "the block slid only {slide} m under 1.01 μN"
+    );
     // Well above μN the slide follows ½ (F − μN)/m t²; the elastic stick spring adds a
     // transient of order μN/k at the start (1.3 % of the slip at F = 1.05 μN, measured).
     let (slip, closed, work) = block_on_band(1.5);
     println!("F = 1.5 μN: slip {slip:.5e} m, closed form {closed:.5e} m ({:.3} %), friction work {work:.5e} J vs μN·slip {:.5e} J ({:.3} %)", 100.0 * rel(slip, closed), mu * n_force * slip, 100.0 * rel(work, mu * n_force * slip));
-    assert!(rel(slip, closed) < 0.01, "slip {slip} against ½at² = {closed}");
-    assert!(rel(work, mu * n_force * slip) < 0.01, "friction work {work}");
+    assert!(
+        rel(slip, closed) < 0.01,
+        "slip {slip} against ½at² = {closed}"
+    );
+    assert!(
+        rel(work, mu * n_force * slip) < 0.01,
+        "friction work {work}"
+    );
 }
 
 /// Reference: equilibrium of two crossing pretensioned strings.
@@ -188,7 +272,13 @@ fn a_block_slides_at_mu_n_and_sticks_below_it_and_friction_work_is_mu_n_slip() {
 fn crossing_strings_pass_the_force_through_contact() {
     let mut m = Model::default();
     let (l, ne, area) = (1e-2, 10, 1e-8);
-    let props = PartProps { youngs_modulus: Some(80e9), density: Some(1440.0), area: Some(area), prestrain: Some(1e-3), ..Default::default() };
+    let props = PartProps {
+        youngs_modulus: Some(80e9),
+        density: Some(1440.0),
+        area: Some(area),
+        prestrain: Some(1e-3),
+        ..Default::default()
+    };
     let pa = m.add_part(1, "a", ElementKind::Truss, props.clone());
     let pb = m.add_part(2, "b", ElementKind::Truss, props);
     let dia = (4.0 * area / std::f64::consts::PI).sqrt();
@@ -225,10 +315,20 @@ fn crossing_strings_pass_the_force_through_contact() {
     // at one point it drifts: 2e-6 of F after 8 ms (measured); one-way reaches round-off.
     m.contacts.push(ContactDef::new(1, Slave::Part(pb), pa));
     let f = 0.05;
-    m.loads.push(Load { id: 1, node: mid_b, force: [0.0, 0.0, -f], law: TimeLaw::Step { start: 0.0 } });
+    m.loads.push(Load {
+        id: 1,
+        node: mid_b,
+        force: [0.0, 0.0, -f],
+        law: TimeLaw::Step { start: 0.0 },
+    });
     // Mass damping: every mode decays at α/2 (8 ms: 400 e-folds), the slow modes of
     // the strings near critical; α = 3e4 left 5e-6 of F after 4 ms (measured).
-    m.analysis = Analysis { end_time: 8e-3, output_interval: 1e-4, mass_damping: 1e5, ..Analysis::default() };
+    m.analysis = Analysis {
+        end_time: 8e-3,
+        output_interval: 1e-4,
+        mass_damping: 1e5,
+        ..Analysis::default()
+    };
     let (mut s, _, _) = run_in_memory(&m).unwrap();
     let nb: Vec<usize> = (0..m.num_nodes()).filter(|&n| m.node_id[n] > 100).collect();
     let fc = [0.0, 0.0, nb.iter().map(|&n| s.op.fcon[n][2]).sum::<f64>()];
@@ -249,19 +349,32 @@ fn a_node_that_starts_inside_is_reported_not_launched() {
     let mut c = ContactDef::new(1, Slave::Set("ball".into()), band);
     c.slave_thickness = Some(t);
     m.contacts.push(c.clone());
-    m.analysis = Analysis { end_time: 1e-5, output_interval: 1e-6, time_step: Some(1e-8), history_sets: vec!["ball".into()], ..Analysis::default() };
+    m.analysis = Analysis {
+        end_time: 1e-5,
+        output_interval: 1e-6,
+        time_step: Some(1e-8),
+        history_sets: vec!["ball".into()],
+        ..Analysis::default()
+    };
     let (s, out, _) = run_in_memory(&m).unwrap();
     let pen = &s.op.surfaces.initial;
     assert_eq!(pen.len(), 1);
     assert_eq!(s.node_id[pen[0].node], 10_000);
-    assert!(rel(pen[0].depth, depth) < 1e-9, "depth {} against {depth}", pen[0].depth);
+    assert!(
+        rel(pen[0].depth, depth) < 1e-9,
+        "depth {} against {depth}",
+        pen[0].depth
+    );
     let vmax = out.v.iter().map(|v| v[0][2].abs()).fold(0.0, f64::max);
     assert_eq!(vmax, 0.0, "the node was launched at {vmax} m/s");
     // With `error`, the run does not start and the message names the node and depth.
     c.initial_penetration = InitialPenetration::Error;
     m.contacts = vec![c];
     let e = Solver::new(&m).err().expect("an error").to_string();
-    assert!(e.contains("`10000`") && e.contains("3.000e-5") && e.contains("contacts.parquet"), "{e}");
+    assert!(
+        e.contains("`10000`") && e.contains("3.000e-5") && e.contains("contacts.parquet"),
+        "{e}"
+    );
     let _ = b;
 }
 
@@ -270,18 +383,28 @@ fn two_crossing_layers_are_bit_identical_on_one_and_two_threads() {
     let c = CrossingBands::with_nodes(3000);
     let m = crossing_bands(&c);
     let run = |threads: usize| {
-        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
         pool.install(|| {
             let (s, out, stats) = run_in_memory(&m).unwrap();
-            (out.u, out.energy, s.op.surfaces.active(), stats.max_balance_error_relative)
+            (
+                out.u,
+                out.energy,
+                s.op.surfaces.active(),
+                stats.max_balance_error_relative,
+            )
         })
     };
     let (u1, e1, active, bal) = run(1);
     let (u2, e2, _, _) = run(2);
-    println!("{} nodes, {active} slaves in contact at the end, energy balance {bal:.2e}", m.num_nodes());
+    println!(
+        "{} nodes, {active} slaves in contact at the end, energy balance {bal:.2e}",
+        m.num_nodes()
+    );
     assert!(active > 100, "only {active} slaves in contact");
     assert!(u1 == u2 && e1 == e2, "1 and 2 threads differ");
     // Friction and penalty keep the balance: measured 3e-4.
     assert!(bal < 1e-2, "energy balance {bal}");
 }
-

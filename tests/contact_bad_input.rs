@@ -17,35 +17,61 @@ use weft::table::{write_table, Provenance, Table};
 /// above it, and one contact of the ball against the band.
 fn good_model(dir: &Path) -> PathBuf {
     let mut m = Model::default();
-    let band = m.add_part(1, "band", ElementKind::Quad, PartProps {
-        youngs_modulus_1: Some(8e10),
-        youngs_modulus_2: Some(8e10),
-        shear_modulus_12: Some(3e10),
-        density: Some(1440.0),
-        thickness: Some(1e-4),
-        ..Default::default()
-    });
+    let band = m.add_part(
+        1,
+        "band",
+        ElementKind::Quad,
+        PartProps {
+            youngs_modulus_1: Some(8e10),
+            youngs_modulus_2: Some(8e10),
+            shear_modulus_12: Some(3e10),
+            density: Some(1440.0),
+            thickness: Some(1e-4),
+            ..Default::default()
+        },
+    );
     for j in 0..3 {
         for i in 0..3 {
-            let n = m.add_node((3 * j + i) as i64 + 1, [i as f64 * 1e-3, j as f64 * 1e-3, 0.0]);
+            let n = m.add_node(
+                (3 * j + i) as i64 + 1,
+                [i as f64 * 1e-3, j as f64 * 1e-3, 0.0],
+            );
             m.constraints.push((n, [true, true, true]));
         }
     }
     for j in 0..2 {
         for i in 0..2 {
             let a = 3 * j + i;
-            m.add_element_with_thickness((2 * j + i) as i64 + 1, band, &[a, a + 1, a + 4, a + 3], &[1e-4, 1.2e-4, 1.2e-4, 1e-4]);
+            m.add_element_with_thickness(
+                (2 * j + i) as i64 + 1,
+                band,
+                &[a, a + 1, a + 4, a + 3],
+                &[1e-4, 1.2e-4, 1.2e-4, 1e-4],
+            );
         }
     }
     let b = m.add_node(100, [1e-3, 1e-3, 5e-4]);
-    let p = m.add_part(2, "ball", ElementKind::PointMass, PartProps { mass: Some(1e-6), ..Default::default() });
+    let p = m.add_part(
+        2,
+        "ball",
+        ElementKind::PointMass,
+        PartProps {
+            mass: Some(1e-6),
+            ..Default::default()
+        },
+    );
     m.add_element(100, p, &[b]);
     m.node_sets.insert("ball".into(), vec![b]);
     m.initial_velocities.push((b, [0.0, 0.0, -1.0]));
     let mut c = ContactDef::new(7, Slave::Set("ball".into()), band).with_friction(0.2);
     c.slave_thickness = Some(1e-4);
     m.contacts.push(c);
-    m.analysis = Analysis { end_time: 1e-6, output_interval: 1e-7, time_step: Some(1e-8), ..Analysis::default() };
+    m.analysis = Analysis {
+        end_time: 1e-6,
+        output_interval: 1e-7,
+        time_step: Some(1e-8),
+        ..Analysis::default()
+    };
     let d = dir.join("model");
     write_model(&m, &d, &Provenance::new("test", serde_json::json!({}))).unwrap();
     d
@@ -66,15 +92,32 @@ fn replace_col(dir: &Path, file: &str, col: &str, dt: DataType, a: ArrayRef) {
         }
     }
     let b = RecordBatch::try_new(Arc::new(Schema::new(fields)), arrays).unwrap();
-    write_table(&path, &b, &Provenance::new("corrupt", serde_json::json!({}))).unwrap();
+    write_table(
+        &path,
+        &b,
+        &Provenance::new("corrupt", serde_json::json!({})),
+    )
+    .unwrap();
 }
 
 fn set_str(dir: &Path, file: &str, col: &str, v: Option<&str>) {
-    replace_col(dir, file, col, DataType::Utf8, Arc::new(StringArray::from(vec![v])));
+    replace_col(
+        dir,
+        file,
+        col,
+        DataType::Utf8,
+        Arc::new(StringArray::from(vec![v])),
+    );
 }
 
 fn set_f64(dir: &Path, file: &str, col: &str, v: Vec<Option<f64>>) {
-    replace_col(dir, file, col, DataType::Float64, Arc::new(Float64Array::from(v)));
+    replace_col(
+        dir,
+        file,
+        col,
+        DataType::Float64,
+        Arc::new(Float64Array::from(v)),
+    );
 }
 
 /// weft-simulate fails with exit code 1, every fragment in stderr, no panic, no tables.
@@ -96,7 +139,10 @@ fn case(f: impl Fn(&Path), fragments: &[&str]) {
     for fr in fragments {
         assert!(err.contains(fr), "stderr lacks `{fr}`:\n{err}");
     }
-    assert!(!out.exists() || std::fs::read_dir(&out).unwrap().next().is_none(), "tables written after a failure");
+    assert!(
+        !out.exists() || std::fs::read_dir(&out).unwrap().next().is_none(),
+        "tables written after a failure"
+    );
 }
 
 #[test]
@@ -113,53 +159,125 @@ fn the_good_model_runs() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     // The nodal thickness survives the round trip.
     let m = weft::model::io::read_model(&model).unwrap();
-    assert_eq!(m.elements[&ElementKind::Quad].thickness[..4], [1e-4, 1.2e-4, 1.2e-4, 1e-4]);
+    assert_eq!(
+        m.elements[&ElementKind::Quad].thickness[..4],
+        [1e-4, 1.2e-4, 1.2e-4, 1e-4]
+    );
     assert_eq!(m.contacts.len(), 1);
 }
 
 #[test]
 fn unknown_master_part() {
-    case(|m| set_str(m, "contacts.parquet", "master_part", Some("sail")), &["contacts.parquet", "master_part", "row 0", "part `sail` does not exist", "`band`"]);
+    case(
+        |m| set_str(m, "contacts.parquet", "master_part", Some("sail")),
+        &[
+            "contacts.parquet",
+            "master_part",
+            "row 0",
+            "part `sail` does not exist",
+            "`band`",
+        ],
+    );
 }
 
 #[test]
 fn unknown_slave_set() {
-    case(|m| set_str(m, "contacts.parquet", "slave_set", Some("moon")), &["contacts.parquet", "slave_set", "row 0", "node set `moon` does not exist", "`ball`"]);
+    case(
+        |m| set_str(m, "contacts.parquet", "slave_set", Some("moon")),
+        &[
+            "contacts.parquet",
+            "slave_set",
+            "row 0",
+            "node set `moon` does not exist",
+            "`ball`",
+        ],
+    );
 }
 
 #[test]
 fn neither_slave_part_nor_set() {
-    case(|m| set_str(m, "contacts.parquet", "slave_set", None), &["contacts.parquet", "row 0", "exactly one of slave_part and slave_set"]);
+    case(
+        |m| set_str(m, "contacts.parquet", "slave_set", None),
+        &[
+            "contacts.parquet",
+            "row 0",
+            "exactly one of slave_part and slave_set",
+        ],
+    );
 }
 
 #[test]
 fn negative_friction() {
-    case(|m| set_f64(m, "contacts.parquet", "static_friction", vec![Some(-0.3)]), &["contacts.parquet", "static_friction", "row 0", "`-0.3`", "≥ 0"]);
+    case(
+        |m| set_f64(m, "contacts.parquet", "static_friction", vec![Some(-0.3)]),
+        &[
+            "contacts.parquet",
+            "static_friction",
+            "row 0",
+            "`-0.3`",
+            "≥ 0",
+        ],
+    );
 }
 
 #[test]
 fn dynamic_above_static_friction() {
-    case(|m| set_f64(m, "contacts.parquet", "dynamic_friction", vec![Some(0.5)]), &["contacts.parquet", "dynamic_friction", "0.5 exceeds static_friction 0.2"]);
+    case(
+        |m| set_f64(m, "contacts.parquet", "dynamic_friction", vec![Some(0.5)]),
+        &[
+            "contacts.parquet",
+            "dynamic_friction",
+            "0.5 exceeds static_friction 0.2",
+        ],
+    );
 }
 
 #[test]
 fn negative_thickness() {
-    case(|m| set_f64(m, "contacts.parquet", "slave_thickness", vec![Some(-1e-4)]), &["contacts.parquet", "slave_thickness", "row 0", "`-0.0001`", "thickness ≥ 0"]);
+    case(
+        |m| set_f64(m, "contacts.parquet", "slave_thickness", vec![Some(-1e-4)]),
+        &[
+            "contacts.parquet",
+            "slave_thickness",
+            "row 0",
+            "`-0.0001`",
+            "thickness ≥ 0",
+        ],
+    );
 }
 
 #[test]
 fn surface_without_faces() {
-    case(|m| set_str(m, "contacts.parquet", "master_part", Some("ball")), &["contacts.parquet", "master_part", "row 0", "`ball` is a point_mass part and has no faces or segments"]);
+    case(
+        |m| set_str(m, "contacts.parquet", "master_part", Some("ball")),
+        &[
+            "contacts.parquet",
+            "master_part",
+            "row 0",
+            "`ball` is a point_mass part and has no faces or segments",
+        ],
+    );
 }
 
 #[test]
 fn bad_penalty_scale() {
-    case(|m| set_f64(m, "contacts.parquet", "penalty_scale", vec![Some(0.0)]), &["contacts.parquet", "penalty_scale", "`0`", "> 0"]);
+    case(
+        |m| set_f64(m, "contacts.parquet", "penalty_scale", vec![Some(0.0)]),
+        &["contacts.parquet", "penalty_scale", "`0`", "> 0"],
+    );
 }
 
 #[test]
 fn unknown_initial_penetration_mode() {
-    case(|m| set_str(m, "contacts.parquet", "initial_penetration", Some("launch")), &["contacts.parquet", "initial_penetration", "`launch`", "`track` (default), `error` or `keep`"]);
+    case(
+        |m| set_str(m, "contacts.parquet", "initial_penetration", Some("launch")),
+        &[
+            "contacts.parquet",
+            "initial_penetration",
+            "`launch`",
+            "`track` (default), `error` or `keep`",
+        ],
+    );
 }
 
 #[test]
@@ -173,7 +291,13 @@ fn initial_penetration_as_an_error() {
             *z.last_mut().unwrap() = Some(6e-5);
             set_f64(m, "nodes.parquet", "z", z);
         },
-        &["contacts.parquet", "initial_penetration", "node `100` starts", "inside the surface of quad", "hint:"],
+        &[
+            "contacts.parquet",
+            "initial_penetration",
+            "node `100` starts",
+            "inside the surface of quad",
+            "hint:",
+        ],
     );
 }
 

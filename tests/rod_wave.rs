@@ -175,8 +175,13 @@ fn pretensioned_string_carries_transverse_waves_at_sqrt_t_over_mu() {
     m.analysis.output_interval = m.analysis.end_time / 1500.0;
     let (s, out, _) = run_in_memory(&m).unwrap();
     // The initial axial force is E·A·ε₀.
-    let n0 =
-        weft::solver::truss::axial_force(&s.x0[0], &s.x0[1], s.op.el.truss.k[0], s.op.el.truss.l0[0], false);
+    let n0 = weft::solver::truss::axial_force(
+        &s.x0[0],
+        &s.x0[1],
+        s.op.el.truss.k[0],
+        s.op.el.truss.l0[0],
+        false,
+    );
     assert!(rel(n0, e * 1e-8 * eps0) < 1e-12, "{n0}");
     let j = |x: f64| {
         out.nodes

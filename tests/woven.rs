@@ -24,7 +24,11 @@ fn lenticular_section_and_areal_density_match_their_closed_forms() {
     // Thickness: h at the centre line, 0 at the edges; area ≈ (2/3)wh (DESIGN §12).
     assert!(rel(lens.thickness(0.0), p.thickness) < 1e-12);
     assert!(lens.thickness(0.5 * p.width).abs() < 1e-12);
-    assert!(rel(lens.area(), 2.0 / 3.0 * p.width * p.thickness) < 0.01, "area {}", lens.area());
+    assert!(
+        rel(lens.area(), 2.0 / 3.0 * p.width * p.thickness) < 0.01,
+        "area {}",
+        lens.area()
+    );
     let (m, info) = woven(&p).unwrap();
     // The band's area, summed from its quads (width × mean nodal thickness), is the exact
     // lenticular area: the nodal thickness is scaled for it.
@@ -50,13 +54,20 @@ fn lenticular_section_and_areal_density_match_their_closed_forms() {
     assert_eq!(ax.len(), p.yarns);
     for (i, &n) in ax.iter().enumerate() {
         let x = m.coords[n];
-        assert!((x[0] - i as f64 * p.spacing).abs() < 1e-12 && x[1].abs() < 1e-12, "{x:?}");
+        assert!(
+            (x[0] - i as f64 * p.spacing).abs() < 1e-12 && x[1].abs() < 1e-12,
+            "{x:?}"
+        );
     }
     let dg = &m.node_sets["diagonal"];
     assert_eq!(dg.len(), p.yarns);
     for (i, &n) in dg.iter().enumerate() {
         let x = m.coords[n];
-        assert!((x[0] - i as f64 * p.spacing).abs() < 1e-12 && (x[1] - i as f64 * p.spacing).abs() < 1e-12, "{x:?}");
+        assert!(
+            (x[0] - i as f64 * p.spacing).abs() < 1e-12
+                && (x[1] - i as f64 * p.spacing).abs() < 1e-12,
+            "{x:?}"
+        );
     }
     // At every crossing the warp and weft centre lines are one centre thickness apart.
     let dw = &m.node_sets["diagonal_weft"];
@@ -73,12 +84,37 @@ fn impossible_geometry_is_refused_with_the_parameter_named() {
         assert!(e.contains(frag), "`{frag}` not in: {e}");
     };
     let d = WovenBandParams::default;
-    bad(WovenBandParams { width: 1.2e-3, ..d() }, "not below the spacing");
-    bad(WovenBandParams { thickness: 0.9e-3, ..d() }, "not below its width");
+    bad(
+        WovenBandParams {
+            width: 1.2e-3,
+            ..d()
+        },
+        "not below the spacing",
+    );
+    bad(
+        WovenBandParams {
+            thickness: 0.9e-3,
+            ..d()
+        },
+        "not below its width",
+    );
     bad(WovenBandParams { yarns: 0, ..d() }, "--yarns");
-    bad(WovenBandParams { crimp_amplitude: Some(1e-5), ..d() }, "--crimp-amplitude");
+    bad(
+        WovenBandParams {
+            crimp_amplitude: Some(1e-5),
+            ..d()
+        },
+        "--crimp-amplitude",
+    );
     bad(WovenBandParams { across: 3, ..d() }, "--across");
-    bad(WovenBandParams { layers: 2, layer_gap: 0.0, ..d() }, "--layer-gap");
+    bad(
+        WovenBandParams {
+            layers: 2,
+            layer_gap: 0.0,
+            ..d()
+        },
+        "--layer-gap",
+    );
 }
 
 /// A straight band of the default section along x on ±half, ends pinned, every node held
@@ -87,7 +123,9 @@ fn band(half: f64, along: f64) -> (Model, usize, usize) {
     let p = WovenBandParams::default();
     let lens = Lenticular::new(p.width, p.thickness);
     let na = 2;
-    let offs: Vec<f64> = (0..=na).map(|k| -0.5 * p.width + p.width * k as f64 / na as f64).collect();
+    let offs: Vec<f64> = (0..=na)
+        .map(|k| -0.5 * p.width + p.width * k as f64 / na as f64)
+        .collect();
     let t: Vec<f64> = offs.iter().map(|&y| lens.thickness(y)).collect();
     let trap: f64 = (0..na).map(|k| 0.25 * p.width * (t[k] + t[k + 1])).sum();
     let t: Vec<f64> = t.iter().map(|x| x * lens.area() / trap).collect();
@@ -110,9 +148,13 @@ fn band(half: f64, along: f64) -> (Model, usize, usize) {
     let mut idx = vec![[0usize; 3]; n + 1];
     for i in 0..=n {
         for k in 0..=na {
-            let node = m.add_node((i * 3 + k) as i64 + 1, [-half + i as f64 * along, offs[k], 0.0]);
+            let node = m.add_node(
+                (i * 3 + k) as i64 + 1,
+                [-half + i as f64 * along, offs[k], 0.0],
+            );
             idx[i][k] = node;
-            m.constraints.push((node, [i == 0 || i == n, true, i == 0 || i == n]));
+            m.constraints
+                .push((node, [i == 0 || i == n, true, i == 0 || i == n]));
         }
     }
     for i in 0..n {
@@ -146,7 +188,13 @@ fn smith_general(p: impl Fn(f64) -> f64, rho: f64, v: f64) -> (f64, f64) {
         (0..=n)
             .map(|i| {
                 let s = (e * i as f64 / n as f64).max(1e-12);
-                let wt = if i == 0 || i == n { 1.0 } else if i % 2 == 1 { 4.0 } else { 2.0 };
+                let wt = if i == 0 || i == n {
+                    1.0
+                } else if i % 2 == 1 {
+                    4.0
+                } else {
+                    2.0
+                };
                 wt * (dp(s) / rho).sqrt()
             })
             .sum::<f64>()
@@ -161,7 +209,11 @@ fn smith_general(p: impl Fn(f64) -> f64, rho: f64, v: f64) -> (f64, f64) {
     let (mut lo, mut hi) = (1e-5, 0.1);
     for _ in 0..100 {
         let mid = 0.5 * (lo + hi);
-        if v_of(mid).0 < v { lo = mid } else { hi = mid }
+        if v_of(mid).0 < v {
+            lo = mid
+        } else {
+            hi = mid
+        }
     }
     let e = 0.5 * (lo + hi);
     (e, v_of(e).1)
@@ -174,7 +226,11 @@ fn smith_transverse_impact_of_a_band() {
     let v = 300.0;
     // The general oracle reproduces Smith's closed form for the linear law.
     let (e_lin, u_lin) = smith_general(|e| p.modulus * e, p.density, v);
-    assert!(rel(e_lin, 0.008947) < 1e-3 && rel(u_lin, c * ((e_lin * (1.0 + e_lin)).sqrt() - e_lin)) < 1e-6, "{e_lin} {u_lin}");
+    assert!(
+        rel(e_lin, 0.008947) < 1e-3
+            && rel(u_lin, c * ((e_lin * (1.0 + e_lin)).sqrt() - e_lin)) < 1e-6,
+        "{e_lin} {u_lin}"
+    );
     let (eps, u_lab) = smith_general(|e| p.modulus * (1.0 + e) * (e + 0.5 * e * e), p.density, v);
     let (half, along) = (0.16, 1e-4);
     let (mut m, n, _) = band(half, along);
@@ -209,9 +265,15 @@ fn smith_transverse_impact_of_a_band() {
             .map(|j| (j as f64 * along - half + out.u[k][j][0], -out.u[k][j][2]))
             .collect();
         let wmax = pts.iter().map(|p| p.1).fold(0.0, f64::max);
-        let sel: Vec<&(f64, f64)> = pts.iter().filter(|p| p.1 > 0.2 * wmax && p.1 < 0.8 * wmax).collect();
+        let sel: Vec<&(f64, f64)> = pts
+            .iter()
+            .filter(|p| p.1 > 0.2 * wmax && p.1 < 0.8 * wmax)
+            .collect();
         let nn = sel.len() as f64;
-        let (sx, sy) = (sel.iter().map(|p| p.0).sum::<f64>() / nn, sel.iter().map(|p| p.1).sum::<f64>() / nn);
+        let (sx, sy) = (
+            sel.iter().map(|p| p.0).sum::<f64>() / nn,
+            sel.iter().map(|p| p.1).sum::<f64>() / nn,
+        );
         let sxy: f64 = sel.iter().map(|p| (p.0 - sx) * (p.1 - sy)).sum();
         let sxx: f64 = sel.iter().map(|p| (p.0 - sx) * (p.0 - sx)).sum();
         let slope = sxy / sxx;
@@ -236,10 +298,18 @@ fn smith_transverse_impact_of_a_band() {
 
 #[test]
 fn a_woven_patch_impact_keeps_its_energy_and_is_thread_independent() {
-    let p = WovenBandParams { yarns: 6, end_time: 6e-6, output_interval: 2e-7, ..WovenBandParams::default() };
+    let p = WovenBandParams {
+        yarns: 6,
+        end_time: 6e-6,
+        output_interval: 2e-7,
+        ..WovenBandParams::default()
+    };
     let (m, _) = woven(&p).unwrap();
     let run = |threads: usize| {
-        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
         pool.install(|| {
             let (s, out, stats) = run_in_memory(&m).unwrap();
             let rep = s.op.surfaces.report(&s.node_id);
@@ -267,5 +337,8 @@ fn a_woven_patch_impact_keeps_its_energy_and_is_thread_independent() {
     assert!(rep.friction_work > 0.0 && rep.active > 0);
     // The projectile has slowed down, by what the fabric took.
     let vz = p1.last().unwrap().2[5];
-    assert!(vz > -p.projectile_velocity && vz < 0.0, "projectile vz {vz}");
+    assert!(
+        vz > -p.projectile_velocity && vz < 0.0,
+        "projectile vz {vz}"
+    );
 }

@@ -230,14 +230,18 @@ fn bench_contact(nodes: &[usize], threads: &[usize], node_steps: f64) -> anyhow:
                 let mut sink = MemorySink::default();
                 let stats = pool.install(|| s.run(&mut sink, &mut |_| {}))?;
                 c += stats.times.contact.as_secs_f64();
-                total += (stats.times.forces + stats.times.update + stats.times.loads).as_secs_f64();
+                total +=
+                    (stats.times.forces + stats.times.update + stats.times.loads).as_secs_f64();
                 last = Some((s, stats));
             }
             let (s, stats) = last.expect("one run");
             let per = 1e9 * c / (nn as f64 * (stats.steps as usize * reps) as f64);
             let rep = s.op.surfaces.report(&s.node_id);
             let same = base.as_ref().map(|b| b.1 == s.state.x);
-            let speedup = base.as_ref().map(|b| format!(" (contact speed-up {:.2})", b.0 / c)).unwrap_or_default();
+            let speedup = base
+                .as_ref()
+                .map(|b| format!(" (contact speed-up {:.2})", b.0 / c))
+                .unwrap_or_default();
             println!(
                 "{nn},{t},{},{c:.3},{total:.3},{per:.2},{},{},{}",
                 stats.steps as usize * reps,
@@ -269,7 +273,12 @@ fn bench_contact(nodes: &[usize], threads: &[usize], node_steps: f64) -> anyhow:
 /// contact's share.
 fn bench_woven(yarns: usize, end_time: f64, threads: &[usize]) -> anyhow::Result<()> {
     use weft::generate::woven::{woven, WovenBandParams};
-    let p = WovenBandParams { yarns, end_time, output_interval: end_time / 20.0, ..WovenBandParams::default() };
+    let p = WovenBandParams {
+        yarns,
+        end_time,
+        output_interval: end_time / 20.0,
+        ..WovenBandParams::default()
+    };
     let (m, _) = woven(&p)?;
     println!("yarns,threads,elements,nodes,steps,dt,wall_seconds,element_cycles_per_second,contact_seconds,contact_share,broad_phase_builds,max_balance_error_relative,finished");
     for &t in threads {
@@ -282,7 +291,11 @@ fn bench_woven(yarns: usize, end_time: f64, threads: &[usize]) -> anyhow::Result
         let rep = s.op.surfaces.report(&s.node_id);
         let (steps, bal, done) = match &r {
             Ok(st) => (st.steps, st.max_balance_error_relative, "yes".to_string()),
-            Err(e) => (s.state.step, f64::NAN, format!("no: {}", e.to_string().replace(',', ";"))),
+            Err(e) => (
+                s.state.step,
+                f64::NAN,
+                format!("no: {}", e.to_string().replace(',', ";")),
+            ),
         };
         let c = rep.build_seconds + rep.narrow_seconds;
         let cycles = steps as f64 * m.num_elements() as f64 / wall;

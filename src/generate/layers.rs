@@ -41,7 +41,16 @@ pub struct CrossingBands {
 impl Default for CrossingBands {
     fn default() -> Self {
         // Aramid-like bands (DESIGN.md §9): 1 mm spacing, 0.6 mm × 0.1 mm.
-        CrossingBands { bands: 6, spacing: 1e-3, width: 0.6e-3, thickness: 1e-4, per_spacing: 4, across: 2, load: 2e-4, friction: 0.2 }
+        CrossingBands {
+            bands: 6,
+            spacing: 1e-3,
+            width: 0.6e-3,
+            thickness: 1e-4,
+            per_spacing: 4,
+            across: 2,
+            load: 2e-4,
+            friction: 0.2,
+        }
     }
 }
 
@@ -70,7 +79,12 @@ pub fn crossing_bands(c: &CrossingBands) -> Model {
         ..Default::default()
     };
     let pa = m.add_part(1, "layer_a", ElementKind::Quad, props(0.0));
-    let pb = m.add_part(2, "layer_b", ElementKind::Quad, props(std::f64::consts::FRAC_PI_2));
+    let pb = m.add_part(
+        2,
+        "layer_b",
+        ElementKind::Quad,
+        props(std::f64::consts::FRAC_PI_2),
+    );
     let length = c.bands as f64 * c.spacing;
     let nl = c.bands * c.per_spacing;
     let (mut nid, mut eid) = (0i64, 0i64);
@@ -82,7 +96,11 @@ pub fn crossing_bands(c: &CrossingBands) -> Model {
                 for j in 0..=c.across {
                     let s = i as f64 * length / nl as f64;
                     let r = centre - 0.5 * c.width + j as f64 * c.width / c.across as f64;
-                    let x = if layer == 0 { [s, r, 0.0] } else { [r, s, c.thickness] };
+                    let x = if layer == 0 {
+                        [s, r, 0.0]
+                    } else {
+                        [r, s, c.thickness]
+                    };
                     nid += 1;
                     let n = m.add_node(nid, x);
                     idx[i][j] = n;
@@ -90,7 +108,12 @@ pub fn crossing_bands(c: &CrossingBands) -> Model {
                         m.constraints.push((n, [true, true, true]));
                     } else if layer == 1 {
                         let id = m.loads.len() as i64 + 1;
-                        m.loads.push(Load { id, node: n, force: [0.0, 0.0, -c.load], law: TimeLaw::Step { start: 0.0 } });
+                        m.loads.push(Load {
+                            id,
+                            node: n,
+                            force: [0.0, 0.0, -c.load],
+                            law: TimeLaw::Step { start: 0.0 },
+                        });
                     }
                 }
             }
@@ -111,6 +134,10 @@ pub fn crossing_bands(c: &CrossingBands) -> Model {
     let mut d = ContactDef::new(1, Slave::Part(pb), pa).with_friction(c.friction);
     d.two_way = true;
     m.contacts.push(d);
-    m.analysis = Analysis { end_time: 2e-6, output_interval: 1e-7, ..Analysis::default() };
+    m.analysis = Analysis {
+        end_time: 2e-6,
+        output_interval: 1e-7,
+        ..Analysis::default()
+    };
     m
 }

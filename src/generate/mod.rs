@@ -4,7 +4,7 @@
 pub mod grid;
 pub mod layers;
 pub mod rod;
-pub mod woven;
 pub mod square;
 pub mod weave;
+pub mod woven;
 pub mod zones;

@@ -29,7 +29,9 @@ use serde::Serialize;
 
 use crate::error::{Result, WeftError};
 use crate::model::contacts::{ContactDef, Slave};
-use crate::model::{Analysis, ElementKind, Model, PartProps, ProjectileShape, ProjectileSpec, SymmetryPlane};
+use crate::model::{
+    Analysis, ElementKind, Model, PartProps, ProjectileShape, ProjectileSpec, SymmetryPlane,
+};
 
 /// Edge condition of the yarn ends at the patch edge.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, clap::ValueEnum)]
@@ -135,7 +137,11 @@ pub struct Lenticular {
 
 impl Lenticular {
     pub fn new(w: f64, h: f64) -> Lenticular {
-        Lenticular { w, h, r: (w * w + h * h) / (4.0 * h) }
+        Lenticular {
+            w,
+            h,
+            r: (w * w + h * h) / (4.0 * h),
+        }
     }
     /// t(y) = 2(√(R² − y²) − R + h/2), clamped at 0.
     pub fn thickness(&self, y: f64) -> f64 {
@@ -163,7 +169,9 @@ pub struct WovenInfo {
 }
 
 fn check(p: &WovenBandParams) -> Result<()> {
-    let bad = |name: &str, v: String, exp: &str| Err(WeftError::input(format!("--{name} = `{v}`")).expected(exp.to_string()));
+    let bad = |name: &str, v: String, exp: &str| {
+        Err(WeftError::input(format!("--{name} = `{v}`")).expected(exp.to_string()))
+    };
     for (n, v) in [
         ("spacing", p.spacing),
         ("width", p.width),
@@ -182,31 +190,60 @@ fn check(p: &WovenBandParams) -> Result<()> {
         }
     }
     if p.yarns == 0 || (!p.quarter && p.yarns % 2 != 0) {
-        return bad("yarns", p.yarns.to_string(), "≥ 1 (quarter), or even ≥ 2 (full patch)");
+        return bad(
+            "yarns",
+            p.yarns.to_string(),
+            "≥ 1 (quarter), or even ≥ 2 (full patch)",
+        );
     }
     if p.width >= p.spacing {
-        return Err(WeftError::input(format!("yarn width {} m is not below the spacing {} m", p.width, p.spacing))
-            .expected("w < p: neighbouring yarns would overlap")
-            .hint("lower --width or raise --spacing"));
+        return Err(WeftError::input(format!(
+            "yarn width {} m is not below the spacing {} m",
+            p.width, p.spacing
+        ))
+        .expected("w < p: neighbouring yarns would overlap")
+        .hint("lower --width or raise --spacing"));
     }
     if p.thickness >= p.width {
-        return Err(WeftError::input(format!("yarn thickness {} m is not below its width {} m", p.thickness, p.width))
-            .expected("h < w: a lenticular section is flatter than a circle"));
+        return Err(WeftError::input(format!(
+            "yarn thickness {} m is not below its width {} m",
+            p.thickness, p.width
+        ))
+        .expected("h < w: a lenticular section is flatter than a circle"));
     }
     if p.per_spacing < 4 || p.per_spacing % 2 != 0 {
-        return bad("per-spacing", p.per_spacing.to_string(), "an even number ≥ 4 (a node at every crossing and midway)");
+        return bad(
+            "per-spacing",
+            p.per_spacing.to_string(),
+            "an even number ≥ 4 (a node at every crossing and midway)",
+        );
     }
     if p.across < 2 || p.across % 2 != 0 {
-        return bad("across", p.across.to_string(), "an even number ≥ 2 (a node on the centre line)");
+        return bad(
+            "across",
+            p.across.to_string(),
+            "an even number ≥ 2 (a node on the centre line)",
+        );
     }
     if p.layers == 0 {
         return bad("layers", "0".into(), "≥ 1");
     }
     if !(p.friction >= 0.0 && p.projectile_friction >= 0.0 && p.layer_gap >= 0.0) {
-        return bad("friction", format!("{}, {}, gap {}", p.friction, p.projectile_friction, p.layer_gap), "friction and the layer gap ≥ 0");
+        return bad(
+            "friction",
+            format!(
+                "{}, {}, gap {}",
+                p.friction, p.projectile_friction, p.layer_gap
+            ),
+            "friction and the layer gap ≥ 0",
+        );
     }
     if !(p.projectile_velocity.is_finite() && p.projectile_velocity >= 0.0) {
-        return bad("projectile-velocity", p.projectile_velocity.to_string(), "a speed ≥ 0 in m/s");
+        return bad(
+            "projectile-velocity",
+            p.projectile_velocity.to_string(),
+            "a speed ≥ 0 in m/s",
+        );
     }
     Ok(())
 }
@@ -217,7 +254,9 @@ pub fn woven(p: &WovenBandParams) -> Result<(Model, WovenInfo)> {
     let lens = Lenticular::new(p.width, p.thickness);
     // Offsets across the band and the trapezoid area of the nodal profile.
     let na = p.across;
-    let offs: Vec<f64> = (0..=na).map(|k| -0.5 * p.width + p.width * k as f64 / na as f64).collect();
+    let offs: Vec<f64> = (0..=na)
+        .map(|k| -0.5 * p.width + p.width * k as f64 / na as f64)
+        .collect();
     let t_raw: Vec<f64> = offs.iter().map(|&y| lens.thickness(y)).collect();
     let dy = p.width / na as f64;
     let a_trap: f64 = (0..na).map(|k| 0.5 * dy * (t_raw[k] + t_raw[k + 1])).sum();
@@ -226,33 +265,64 @@ pub fn woven(p: &WovenBandParams) -> Result<(Model, WovenInfo)> {
     let t_centre = t_node[na / 2];
     let amp = p.crimp_amplitude.unwrap_or(0.5 * t_centre + 1e-9);
     if amp < 0.5 * t_centre {
-        return Err(WeftError::input(format!("--crimp-amplitude = `{amp}` m is below half the yarns' centre thickness {:.4e} m", 0.5 * t_centre))
-            .expected("a ≥ t_c/2: crossing yarns would start inside each other")
-            .hint("leave --crimp-amplitude out for yarns that just touch"));
+        return Err(WeftError::input(format!(
+            "--crimp-amplitude = `{amp}` m is below half the yarns' centre thickness {:.4e} m",
+            0.5 * t_centre
+        ))
+        .expected("a ≥ t_c/2: crossing yarns would start inside each other")
+        .hint("leave --crimp-amplitude out for yarns that just touch"));
     }
     // Layer pitch: a layer spans ±(a + t_c/2) about its mid-plane.
     let pitch = 2.0 * amp + t_centre + p.layer_gap;
     if p.layers > 1 && p.layer_gap <= 0.0 {
-        return Err(WeftError::input("layers touch: --layer-gap is 0".to_string()).expected("a gap > 0 between layers"));
+        return Err(
+            WeftError::input("layers touch: --layer-gap is 0".to_string())
+                .expected("a gap > 0 between layers"),
+        );
     }
     let k_c = std::f64::consts::PI * amp / p.spacing;
     // Crimp of z = a cos(πx/p): ∫₀^p √(1 + k² sin²) dx / p − 1, by Simpson's rule.
     let crimp = {
         let n = 2000;
         let f = |x: f64| (1.0 + (k_c * (std::f64::consts::PI * x).sin()).powi(2)).sqrt();
-        let s: f64 = (0..=n).map(|i| {
-            let w = if i == 0 || i == n { 1.0 } else if i % 2 == 1 { 4.0 } else { 2.0 };
-            w * f(i as f64 / n as f64)
-        }).sum();
+        let s: f64 = (0..=n)
+            .map(|i| {
+                let w = if i == 0 || i == n {
+                    1.0
+                } else if i % 2 == 1 {
+                    4.0
+                } else {
+                    2.0
+                };
+                w * f(i as f64 / n as f64)
+            })
+            .sum();
         s / (3.0 * n as f64) - 1.0
     };
 
     let mut m = Model::default();
-    let (first, last) = if p.quarter { (0i64, p.yarns as i64 - 1) } else { (-(p.yarns as i64) / 2, p.yarns as i64 / 2 - 1) };
+    let (first, last) = if p.quarter {
+        (0i64, p.yarns as i64 - 1)
+    } else {
+        (-(p.yarns as i64) / 2, p.yarns as i64 / 2 - 1)
+    };
     // Yarn centre lines at j·p (quarter) or (j + ½)·p (full, no yarn on x = 0).
-    let centre = |j: i64| if p.quarter { j as f64 * p.spacing } else { (j as f64 + 0.5) * p.spacing };
+    let centre = |j: i64| {
+        if p.quarter {
+            j as f64 * p.spacing
+        } else {
+            (j as f64 + 0.5) * p.spacing
+        }
+    };
     let sign = |j: i64| if j.rem_euclid(2) == 0 { 1.0 } else { -1.0 };
-    let (lo, hi) = if p.quarter { (0.0, (p.yarns as f64 - 0.5) * p.spacing) } else { (-(p.yarns as f64) * 0.5 * p.spacing, p.yarns as f64 * 0.5 * p.spacing) };
+    let (lo, hi) = if p.quarter {
+        (0.0, (p.yarns as f64 - 0.5) * p.spacing)
+    } else {
+        (
+            -(p.yarns as f64) * 0.5 * p.spacing,
+            p.yarns as f64 * 0.5 * p.spacing,
+        )
+    };
     let n_along = ((hi - lo) / p.spacing * p.per_spacing as f64).round() as usize;
     let props = |angle: f64| PartProps {
         youngs_modulus_1: Some(p.modulus),
@@ -271,7 +341,12 @@ pub fn woven(p: &WovenBandParams) -> Result<(Model, WovenInfo)> {
     };
     // Along-index of each crossing: the other family's yarn centre lines.
     let crossing_at: std::collections::BTreeMap<usize, i64> = (first..=last)
-        .map(|jj| (((centre(jj) - lo) / p.spacing * p.per_spacing as f64).round() as usize, jj))
+        .map(|jj| {
+            (
+                ((centre(jj) - lo) / p.spacing * p.per_spacing as f64).round() as usize,
+                jj,
+            )
+        })
         .collect();
     let (mut nid, mut eid) = (0i64, 0i64);
     let mut parts = vec![];
@@ -283,8 +358,18 @@ pub fn woven(p: &WovenBandParams) -> Result<(Model, WovenInfo)> {
     let mut top = f64::NEG_INFINITY;
     for layer in 0..p.layers {
         let zl = -(layer as f64) * pitch;
-        let warp = m.add_part(2 * layer as i64 + 1, &format!("warp_{}", layer + 1), ElementKind::Quad, props(0.0));
-        let weft = m.add_part(2 * layer as i64 + 2, &format!("weft_{}", layer + 1), ElementKind::Quad, props(std::f64::consts::FRAC_PI_2));
+        let warp = m.add_part(
+            2 * layer as i64 + 1,
+            &format!("warp_{}", layer + 1),
+            ElementKind::Quad,
+            props(0.0),
+        );
+        let weft = m.add_part(
+            2 * layer as i64 + 2,
+            &format!("weft_{}", layer + 1),
+            ElementKind::Quad,
+            props(std::f64::consts::FRAC_PI_2),
+        );
         parts.push((warp, weft));
         for (fam, part) in [(0, warp), (1, weft)] {
             for j in first..=last {
@@ -295,7 +380,10 @@ pub fn woven(p: &WovenBandParams) -> Result<(Model, WovenInfo)> {
                 for i in 0..=n_along {
                     let s = lo + (hi - lo) * i as f64 / n_along as f64;
                     // Warp (fam 0) follows (−1)^j a cos(πx/p); weft −(−1)^j a cos(πy/p).
-                    let z = zl + if fam == 0 { sign(j) } else { -sign(j) } * amp * (std::f64::consts::PI * s / p.spacing).cos();
+                    let z = zl
+                        + if fam == 0 { sign(j) } else { -sign(j) }
+                            * amp
+                            * (std::f64::consts::PI * s / p.spacing).cos();
                     top = top.max(z + 0.5 * t_centre);
                     for k in k0..=na {
                         let r = c + offs[k];
@@ -328,7 +416,11 @@ pub fn woven(p: &WovenBandParams) -> Result<(Model, WovenInfo)> {
                                 axis_x_weft.push(n);
                             }
                             if other == j {
-                                if fam == 0 { diagonal.push(n) } else { diagonal_weft.push(n) }
+                                if fam == 0 {
+                                    diagonal.push(n)
+                                } else {
+                                    diagonal_weft.push(n)
+                                }
                             }
                         }
                     }
@@ -375,7 +467,11 @@ pub fn woven(p: &WovenBandParams) -> Result<(Model, WovenInfo)> {
     }
     if p.quarter {
         for normal in [0, 1] {
-            m.symmetry.push(SymmetryPlane { normal, position: 0.0, tolerance: 1e-9 });
+            m.symmetry.push(SymmetryPlane {
+                normal,
+                position: 0.0,
+                tolerance: 1e-9,
+            });
         }
     }
     let share = if p.quarter { 0.25 } else { 1.0 };
@@ -402,13 +498,24 @@ pub fn woven(p: &WovenBandParams) -> Result<(Model, WovenInfo)> {
     m.analysis = Analysis {
         end_time: p.end_time,
         output_interval: p.output_interval,
-        history_sets: vec!["axis_x".into(), "axis_x_weft".into(), "diagonal".into(), "diagonal_weft".into()],
+        history_sets: vec![
+            "axis_x".into(),
+            "axis_x_weft".into(),
+            "diagonal".into(),
+            "diagonal_weft".into(),
+        ],
         ..Analysis::default()
     };
     m.validate()?;
     let area = lens.area();
     Ok((
         m,
-        WovenInfo { thickness_scale: scale, crimp_amplitude: amp, crimp, area, areal_density: 2.0 * p.density * area * (1.0 + crimp) / p.spacing },
+        WovenInfo {
+            thickness_scale: scale,
+            crimp_amplitude: amp,
+            crimp,
+            area,
+            areal_density: 2.0 * p.density * area * (1.0 + crimp) / p.spacing,
+        },
     ))
 }

@@ -16,7 +16,8 @@ use crate::error::{Result, WeftError};
 use crate::table::{batch, write_table, Col, Provenance, Table};
 
 /// Expected columns, for error messages.
-pub const CONTACT_COLS: &str = "contact_id, master_part, slave_part or slave_set (+ optional columns)";
+pub const CONTACT_COLS: &str =
+    "contact_id, master_part, slave_part or slave_set (+ optional columns)";
 
 /// What to do with a slave node that starts inside the surface.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -99,12 +100,18 @@ impl ContactDef {
 }
 
 fn err(row: usize, col: &str, what: String) -> WeftError {
-    WeftError::input(what).in_file("contacts.parquet").in_column(col).at_row(row)
+    WeftError::input(what)
+        .in_file("contacts.parquet")
+        .in_column(col)
+        .at_row(row)
 }
 
 /// Part kinds that can form a contact surface.
 pub fn is_surface_kind(k: ElementKind) -> bool {
-    matches!(k, ElementKind::Tri | ElementKind::Quad | ElementKind::Truss | ElementKind::Beam)
+    matches!(
+        k,
+        ElementKind::Tri | ElementKind::Quad | ElementKind::Truss | ElementKind::Beam
+    )
 }
 
 /// Checks every definition; the messages name contacts.parquet, the column, row and value.
@@ -112,26 +119,56 @@ pub fn validate(m: &Model) -> Result<()> {
     let mut ids = HashMap::new();
     for (row, c) in m.contacts.iter().enumerate() {
         if let Some(first) = ids.insert(c.id, row) {
-            return Err(err(row, "contact_id", format!("duplicate contact id `{}` (first at row {first})", c.id))
-                .expected("unique contact ids"));
+            return Err(err(
+                row,
+                "contact_id",
+                format!("duplicate contact id `{}` (first at row {first})", c.id),
+            )
+            .expected("unique contact ids"));
         }
         let Some(mp) = m.parts.get(c.master) else {
-            return Err(err(row, "master_part", format!("master part index {} out of range", c.master)));
+            return Err(err(
+                row,
+                "master_part",
+                format!("master part index {} out of range", c.master),
+            ));
         };
         if !is_surface_kind(mp.kind) {
-            return Err(err(row, "master_part", format!("master part `{}` is a {} part and has no faces or segments", mp.name, mp.kind.name()))
-                .expected("a part of triangles, quads, trusses or beams")
-                .hint("a contact surface is made of membrane faces or of rod segments"));
+            return Err(err(
+                row,
+                "master_part",
+                format!(
+                    "master part `{}` is a {} part and has no faces or segments",
+                    mp.name,
+                    mp.kind.name()
+                ),
+            )
+            .expected("a part of triangles, quads, trusses or beams")
+            .hint("a contact surface is made of membrane faces or of rod segments"));
         }
-        let has_elements = m.elements.get(&mp.kind).is_some_and(|b| b.part.contains(&c.master));
+        let has_elements = m
+            .elements
+            .get(&mp.kind)
+            .is_some_and(|b| b.part.contains(&c.master));
         if !has_elements {
-            return Err(err(row, "master_part", format!("master part `{}` has no elements: the surface has no faces", mp.name))
-                .expected("a part with at least one element"));
+            return Err(err(
+                row,
+                "master_part",
+                format!(
+                    "master part `{}` has no elements: the surface has no faces",
+                    mp.name
+                ),
+            )
+            .expected("a part with at least one element"));
         }
         match &c.slave {
             Slave::Part(p) => {
                 if m.parts.get(*p).is_none() {
-                    return Err(err(row, "slave_part", format!("slave part index {p} out of range")));
+                    return Err(err(
+                        row,
+                        "slave_part",
+                        format!("slave part index {p} out of range"),
+                    ));
                 }
                 if c.two_way && !is_surface_kind(m.parts[*p].kind) {
                     return Err(err(row, "two_way", format!("two-way contact needs a surface on the slave side, but `{}` is a {} part", m.parts[*p].name, m.parts[*p].kind.name()))
@@ -140,32 +177,62 @@ pub fn validate(m: &Model) -> Result<()> {
             }
             Slave::Set(s) => {
                 if !m.node_sets.contains_key(s) {
-                    return Err(err(row, "slave_set", format!("node set `{s}` does not exist"))
-                        .expected(format!("one of the model's node sets: {}", names(m.node_sets.keys()))));
+                    return Err(
+                        err(row, "slave_set", format!("node set `{s}` does not exist")).expected(
+                            format!(
+                                "one of the model's node sets: {}",
+                                names(m.node_sets.keys())
+                            ),
+                        ),
+                    );
                 }
                 if c.two_way {
-                    return Err(err(row, "two_way", "two-way contact needs a slave part, not a node set".into())
-                        .expected("false with slave_set"));
+                    return Err(err(
+                        row,
+                        "two_way",
+                        "two-way contact needs a slave part, not a node set".into(),
+                    )
+                    .expected("false with slave_set"));
                 }
             }
         }
-        for (col, v) in [("static_friction", c.static_friction), ("dynamic_friction", c.dynamic_friction), ("friction_decay", c.friction_decay)] {
+        for (col, v) in [
+            ("static_friction", c.static_friction),
+            ("dynamic_friction", c.dynamic_friction),
+            ("friction_decay", c.friction_decay),
+        ] {
             if !(v.is_finite() && v >= 0.0) {
                 return Err(err(row, col, format!("{col} is `{v}`")).expected("a finite value ≥ 0"));
             }
         }
         if c.dynamic_friction > c.static_friction {
-            return Err(err(row, "dynamic_friction", format!("dynamic_friction {} exceeds static_friction {}", c.dynamic_friction, c.static_friction))
-                .expected("μ_d ≤ μ_s")
-                .hint("leave dynamic_friction empty for one coefficient"));
+            return Err(err(
+                row,
+                "dynamic_friction",
+                format!(
+                    "dynamic_friction {} exceeds static_friction {}",
+                    c.dynamic_friction, c.static_friction
+                ),
+            )
+            .expected("μ_d ≤ μ_s")
+            .hint("leave dynamic_friction empty for one coefficient"));
         }
         if !(c.penalty_scale.is_finite() && c.penalty_scale > 0.0) {
-            return Err(err(row, "penalty_scale", format!("penalty_scale is `{}`", c.penalty_scale)).expected("a finite value > 0 (null = 1)"));
+            return Err(err(
+                row,
+                "penalty_scale",
+                format!("penalty_scale is `{}`", c.penalty_scale),
+            )
+            .expected("a finite value > 0 (null = 1)"));
         }
-        for (col, v) in [("slave_thickness", c.slave_thickness), ("master_thickness", c.master_thickness)] {
+        for (col, v) in [
+            ("slave_thickness", c.slave_thickness),
+            ("master_thickness", c.master_thickness),
+        ] {
             if let Some(v) = v {
                 if !(v.is_finite() && v >= 0.0) {
-                    return Err(err(row, col, format!("{col} is `{v}`")).expected("a thickness ≥ 0 in m, or null (from the elements)"));
+                    return Err(err(row, col, format!("{col} is `{v}`"))
+                        .expected("a thickness ≥ 0 in m, or null (from the elements)"));
                 }
             }
         }
@@ -189,7 +256,9 @@ pub fn read(dir: &Path, m: &mut Model) -> Result<()> {
     let master = t.str("master_part", CONTACT_COLS)?;
     let sp = t.str_opt("slave_part")?.unwrap_or_else(|| vec![None; n]);
     let ss = t.str_opt("slave_set")?.unwrap_or_else(|| vec![None; n]);
-    let f = |c: &str| -> Result<Vec<Option<f64>>> { Ok(t.f64_opt(c)?.unwrap_or_else(|| vec![None; n])) };
+    let f = |c: &str| -> Result<Vec<Option<f64>>> {
+        Ok(t.f64_opt(c)?.unwrap_or_else(|| vec![None; n]))
+    };
     let (mus, mud, dc, ps, ts, tm) = (
         f("static_friction")?,
         f("dynamic_friction")?,
@@ -199,32 +268,50 @@ pub fn read(dir: &Path, m: &mut Model) -> Result<()> {
         f("master_thickness")?,
     );
     let tw = t.bool_opt("two_way")?.unwrap_or_else(|| vec![None; n]);
-    let ip = t.str_opt("initial_penetration")?.unwrap_or_else(|| vec![None; n]);
+    let ip = t
+        .str_opt("initial_penetration")?
+        .unwrap_or_else(|| vec![None; n]);
     let part = |row: usize, col: &str, name: &str| -> Result<usize> {
         m.part_index(name).ok_or_else(|| {
-            t.value_error(col, row, format!("part `{name}` does not exist in parts.parquet"))
-                .expected(format!("the name of a part: {}", names(m.parts.iter().map(|p| &p.name))))
+            t.value_error(
+                col,
+                row,
+                format!("part `{name}` does not exist in parts.parquet"),
+            )
+            .expected(format!(
+                "the name of a part: {}",
+                names(m.parts.iter().map(|p| &p.name))
+            ))
         })
     };
     let mut defs = Vec::with_capacity(n);
     for row in 0..n {
         let master = part(row, "master_part", &master[row])?;
-        let slave = match (&sp[row], &ss[row]) {
-            (Some(p), None) => Slave::Part(part(row, "slave_part", p)?),
-            (None, Some(s)) => Slave::Set(s.clone()),
-            _ => {
-                return Err(t
-                    .value_error("slave_part", row, "a contact needs exactly one of slave_part and slave_set".into())
-                    .expected("a part name in slave_part or a node set name in slave_set, the other null"))
-            }
-        };
+        let slave =
+            match (&sp[row], &ss[row]) {
+                (Some(p), None) => Slave::Part(part(row, "slave_part", p)?),
+                (None, Some(s)) => Slave::Set(s.clone()),
+                _ => return Err(t
+                    .value_error(
+                        "slave_part",
+                        row,
+                        "a contact needs exactly one of slave_part and slave_set".into(),
+                    )
+                    .expected(
+                        "a part name in slave_part or a node set name in slave_set, the other null",
+                    )),
+            };
         let initial_penetration = match ip[row].as_deref() {
             None | Some("track") => InitialPenetration::Track,
             Some("error") => InitialPenetration::Error,
             Some("keep") => InitialPenetration::Keep,
             Some(o) => {
                 return Err(t
-                    .value_error("initial_penetration", row, format!("unknown initial_penetration `{o}`"))
+                    .value_error(
+                        "initial_penetration",
+                        row,
+                        format!("unknown initial_penetration `{o}`"),
+                    )
                     .expected("`track` (default), `error` or `keep`"))
             }
         };
@@ -259,16 +346,52 @@ pub fn write(m: &Model, dir: &Path, prov: &Provenance) -> Result<()> {
         &batch(vec![
             Col::I64("contact_id", c.iter().map(|d| d.id).collect()),
             Col::Str("master_part", c.iter().map(|d| pname(d.master)).collect()),
-            Col::OptStr("slave_part", c.iter().map(|d| match &d.slave { Slave::Part(p) => Some(pname(*p)), _ => None }).collect()),
-            Col::OptStr("slave_set", c.iter().map(|d| match &d.slave { Slave::Set(s) => Some(s.clone()), _ => None }).collect()),
-            Col::F64("static_friction", c.iter().map(|d| d.static_friction).collect()),
-            Col::F64("dynamic_friction", c.iter().map(|d| d.dynamic_friction).collect()),
-            Col::F64("friction_decay", c.iter().map(|d| d.friction_decay).collect()),
+            Col::OptStr(
+                "slave_part",
+                c.iter()
+                    .map(|d| match &d.slave {
+                        Slave::Part(p) => Some(pname(*p)),
+                        _ => None,
+                    })
+                    .collect(),
+            ),
+            Col::OptStr(
+                "slave_set",
+                c.iter()
+                    .map(|d| match &d.slave {
+                        Slave::Set(s) => Some(s.clone()),
+                        _ => None,
+                    })
+                    .collect(),
+            ),
+            Col::F64(
+                "static_friction",
+                c.iter().map(|d| d.static_friction).collect(),
+            ),
+            Col::F64(
+                "dynamic_friction",
+                c.iter().map(|d| d.dynamic_friction).collect(),
+            ),
+            Col::F64(
+                "friction_decay",
+                c.iter().map(|d| d.friction_decay).collect(),
+            ),
             Col::F64("penalty_scale", c.iter().map(|d| d.penalty_scale).collect()),
-            Col::OptF64("slave_thickness", c.iter().map(|d| d.slave_thickness).collect()),
-            Col::OptF64("master_thickness", c.iter().map(|d| d.master_thickness).collect()),
+            Col::OptF64(
+                "slave_thickness",
+                c.iter().map(|d| d.slave_thickness).collect(),
+            ),
+            Col::OptF64(
+                "master_thickness",
+                c.iter().map(|d| d.master_thickness).collect(),
+            ),
             Col::Bool("two_way", c.iter().map(|d| d.two_way).collect()),
-            Col::Str("initial_penetration", c.iter().map(|d| d.initial_penetration.name().to_string()).collect()),
+            Col::Str(
+                "initial_penetration",
+                c.iter()
+                    .map(|d| d.initial_penetration.name().to_string())
+                    .collect(),
+            ),
         ]),
         prov,
     )

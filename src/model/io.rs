@@ -190,7 +190,10 @@ fn read_model_inner(dir: &Path) -> Result<Model> {
         // Nodal thickness of membranes: t1… (null: the part's thickness).
         let mut tcols = Vec::new();
         if matches!(kind, ElementKind::Tri | ElementKind::Quad) {
-            for c in ["t1", "t2", "t3", "t4"].iter().take(kind.nodes_per_element()) {
+            for c in ["t1", "t2", "t3", "t4"]
+                .iter()
+                .take(kind.nodes_per_element())
+            {
                 if let Some(v) = t.f64_opt(c)? {
                     tcols.push(v);
                 }
@@ -214,9 +217,12 @@ fn read_model_inner(dir: &Path) -> Result<Model> {
                 }
             }
             if !s0cols.is_empty() && s0cols.len() != 3 {
-                return Err(WeftError::input(format!("{} of the initial stress columns s0_11, s0_22, s0_12 are present", s0cols.len()))
-                    .in_file(&t.path)
-                    .expected("all three or none"));
+                return Err(WeftError::input(format!(
+                    "{} of the initial stress columns s0_11, s0_22, s0_12 are present",
+                    s0cols.len()
+                ))
+                .in_file(&t.path)
+                .expected("all three or none"));
             }
         }
         let mut b = ElementBlock::default();
@@ -239,7 +245,8 @@ fn read_model_inner(dir: &Path) -> Result<Model> {
                 b.thickness.push(c[row].unwrap_or(pt));
             }
             if !s0cols.is_empty() {
-                b.stress0.push(std::array::from_fn(|k| s0cols[k][row].unwrap_or(0.0)));
+                b.stress0
+                    .push(std::array::from_fn(|k| s0cols[k][row].unwrap_or(0.0)));
             }
         }
         m.elements.insert(kind, b);
@@ -608,7 +615,10 @@ fn write_tables(m: &Model, dir: &Path, prov: &Provenance) -> Result<()> {
         }
         if !b.thickness.is_empty() {
             for (j, c) in ["t1", "t2", "t3", "t4"].into_iter().take(npe).enumerate() {
-                cols.push(Col::F64(c, b.thickness.iter().skip(j).step_by(npe).copied().collect()));
+                cols.push(Col::F64(
+                    c,
+                    b.thickness.iter().skip(j).step_by(npe).copied().collect(),
+                ));
             }
         }
         if !b.stress0.is_empty() {

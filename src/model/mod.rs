@@ -374,7 +374,13 @@ impl Model {
     }
 
     /// Add a membrane element with a thickness at each of its nodes [m].
-    pub fn add_element_with_thickness(&mut self, id: i64, part: usize, nodes: &[usize], thickness: &[f64]) {
+    pub fn add_element_with_thickness(
+        &mut self,
+        id: i64,
+        part: usize,
+        nodes: &[usize],
+        thickness: &[f64],
+    ) {
         assert_eq!(nodes.len(), thickness.len(), "one thickness per node");
         let kind = self.parts[part].kind;
         let parts = &self.parts;
@@ -675,19 +681,32 @@ impl Model {
         for (kind, b) in &self.elements {
             if !b.stress0.is_empty() {
                 let file = format!("elements_{}.parquet", kind.name());
-                if !matches!(kind, ElementKind::Tri | ElementKind::Quad) || b.stress0.len() != b.len() {
-                    return Err(WeftError::input(format!("{} elements carry {} initial stresses for {} elements", kind.name(), b.stress0.len(), b.len()))
-                        .in_file(file)
-                        .expected("initial stress columns s0_11, s0_22, s0_12 on tri and quad tables only"));
+                if !matches!(kind, ElementKind::Tri | ElementKind::Quad)
+                    || b.stress0.len() != b.len()
+                {
+                    return Err(WeftError::input(format!(
+                        "{} elements carry {} initial stresses for {} elements",
+                        kind.name(),
+                        b.stress0.len(),
+                        b.len()
+                    ))
+                    .in_file(file)
+                    .expected(
+                        "initial stress columns s0_11, s0_22, s0_12 on tri and quad tables only",
+                    ));
                 }
                 for (e, s) in b.stress0.iter().enumerate() {
                     for (c, v) in ["s0_11", "s0_22", "s0_12"].iter().zip(s) {
                         if !v.is_finite() {
-                            return Err(WeftError::input(format!("{} `{}` has initial stress {c} = `{v}`", kind.name(), b.id[e]))
-                                .in_file(file.clone())
-                                .in_column(*c)
-                                .at_row(e)
-                                .expected("a finite stress in Pa, or null for 0"));
+                            return Err(WeftError::input(format!(
+                                "{} `{}` has initial stress {c} = `{v}`",
+                                kind.name(),
+                                b.id[e]
+                            ))
+                            .in_file(file.clone())
+                            .in_column(*c)
+                            .at_row(e)
+                            .expected("a finite stress in Pa, or null for 0"));
                         }
                     }
                 }
@@ -697,7 +716,9 @@ impl Model {
             }
             let npe = kind.nodes_per_element();
             let file = format!("elements_{}.parquet", kind.name());
-            if !matches!(kind, ElementKind::Tri | ElementKind::Quad) || b.thickness.len() != npe * b.len() {
+            if !matches!(kind, ElementKind::Tri | ElementKind::Quad)
+                || b.thickness.len() != npe * b.len()
+            {
                 return Err(WeftError::input(format!(
                     "{} elements carry {} nodal thicknesses for {} elements",
                     kind.name(),
@@ -705,7 +726,9 @@ impl Model {
                     b.len()
                 ))
                 .in_file(file)
-                .expected("nodal thickness columns t1… on tri and quad tables only, one per element node"));
+                .expected(
+                    "nodal thickness columns t1… on tri and quad tables only, one per element node",
+                ));
             }
             for (k, &t) in b.thickness.iter().enumerate() {
                 if !(t.is_finite() && t >= 0.0) {

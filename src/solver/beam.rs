@@ -202,7 +202,10 @@ pub struct Rotations {
 
 impl Rotations {
     pub fn new(nodes: usize) -> Rotations {
-        Rotations { of_node: vec![u32::MAX; nodes], ..Default::default() }
+        Rotations {
+            of_node: vec![u32::MAX; nodes],
+            ..Default::default()
+        }
     }
     pub fn len(&self) -> usize {
         self.node.len()
@@ -215,7 +218,8 @@ impl Rotations {
         if self.of_node[n] == u32::MAX {
             self.of_node[n] = self.node.len() as u32;
             self.node.push(n);
-            self.r.push([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]);
+            self.r
+                .push([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]);
             self.omega.push([0.0; 3]);
             self.j.push(0.0);
             self.fixed.push(0);
@@ -284,7 +288,9 @@ impl Family for BeamGroup {
     fn build(bd: &mut Build) -> Result<Self> {
         let m = bd.model;
         let mut g = BeamGroup::default();
-        let Some(b) = m.block(ElementKind::Beam) else { return Ok(g) };
+        let Some(b) = m.block(ElementKind::Beam) else {
+            return Ok(g);
+        };
         for e in 0..b.len() {
             let p = &m.parts[b.part[e]].props;
             let (a, c) = (b.nodes[2 * e], b.nodes[2 * e + 1]);
@@ -296,8 +302,12 @@ impl Family for BeamGroup {
             })?;
             let d = super::vec3::sub(&m.coords[c], &m.coords[a]);
             let l0 = dot(&d, &d).sqrt();
-            let (em, rho, bw, hh) =
-                (p.youngs_modulus.unwrap(), p.density.unwrap(), p.width.unwrap(), p.height.unwrap());
+            let (em, rho, bw, hh) = (
+                p.youngs_modulus.unwrap(),
+                p.density.unwrap(),
+                p.width.unwrap(),
+                p.height.unwrap(),
+            );
             let gm = em / (2.0 * (1.0 + p.poisson_ratio.unwrap_or(0.3)));
             let area = bw * hh;
             let me = rho * area * l0;
@@ -342,11 +352,21 @@ impl Family for BeamGroup {
         let (nodes, rot, props) = (&self.nodes, &self.rot, &self.props);
         let body = |(ci, (out, mo)): (usize, (&mut [[f64; 3]], &mut [[f64; 3]]))| {
             let e0 = ci * CHUNK;
-            for (j, (f, m)) in out.chunks_exact_mut(2).zip(mo.chunks_exact_mut(2)).enumerate() {
+            for (j, (f, m)) in out
+                .chunks_exact_mut(2)
+                .zip(mo.chunks_exact_mut(2))
+                .enumerate()
+            {
                 let e = e0 + j;
                 let [a, b] = nodes[e];
                 let [ra, rb] = rot[e];
-                let r = forces(&x[a as usize], &x[b as usize], &rr[ra as usize], &rr[rb as usize], &props[e]);
+                let r = forces(
+                    &x[a as usize],
+                    &x[b as usize],
+                    &rr[ra as usize],
+                    &rr[rb as usize],
+                    &props[e],
+                );
                 f[0] = r[0];
                 f[1] = r[1];
                 m[0] = r[2];
@@ -378,8 +398,11 @@ impl Family for BeamGroup {
                 let (n, o) = (n as usize, o as usize);
                 let (mn, jn) = (ctx.mass[n].max(f64::MIN_POSITIVE), ctx.rot_j[rk as usize]);
                 let wo = if ctx.fixed[o] == 0b111 { 1.0 } else { 2.0 };
-                s[n] += wo * p.ea / l + 24.0 * ei / l.powi(3) + 12.0 * ei / (l * l) * (mn / jn).sqrt();
-                rrow[n] += 12.0 * ei / (l * l * (mn * jn).sqrt()) + 6.0 * ei / (l * jn) + 2.0 * p.gj / (l * jn);
+                s[n] +=
+                    wo * p.ea / l + 24.0 * ei / l.powi(3) + 12.0 * ei / (l * l) * (mn / jn).sqrt();
+                rrow[n] += 12.0 * ei / (l * l * (mn * jn).sqrt())
+                    + 6.0 * ei / (l * jn)
+                    + 2.0 * p.gj / (l * jn);
             }
         }
     }
@@ -390,7 +413,13 @@ impl Family for BeamGroup {
             .map(|e| {
                 let [a, b] = self.nodes[e];
                 let [ra, rb] = self.rot[e];
-                energy(&x[a as usize], &x[b as usize], &rr[ra as usize], &rr[rb as usize], &self.props[e])
+                energy(
+                    &x[a as usize],
+                    &x[b as usize],
+                    &rr[ra as usize],
+                    &rr[rb as usize],
+                    &self.props[e],
+                )
             })
             .sum();
         self.partials.clear();

@@ -227,9 +227,13 @@ where
 {
     use rayon::prelude::*;
     if n_elements <= CHUNK {
-        out.chunks_mut(per * CHUNK).enumerate().for_each(|(ci, o)| body(ci, o));
+        out.chunks_mut(per * CHUNK)
+            .enumerate()
+            .for_each(|(ci, o)| body(ci, o));
     } else {
-        out.par_chunks_mut(per * CHUNK).enumerate().for_each(|(ci, o)| body(ci, o));
+        out.par_chunks_mut(per * CHUNK)
+            .enumerate()
+            .for_each(|(ci, o)| body(ci, o));
     }
 }
 

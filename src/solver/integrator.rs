@@ -56,7 +56,13 @@ pub fn advance_nodes<const SNAP: bool>(
     let fcon = op.has_fcon().then_some(&op.fcon);
     type Chunk<'c> = (
         usize,
-        ((((&'c mut [[f64; 3]], &'c mut [[f64; 3]]), &'c mut [[f64; 3]]), &'c mut [[f64; 3]]), &'c mut NodePartial),
+        (
+            (
+                ((&'c mut [[f64; 3]], &'c mut [[f64; 3]]), &'c mut [[f64; 3]]),
+                &'c mut [[f64; 3]],
+            ),
+            &'c mut NodePartial,
+        ),
     );
     let body = |(ci, ((((x, v), xn), vn), part)): Chunk| {
         let i0 = ci * CHUNK;
@@ -81,8 +87,16 @@ pub fn advance_nodes<const SNAP: bool>(
                 }
             }
             let vo = v[j];
-            let vh = [(vo[0] + h_prev * a[0]) * c1, (vo[1] + h_prev * a[1]) * c1, (vo[2] + h_prev * a[2]) * c1];
-            let vnew = [vh[0] * c2 + h_next * a[0], vh[1] * c2 + h_next * a[1], vh[2] * c2 + h_next * a[2]];
+            let vh = [
+                (vo[0] + h_prev * a[0]) * c1,
+                (vo[1] + h_prev * a[1]) * c1,
+                (vo[2] + h_prev * a[2]) * c1,
+            ];
+            let vnew = [
+                vh[0] * c2 + h_next * a[0],
+                vh[1] * c2 + h_next * a[1],
+                vh[2] * c2 + h_next * a[2],
+            ];
             let v2 = dot(&vh, &vh);
             if SNAP {
                 xn[j] = x[j];
@@ -91,14 +105,24 @@ pub fn advance_nodes<const SNAP: bool>(
             }
             dp += mass[i] * v2;
             let xo = x[j];
-            let xnew = [xo[0] + dt_next * vnew[0], xo[1] + dt_next * vnew[1], xo[2] + dt_next * vnew[2]];
-            if !(vnew[0] + vnew[1] + vnew[2] + xnew[0] + xnew[1] + xnew[2]).is_finite() && bad == usize::MAX {
+            let xnew = [
+                xo[0] + dt_next * vnew[0],
+                xo[1] + dt_next * vnew[1],
+                xo[2] + dt_next * vnew[2],
+            ];
+            if !(vnew[0] + vnew[1] + vnew[2] + xnew[0] + xnew[1] + xnew[2]).is_finite()
+                && bad == usize::MAX
+            {
                 bad = i;
             }
             v[j] = vnew;
             x[j] = xnew;
         }
-        *part = NodePartial { ke, damp_power: alpha * dp, bad };
+        *part = NodePartial {
+            ke,
+            damp_power: alpha * dp,
+            bad,
+        };
     };
     if st.x.len() <= CHUNK {
         st.x.chunks_mut(CHUNK)
@@ -150,7 +174,13 @@ pub fn advance_rotations(
             add(&mut mom, &moments[sl as usize]);
         }
         let ij = 1.0 / rot.j[k];
-        let a: [f64; 3] = std::array::from_fn(|d| if rot.fixed[k] & (1 << d) != 0 { 0.0 } else { mom[d] * ij });
+        let a: [f64; 3] = std::array::from_fn(|d| {
+            if rot.fixed[k] & (1 << d) != 0 {
+                0.0
+            } else {
+                mom[d] * ij
+            }
+        });
         let w = rot.omega[k];
         let wn: [f64; 3] = std::array::from_fn(|d| (w[d] + 0.5 * dt_prev * a[d]) * c1);
         let wnew: [f64; 3] = std::array::from_fn(|d| wn[d] * c2 + 0.5 * dt_next * a[d]);
@@ -159,14 +189,20 @@ pub fn advance_rotations(
         dp += alpha * rot.j[k] * w2;
         if !(wnew[0] + wnew[1] + wnew[2]).is_finite() {
             return Err(WeftError::Numerical {
-                what: format!("the rotation of node `{}` became NaN or infinite", node_id[rot.node[k]]),
+                what: format!(
+                    "the rotation of node `{}` became NaN or infinite",
+                    node_id[rot.node[k]]
+                ),
                 step,
                 time: t,
                 hint: Some("check the beam properties near this node".into()),
             });
         }
         rot.omega[k] = wnew;
-        rot.r[k] = beam::rotate(&rot.r[k], &[dt_next * wnew[0], dt_next * wnew[1], dt_next * wnew[2]]);
+        rot.r[k] = beam::rotate(
+            &rot.r[k],
+            &[dt_next * wnew[0], dt_next * wnew[1], dt_next * wnew[2]],
+        );
     }
     Ok((ke, dp))
 }

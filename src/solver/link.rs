@@ -107,7 +107,9 @@ pub fn energy(d: &[f64; 3], p: &LinkProps, slip: &[f64; 2]) -> f64 {
 
 use rayon::prelude::*;
 
-use super::family::{chunk_partials, Build, EnergyGroup, EnergyPartial, Family, ForceCtx, StiffCtx, CHUNK};
+use super::family::{
+    chunk_partials, Build, EnergyGroup, EnergyPartial, Family, ForceCtx, StiffCtx, CHUNK,
+};
 use crate::error::Result;
 use crate::model::ElementKind;
 
@@ -131,7 +133,9 @@ impl Family for LinkGroup {
     fn build(bd: &mut Build) -> Result<Self> {
         let m = bd.model;
         let mut g = LinkGroup::default();
-        let Some(b) = m.block(ElementKind::Link) else { return Ok(g) };
+        let Some(b) = m.block(ElementKind::Link) else {
+            return Ok(g);
+        };
         for e in 0..b.len() {
             let p = &m.parts[b.part[e]].props;
             let (a, c) = (b.nodes[2 * e], b.nodes[2 * e + 1]);
@@ -190,7 +194,13 @@ impl Family for LinkGroup {
         }
     }
     fn stiffness_sums(&self, ctx: &StiffCtx, s: &mut [f64], c: &mut [f64], _r: &mut [f64]) {
-        let w = |other: u32| if ctx.fixed[other as usize] == 0b111 { 1.0 } else { 2.0 };
+        let w = |other: u32| {
+            if ctx.fixed[other as usize] == 0b111 {
+                1.0
+            } else {
+                2.0
+            }
+        };
         for (e, p) in self.nodes.iter().enumerate() {
             let pr = &self.props[e];
             let kmax = pr.k.iter().cloned().fold(0.0, f64::max);

@@ -327,7 +327,10 @@ pub fn energy<const N: usize>(
     let (_, e) = kinematics(x, r);
     let s = stress(m, &e);
     let s0 = m.s0;
-    let w = 0.5 * r.area * thickness * ((s[0] - s0[0]) * e[0] + (s[1] - s0[1]) * e[1] + (s[2] - s0[2]) * e[2])
+    let w = 0.5
+        * r.area
+        * thickness
+        * ((s[0] - s0[0]) * e[0] + (s[1] - s0[1]) * e[1] + (s[2] - s0[2]) * e[2])
         + r.area * thickness * (s0[0] * e[0] + s0[1] * e[1] + s0[2] * e[2]);
     let mut hg = 0.0;
     if N == 4 && k_hg > 0.0 {
@@ -391,7 +394,10 @@ pub fn max_stiffness<const N: usize>(
 // ---------------------------------------------------------------------------------------
 // The membrane families (triangles and quads).
 
-use super::family::{chunk_partials, for_chunks, Build, EnergyGroup, EnergyPartial, Family, ForceCtx, StiffCtx, CHUNK};
+use super::family::{
+    chunk_partials, for_chunks, Build, EnergyGroup, EnergyPartial, Family, ForceCtx, StiffCtx,
+    CHUNK,
+};
 use crate::model::ElementKind;
 
 /// Membrane elements with `N` nodes (3: triangles, 4: quads), struct-of-arrays.
@@ -412,7 +418,11 @@ pub struct MembraneGroup<const N: usize> {
 }
 
 impl<const N: usize> Family for MembraneGroup<N> {
-    const KIND: ElementKind = if N == 3 { ElementKind::Tri } else { ElementKind::Quad };
+    const KIND: ElementKind = if N == 3 {
+        ElementKind::Tri
+    } else {
+        ElementKind::Quad
+    };
     const SLOTS: usize = N;
     const GROUP: EnergyGroup = EnergyGroup::Membrane;
 
@@ -447,7 +457,9 @@ impl<const N: usize> Family for MembraneGroup<N> {
                 ))
                 .in_file(format!("elements_{}.parquet", kind.name()))
                 .at_row(e)
-                .expected("nodes in counter-clockwise order around a convex element of positive area")
+                .expected(
+                    "nodes in counter-clockwise order around a convex element of positive area",
+                )
             })?;
             let mat = Material::orthotropic(
                 p.youngs_modulus_1.unwrap(),
@@ -517,7 +529,13 @@ impl<const N: usize> Family for MembraneGroup<N> {
                 let e = e0 + j;
                 let nodes = &g.nodes[e];
                 let xe: [[f64; 3]; N] = std::array::from_fn(|a| x[nodes[a] as usize]);
-                let f = forces(&xe, &g.reference[e], &g.material[e], g.thickness[e], g.k_hg[e]);
+                let f = forces(
+                    &xe,
+                    &g.reference[e],
+                    &g.material[e],
+                    g.thickness[e],
+                    g.k_hg[e],
+                );
                 el.copy_from_slice(&f);
             }
         });
@@ -532,8 +550,13 @@ impl<const N: usize> Family for MembraneGroup<N> {
     }
     fn energies(&mut self, ctx: &ForceCtx) -> &[EnergyPartial] {
         let x = ctx.x;
-        let (nodes, reference, material, thickness, k_hg) =
-            (&self.nodes, &self.reference, &self.material, &self.thickness, &self.k_hg);
+        let (nodes, reference, material, thickness, k_hg) = (
+            &self.nodes,
+            &self.reference,
+            &self.material,
+            &self.thickness,
+            &self.k_hg,
+        );
         chunk_partials(&mut self.partials, nodes.len(), |r| {
             let mut acc = [0.0; 4];
             for e in r {

@@ -45,8 +45,8 @@ use std::time::{Duration, Instant};
 use crate::error::{Result, WeftError};
 use crate::model::{ElementKind, Model};
 
-pub use family::CHUNK;
 use family::ForceCtx;
+pub use family::CHUNK;
 use integrator::{Nodal, NodePartial};
 pub use operator::{Operator, State};
 pub use stable::{MassScaling, StableStep};
@@ -182,14 +182,29 @@ struct Ledger {
 
 impl Ledger {
     /// Books the energies at t_n; the relative balance error.
-    fn book(&mut self, ke: f64, el: &ElementEnergies, contact: f64, w_ext: f64, step: u64) -> Energies {
+    fn book(
+        &mut self,
+        ke: f64,
+        el: &ElementEnergies,
+        contact: f64,
+        w_ext: f64,
+        step: u64,
+    ) -> Energies {
         let (ie, damp, fric, hg) = (el.internal, el.damping, el.friction, el.hourglass);
         let total = ke + ie + damp + self.mass_damping + fric + hg + contact;
         let e_init = *self.e0.get_or_insert(total);
         let err = total - e_init - w_ext;
         // |E_int|: with initial stresses the stored energy ½E·DE + S₀·E can be negative.
-        self.reference = self.reference.max(e_init.abs()).max(w_ext.abs()).max(ke + ie.abs());
-        let rel = if self.reference > 0.0 { err.abs() / self.reference } else { 0.0 };
+        self.reference = self
+            .reference
+            .max(e_init.abs())
+            .max(w_ext.abs())
+            .max(ke + ie.abs());
+        let rel = if self.reference > 0.0 {
+            err.abs() / self.reference
+        } else {
+            0.0
+        };
         if step >= ENERGY_CHECK_AFTER {
             self.max_rel = self.max_rel.max(rel);
         }
@@ -238,7 +253,11 @@ struct Sampler {
 
 impl Sampler {
     fn new(nout: usize) -> Sampler {
-        let prev = Snapshot { u: vec![[0.0; 3]; nout], v: vec![[0.0; 3]; nout], ..Default::default() };
+        let prev = Snapshot {
+            u: vec![[0.0; 3]; nout],
+            v: vec![[0.0; 3]; nout],
+            ..Default::default()
+        };
         Sampler {
             cur: prev.clone(),
             prev,
@@ -263,12 +282,18 @@ impl Sampler {
         let (prev, cur) = (&self.prev, &self.cur);
         while *k <= n_out && *k as f64 * dt_out <= cur.t {
             let tk = *k as f64 * dt_out;
-            let w = if self.have_prev && prev.t < tk { (tk - prev.t) / (cur.t - prev.t) } else { 1.0 };
+            let w = if self.have_prev && prev.t < tk {
+                (tk - prev.t) / (cur.t - prev.t)
+            } else {
+                1.0
+            };
             for (j, id) in ids.iter().enumerate() {
                 let row: [f64; 9] = if w >= 1.0 {
                     cur.proj[j]
                 } else {
-                    std::array::from_fn(|c| prev.proj[j][c] + w * (cur.proj[j][c] - prev.proj[j][c]))
+                    std::array::from_fn(|c| {
+                        prev.proj[j][c] + w * (cur.proj[j][c] - prev.proj[j][c])
+                    })
                 };
                 sink.projectile(tk, *id, &row)?;
             }
@@ -354,7 +379,11 @@ fn output_nodes(m: &Model) -> Result<Vec<usize>> {
                 .in_column("history_sets")
                 .expected(format!(
                     "one of the model's node sets: {}",
-                    m.node_sets.keys().map(|k| format!("`{k}`")).collect::<Vec<_>>().join(", ")
+                    m.node_sets
+                        .keys()
+                        .map(|k| format!("`{k}`"))
+                        .collect::<Vec<_>>()
+                        .join(", ")
                 ))
         })?;
         for &i in set {
@@ -371,11 +400,17 @@ impl Solver {
         m.validate()?;
         let nn = m.num_nodes();
         if nn >= u32::MAX as usize {
-            return Err(WeftError::input(format!("{nn} nodes exceed the solver's limit of 2³²−1")));
+            return Err(WeftError::input(format!(
+                "{nn} nodes exceed the solver's limit of 2³²−1"
+            )));
         }
         let mut mass = vec![0.0; nn];
         let mut rot = beam::Rotations::new(nn);
-        let el = Families::build(&mut family::Build { model: m, mass: &mut mass, rot: &mut rot })?;
+        let el = Families::build(&mut family::Build {
+            model: m,
+            mass: &mut mass,
+            rot: &mut rot,
+        })?;
         rot.finish(m, &el.beam);
         let faces: Vec<(&[u32], f64)> = el
             .tri
@@ -383,7 +418,13 @@ impl Solver {
             .iter()
             .map(|f| &f[..])
             .zip(el.tri.mass.iter().copied())
-            .chain(el.quad.nodes.iter().map(|f| &f[..]).zip(el.quad.mass.iter().copied()))
+            .chain(
+                el.quad
+                    .nodes
+                    .iter()
+                    .map(|f| &f[..])
+                    .zip(el.quad.mass.iter().copied()),
+            )
             .collect();
         let projectiles = contact::ProjectileContact::new(m, &faces);
         let fixed = fixed_dofs(m);
@@ -416,7 +457,12 @@ impl Solver {
             partials: vec![NodePartial::default(); nn.div_ceil(CHUNK)],
             alpha: m.analysis.mass_damping,
             output_nodes: output_nodes(m)?,
-            stable: StableStep { dt: 0.0, dt_stable: 0.0, node: 0, element: None },
+            stable: StableStep {
+                dt: 0.0,
+                dt_stable: 0.0,
+                node: 0,
+                element: None,
+            },
             scaling: None,
             analysis: m.analysis.clone(),
             ledger: Ledger::default(),
@@ -428,7 +474,8 @@ impl Solver {
             s.op.surfaces = contact::SurfaceContact::new(m, &s.mass);
             s.op.surfaces.start(m)?;
         }
-        s.op.ties.update_slaves(&mut s.state.x, &mut s.state.v, None);
+        s.op.ties
+            .update_slaves(&mut s.state.x, &mut s.state.v, None);
         s.check_slave_velocities(m)?;
         Ok(s)
     }
@@ -441,15 +488,25 @@ impl Solver {
         }
         for i in 0..m.num_nodes() {
             let attached = !op.gather.of(i).is_empty();
-            if mass[i] <= 0.0 && fixed[i] != 0b111 && (attached || loaded[i]) && !op.ties.is_slave[i] {
+            if mass[i] <= 0.0
+                && fixed[i] != 0b111
+                && (attached || loaded[i])
+                && !op.ties.is_slave[i]
+            {
                 return Err(WeftError::input(format!(
                     "node `{}` has no mass but can move and {}",
                     m.node_id[i],
-                    if attached { "has elements attached" } else { "carries a load" }
+                    if attached {
+                        "has elements attached"
+                    } else {
+                        "carries a load"
+                    }
                 ))
                 .in_file("nodes.parquet")
                 .expected("mass > 0 at every free node that elements or loads act on")
-                .hint("links carry no mass: attach a truss or a point_mass to the node, or fix it"));
+                .hint(
+                    "links carry no mass: attach a truss or a point_mass to the node, or fix it",
+                ));
             }
         }
         Ok(())
@@ -463,9 +520,13 @@ impl Solver {
     fn set_time_step(&mut self, kappa: f64) -> Result<()> {
         let a = self.analysis.clone();
         if a.time_step.is_some() && a.target_time_step.is_some() {
-            return Err(WeftError::input("both time_step and target_time_step are set")
-                .in_file("analysis.parquet")
-                .expected("at most one: a fixed step, or a target step reached by mass scaling"));
+            return Err(
+                WeftError::input("both time_step and target_time_step are set")
+                    .in_file("analysis.parquet")
+                    .expected(
+                        "at most one: a fixed step, or a target step reached by mass scaling",
+                    ),
+            );
         }
         if let Some(target) = a.target_time_step {
             self.scale_mass(target, a.dt_safety);
@@ -475,14 +536,18 @@ impl Solver {
         }
         let (dt_stable, node) = self.stable_step();
         if !dt_stable.is_finite() && a.time_step.is_none() {
-            return Err(WeftError::input("no element limits the time step (the model has no stiffness)")
-                .expected("at least one truss, or a link with stiffness or damping")
-                .hint("set `time_step` in analysis.parquet for a model of free masses"));
+            return Err(WeftError::input(
+                "no element limits the time step (the model has no stiffness)",
+            )
+            .expected("at least one truss, or a link with stiffness or damping")
+            .hint("set `time_step` in analysis.parquet for a model of free masses"));
         }
         let dt = match (a.time_step, a.target_time_step) {
             (Some(dt), _) => {
                 if dt > dt_stable {
-                    let (k, id) = self.controlling_element(node).unwrap_or((ElementKind::PointMass, -1));
+                    let (k, id) = self
+                        .controlling_element(node)
+                        .unwrap_or((ElementKind::PointMass, -1));
                     return Err(WeftError::input(format!(
                         "time_step {dt:.4e} s exceeds the stable step {dt_stable:.4e} s set by node `{}` ({} `{id}`)",
                         self.node_id[node],
@@ -507,14 +572,23 @@ impl Solver {
                     .expected(format!("κ < 2 dt_safety² = {}", 2.0 * a.dt_safety * a.dt_safety))
                     .hint("lower penalty_scale (1 is LS-DYNA's SOFT = 1 default)"));
                 }
-                let safe = if kappa > 0.0 { dt_stable * s2.sqrt() } else { a.dt_safety * dt_stable };
+                let safe = if kappa > 0.0 {
+                    dt_stable * s2.sqrt()
+                } else {
+                    a.dt_safety * dt_stable
+                };
                 match other {
                     Some(target) => target.min(safe),
                     None => safe,
                 }
             }
         };
-        self.stable = StableStep { dt, dt_stable, node, element: self.controlling_element(node) };
+        self.stable = StableStep {
+            dt,
+            dt_stable,
+            node,
+            element: self.controlling_element(node),
+        };
         Ok(())
     }
 
@@ -541,10 +615,24 @@ impl Solver {
     /// states). Sums run over fixed chunks into preallocated partials, summed in
     /// chunk order.
     fn element_energies_at(&mut self, use_xn: bool) -> ElementEnergies {
-        let x = if use_xn { &self.state.xn } else { &self.state.x };
-        let ctx = ForceCtx { x, v: &self.state.v, rot_r: &self.state.rot.r, dt_prev: self.state.dt_prev };
+        let x = if use_xn {
+            &self.state.xn
+        } else {
+            &self.state.x
+        };
+        let ctx = ForceCtx {
+            x,
+            v: &self.state.v,
+            rot_r: &self.state.rot.r,
+            dt_prev: self.state.dt_prev,
+        };
         let sums = self.op.el.energies(&ctx);
-        ElementEnergies { internal: sums.total(0), damping: sums.total(1), friction: sums.total(2), hourglass: sums.total(3) }
+        ElementEnergies {
+            internal: sums.total(0),
+            damping: sums.total(1),
+            friction: sums.total(2),
+            hourglass: sums.total(3),
+        }
     }
 
     /// Element energies at the current positions: (internal, damping, friction,
@@ -605,7 +693,11 @@ impl Solver {
 
     /// Run to the end time, sending samples on the output grid to `sink`. `progress` is
     /// called now and then with the fraction of simulated time done.
-    pub fn run(&mut self, sink: &mut (dyn Sink + Send), progress: &mut (dyn FnMut(f64) + Send)) -> Result<RunStats> {
+    pub fn run(
+        &mut self,
+        sink: &mut (dyn Sink + Send),
+        progress: &mut (dyn FnMut(f64) + Send),
+    ) -> Result<RunStats> {
         self.run_until(sink, progress, &mut |_, _| false)
     }
 
@@ -623,7 +715,13 @@ impl Solver {
         let dt = self.stable.dt;
         let mut times = PhaseTimes::default();
         let mut sampler = Sampler::new(self.output_nodes.len());
-        let proj_ids: Vec<i64> = self.op.projectiles.projectiles.iter().map(|p| p.id).collect();
+        let proj_ids: Vec<i64> = self
+            .op
+            .projectiles
+            .projectiles
+            .iter()
+            .map(|p| p.id)
+            .collect();
         let mut k = 0u64;
         let progress_every = (n_out / 200).max(1);
         let mut last_e = Energies::default();
@@ -640,25 +738,54 @@ impl Solver {
             times.forces += t2 - t1;
             let dt_next = dt;
             let snap = k as f64 * a.output_interval <= self.state.t + dt_next;
-            let nd = Nodal { inv_m: &self.inv_m, mass: &self.mass, fixed: &self.fixed, alpha: self.alpha };
+            let nd = Nodal {
+                inv_m: &self.inv_m,
+                mass: &self.mass,
+                fixed: &self.fixed,
+                alpha: self.alpha,
+            };
             let r = if snap {
-                integrator::advance_nodes::<true>(&mut self.state, &self.op, &nd, dt_next, &mut self.partials)
+                integrator::advance_nodes::<true>(
+                    &mut self.state,
+                    &self.op,
+                    &nd,
+                    dt_next,
+                    &mut self.partials,
+                )
             } else {
-                integrator::advance_nodes::<false>(&mut self.state, &self.op, &nd, dt_next, &mut self.partials)
+                integrator::advance_nodes::<false>(
+                    &mut self.state,
+                    &self.op,
+                    &nd,
+                    dt_next,
+                    &mut self.partials,
+                )
             };
             let (ke, dp) = r.map_err(|node| self.nan_error(node))?;
             // Element energies at t_n (x^n is in xn), before the rotations advance.
-            let el_e = if snap { self.element_energies_at(true) } else { ElementEnergies::default() };
+            let el_e = if snap {
+                self.element_energies_at(true)
+            } else {
+                ElementEnergies::default()
+            };
             let (ke_rot, dp_rot) = if self.state.rot.is_empty() {
                 (0.0, 0.0)
             } else {
-                integrator::advance_rotations(&mut self.state, &self.op.el.beam.moments, self.alpha, dt_next, &self.node_id)?
+                integrator::advance_rotations(
+                    &mut self.state,
+                    &self.op.el.beam.moments,
+                    self.alpha,
+                    dt_next,
+                    &self.node_id,
+                )?
             };
             let (ke, dp) = (ke + ke_rot, dp + dp_rot);
             self.ledger.mass_damping += 0.5 * self.state.dt_prev * dp;
             if !self.op.ties.is_empty() {
                 let st = &mut self.state;
-                self.op.ties.update_slaves(&mut st.x, &mut st.v, snap.then_some(&mut st.vn[..]));
+                self.op
+                    .ties
+                    .update_slaves(&mut st.x, &mut st.v, snap.then_some(&mut st.vn[..]));
             }
             let mut contact_e = 0.0;
             if snap {
@@ -666,7 +793,8 @@ impl Solver {
                 sampler.cur.proj.clear();
                 for p in &self.op.projectiles.projectiles {
                     sampler.cur.proj.push([
-                        p.tip[0], p.tip[1], p.tip[2], 0.0, 0.0, 0.0, p.force[0], p.force[1], p.force[2],
+                        p.tip[0], p.tip[1], p.tip[2], 0.0, 0.0, 0.0, p.force[0], p.force[1],
+                        p.force[2],
                     ]);
                 }
                 if !self.op.projectiles.is_empty() {
@@ -682,7 +810,12 @@ impl Solver {
             let t3 = Instant::now();
             times.update += t3 - t2;
             if snap {
-                for (row, p) in sampler.cur.proj.iter_mut().zip(&self.op.projectiles.projectiles) {
+                for (row, p) in sampler
+                    .cur
+                    .proj
+                    .iter_mut()
+                    .zip(&self.op.projectiles.projectiles)
+                {
                     row[3..6].copy_from_slice(&p.v_full);
                 }
                 let contact = contact_e
@@ -693,7 +826,9 @@ impl Solver {
                 sampler.cur.t = self.state.t;
                 sampler.cur.e = e;
                 last_e = e;
-                if e.balance_error_relative > a.max_energy_error && self.state.step >= ENERGY_CHECK_AFTER {
+                if e.balance_error_relative > a.max_energy_error
+                    && self.state.step >= ENERGY_CHECK_AFTER
+                {
                     return Err(WeftError::Numerical {
                         what: format!(
                             "energy balance error {:.3e} J is {:.1} % of the reference energy {:.3e} J (limit {:.1} %): the run is unstable or a force is not conservative",
@@ -713,11 +848,19 @@ impl Solver {
                     sampler.cur.u[j] = [x[0] - x0[0], x[1] - x0[1], x[2] - x0[2]];
                     sampler.cur.v[j] = self.state.vn[i];
                 }
-                sampler.emit(&mut k, n_out, a.output_interval, &proj_ids, &self.output_nodes, sink, |kk, tk| {
-                    if kk % progress_every == 0 {
-                        progress(tk / a.end_time);
-                    }
-                })?;
+                sampler.emit(
+                    &mut k,
+                    n_out,
+                    a.output_interval,
+                    &proj_ids,
+                    &self.output_nodes,
+                    sink,
+                    |kk, tk| {
+                        if kk % progress_every == 0 {
+                            progress(tk / a.end_time);
+                        }
+                    },
+                )?;
                 times.output += t3.elapsed();
             }
             self.ledger.mass_damping += 0.5 * dt_next * dp;

@@ -52,7 +52,12 @@ impl LoadSet {
         let mut nodes: Vec<usize> = loads.iter().map(|l| l.node).collect();
         nodes.sort_unstable();
         nodes.dedup();
-        LoadSet { loads: loads.to_vec(), prev: vec![[0.0; 3]; nodes.len()], nodes, work: 0.0 }
+        LoadSet {
+            loads: loads.to_vec(),
+            prev: vec![[0.0; 3]; nodes.len()],
+            nodes,
+            work: 0.0,
+        }
     }
 
     /// f_ext at t_n into `fext`, and the external work up to t_n, trapezoidal:
@@ -131,7 +136,13 @@ pub struct Operator {
 }
 
 impl Operator {
-    pub fn new(el: Families, ties: Ties, projectiles: ProjectileContact, loads: &[Load], nodes: usize) -> Operator {
+    pub fn new(
+        el: Families,
+        ties: Ties,
+        projectiles: ProjectileContact,
+        loads: &[Load],
+        nodes: usize,
+    ) -> Operator {
         let gather = Gather::new(nodes, &el.slot_nodes());
         Operator {
             fe: vec![[0.0; 3]; el.slots()],
@@ -160,7 +171,12 @@ impl Operator {
 
     /// Element forces at x^n.
     pub fn element_forces(&mut self, st: &State) {
-        let ctx = ForceCtx { x: &st.x, v: &st.v, rot_r: &st.rot.r, dt_prev: st.dt_prev };
+        let ctx = ForceCtx {
+            x: &st.x,
+            v: &st.v,
+            rot_r: &st.rot.r,
+            dt_prev: st.dt_prev,
+        };
         self.el.forces(&ctx, &mut self.fe);
     }
 
@@ -179,17 +195,34 @@ impl Operator {
             // Contact between parts touches many nodes: clear them all, in parallel.
             use rayon::prelude::*;
             if self.fcon.len() > 16 * 1024 {
-                self.fcon.par_chunks_mut(8 * 1024).for_each(|c| c.fill([0.0; 3]));
+                self.fcon
+                    .par_chunks_mut(8 * 1024)
+                    .for_each(|c| c.fill([0.0; 3]));
             } else {
                 self.fcon.fill([0.0; 3]);
             }
         }
         self.touched.clear();
         if !self.projectiles.is_empty() {
-            self.projectiles.forces(&st.x, &st.v, mass, dt, st.dt_prev, &mut self.fcon, &mut self.touched);
+            self.projectiles.forces(
+                &st.x,
+                &st.v,
+                mass,
+                dt,
+                st.dt_prev,
+                &mut self.fcon,
+                &mut self.touched,
+            );
         }
         if !self.surfaces.is_empty() {
-            self.surfaces.forces(&st.x, &st.v, dt, st.dt_prev, &mut self.fcon, &mut self.touched);
+            self.surfaces.forces(
+                &st.x,
+                &st.v,
+                dt,
+                st.dt_prev,
+                &mut self.fcon,
+                &mut self.touched,
+            );
         }
         let (fext, fe, gather) = (&self.fext, &self.fe, &self.gather);
         self.ties.transfer(

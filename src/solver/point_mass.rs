@@ -22,7 +22,9 @@ impl Family for PointMassGroup {
     fn build(bd: &mut Build) -> Result<Self> {
         let m = bd.model;
         let mut g = PointMassGroup::default();
-        let Some(b) = m.block(ElementKind::PointMass) else { return Ok(g) };
+        let Some(b) = m.block(ElementKind::PointMass) else {
+            return Ok(g);
+        };
         for e in 0..b.len() {
             let mp = m.parts[b.part[e]].props.mass.unwrap();
             bd.mass[b.nodes[e]] += mp;

@@ -46,7 +46,11 @@ pub struct MassScaling {
 pub fn nodal_dt(s: f64, c: f64, m: f64, alpha: f64) -> f64 {
     let damp = c / m + alpha;
     if s <= 0.0 {
-        return if damp > 0.0 { 2.0 / damp } else { f64::INFINITY };
+        return if damp > 0.0 {
+            2.0 / damp
+        } else {
+            f64::INFINITY
+        };
     }
     let w = (s / m).sqrt();
     let xi = damp / (2.0 * w);
@@ -59,7 +63,11 @@ impl Solver {
         let nn = self.x0.len();
         let (mut s, mut c) = (vec![0.0; nn], vec![0.0; nn]);
         let mut rrow = vec![0.0; nn];
-        let ctx = StiffCtx { fixed: &self.fixed, mass: &self.mass, rot_j: &self.state.rot.j };
+        let ctx = StiffCtx {
+            fixed: &self.fixed,
+            mass: &self.mass,
+            rot_j: &self.state.rot.j,
+        };
         self.op.el.stiffness_sums(&ctx, &mut s, &mut c, &mut rrow);
         for n in 0..nn {
             s[n] = s[n].max(rrow[n] * self.mass[n]);
@@ -94,7 +102,9 @@ impl Solver {
     pub fn controlling_element(&self, node: usize) -> Option<(ElementKind, i64)> {
         let mut best: Option<(f64, ElementKind, i64)> = None;
         for &slot in self.op.gather.of(node) {
-            let Some((kind, id, k)) = self.op.el.slot_element(slot as usize) else { continue };
+            let Some((kind, id, k)) = self.op.el.slot_element(slot as usize) else {
+                continue;
+            };
             if best.map_or(true, |b| k > b.0) {
                 best = Some((k, kind, id));
             }
@@ -115,7 +125,11 @@ impl Solver {
             }
             best
         };
-        let mut rep = MassScaling { dt_stable_unscaled: dt_before, max_ratio: 1.0, ..Default::default() };
+        let mut rep = MassScaling {
+            dt_stable_unscaled: dt_before,
+            max_ratio: 1.0,
+            ..Default::default()
+        };
         for i in 0..self.x0.len() {
             if self.fixed[i] == 0b111 || self.mass[i] <= 0.0 {
                 continue;

@@ -62,7 +62,8 @@ pub fn tie_weights(p: &[f64; 3], m: &[[f64; 3]]) -> (Vec<f64>, f64) {
                         - (1.0 + eta) * m[3][d])
                 });
                 let deta: [f64; 3] = std::array::from_fn(|d| {
-                    0.25 * (-(1.0 - xi) * m[0][d] - (1.0 + xi) * m[1][d] + (1.0 + xi) * m[2][d]
+                    0.25 * (-(1.0 - xi) * m[0][d] - (1.0 + xi) * m[1][d]
+                        + (1.0 + xi) * m[2][d]
                         + (1.0 - xi) * m[3][d])
                 });
                 let r = sub(p, &x);
@@ -113,8 +114,12 @@ impl Ties {
                 ))
                 .in_file("ties.parquet")
                 .at_row(row)
-                .expected(format!("the slave on the edge or face of its masters, within {tol:.1e} m"))
-                .hint("order the masters around the face, or tie the node to the entity it lies on"));
+                .expected(format!(
+                    "the slave on the edge or face of its masters, within {tol:.1e} m"
+                ))
+                .hint(
+                    "order the masters around the face, or tie the node to the entity it lies on",
+                ));
             }
             let w: Vec<f64> = w.iter().map(|x| x.clamp(0.0, 1.0)).collect();
             let sum: f64 = w.iter().sum();
@@ -124,7 +129,11 @@ impl Ties {
             }
             mass[t.slave] = 0.0;
             is_slave[t.slave] = true;
-            ties.push(Tie { slave: t.slave, masters: t.masters.clone(), w });
+            ties.push(Tie {
+                slave: t.slave,
+                masters: t.masters.clone(),
+                w,
+            });
         }
         Ok(Ties { ties, is_slave })
     }
@@ -149,7 +158,10 @@ impl Ties {
         for t in &self.ties {
             let fs = force_on(t.slave, f);
             for (a, &mn) in t.masters.iter().enumerate() {
-                add(&mut f[mn], &[t.w[a] * fs[0], t.w[a] * fs[1], t.w[a] * fs[2]]);
+                add(
+                    &mut f[mn],
+                    &[t.w[a] * fs[0], t.w[a] * fs[1], t.w[a] * fs[2]],
+                );
                 touched.push(mn);
             }
         }
@@ -157,7 +169,12 @@ impl Ties {
 
     /// Slaves follow their masters: x_s = Σ w_a x_a, v_s = Σ w_a v_a (and v^n into `vn`
     /// when given).
-    pub fn update_slaves(&self, x: &mut [[f64; 3]], v: &mut [[f64; 3]], mut vn: Option<&mut [[f64; 3]]>) {
+    pub fn update_slaves(
+        &self,
+        x: &mut [[f64; 3]],
+        v: &mut [[f64; 3]],
+        mut vn: Option<&mut [[f64; 3]]>,
+    ) {
         for t in &self.ties {
             let mut xs = [0.0; 3];
             let mut vs = [0.0; 3];

@@ -62,7 +62,10 @@ pub fn axial_force(x1: &[f64; 3], x2: &[f64; 3], k: f64, l0: f64, tension_only: 
 // ---------------------------------------------------------------------------------------
 // The truss family.
 
-use super::family::{chunk_partials, for_chunks, Build, EnergyGroup, EnergyPartial, Family, ForceCtx, StiffCtx, CHUNK};
+use super::family::{
+    chunk_partials, for_chunks, Build, EnergyGroup, EnergyPartial, Family, ForceCtx, StiffCtx,
+    CHUNK,
+};
 use super::vec3::dot;
 use crate::error::Result;
 use crate::model::ElementKind;
@@ -88,13 +91,19 @@ impl Family for TrussGroup {
     fn build(bd: &mut Build) -> Result<Self> {
         let (m, mass) = (bd.model, &mut *bd.mass);
         let mut g = TrussGroup::default();
-        let Some(b) = m.block(ElementKind::Truss) else { return Ok(g) };
+        let Some(b) = m.block(ElementKind::Truss) else {
+            return Ok(g);
+        };
         for e in 0..b.len() {
             let p = &m.parts[b.part[e]].props;
             let (a, c) = (b.nodes[2 * e], b.nodes[2 * e + 1]);
             let d = super::vec3::sub(&m.coords[c], &m.coords[a]);
             let l0 = dot(&d, &d).sqrt();
-            let (e_mod, rho, area) = (p.youngs_modulus.unwrap(), p.density.unwrap(), p.area.unwrap());
+            let (e_mod, rho, area) = (
+                p.youngs_modulus.unwrap(),
+                p.density.unwrap(),
+                p.area.unwrap(),
+            );
             let me = rho * area * l0;
             mass[a] += 0.5 * me;
             mass[c] += 0.5 * me;
@@ -140,7 +149,13 @@ impl Family for TrussGroup {
     fn stiffness_sums(&self, ctx: &StiffCtx, s: &mut [f64], _c: &mut [f64], _r: &mut [f64]) {
         // Row sum of |K| for node i: k_e on the diagonal, plus k_e off the diagonal when
         // the other node can move (a fully fixed node's degrees of freedom are eliminated).
-        let w = |other: u32| if ctx.fixed[other as usize] == 0b111 { 1.0 } else { 2.0 };
+        let w = |other: u32| {
+            if ctx.fixed[other as usize] == 0b111 {
+                1.0
+            } else {
+                2.0
+            }
+        };
         for (e, p) in self.nodes.iter().enumerate() {
             s[p[0] as usize] += w(p[1]) * self.k[e];
             s[p[1] as usize] += w(p[0]) * self.k[e];

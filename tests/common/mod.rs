@@ -124,7 +124,12 @@ pub fn composite() -> weft::model::Model {
     for j in 0..4 {
         for i in 0..4 {
             eid += 1;
-            let ns = [q[j * 5 + i], q[j * 5 + i + 1], q[(j + 1) * 5 + i + 1], q[(j + 1) * 5 + i]];
+            let ns = [
+                q[j * 5 + i],
+                q[j * 5 + i + 1],
+                q[(j + 1) * 5 + i + 1],
+                q[(j + 1) * 5 + i],
+            ];
             if j == 3 {
                 // The last row has a nodal thickness growing along y (band-like).
                 m.add_element_with_thickness(eid, pq, &ns, &[1e-4, 1e-4, 1.4e-4, 1.4e-4]);
@@ -273,7 +278,9 @@ pub fn composite() -> weft::model::Model {
     });
     m.node_sets.insert("beam".into(), b_nodes);
     // Contact: the yarn's nodes against the quad patch's faces, with friction.
-    let mut c = weft::model::contacts::ContactDef::new(1, weft::model::contacts::Slave::Part(ptr), pq).with_friction(0.15);
+    let mut c =
+        weft::model::contacts::ContactDef::new(1, weft::model::contacts::Slave::Part(ptr), pq)
+            .with_friction(0.15);
     c.dynamic_friction = 0.1;
     c.friction_decay = 10.0;
     m.contacts.push(c);

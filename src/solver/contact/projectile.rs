@@ -239,8 +239,16 @@ fn sphere_face(
     let d0 = [xs[0][0] - c[0], xs[0][1] - c[1], xs[0][2] - c[2]];
     let r0 = dot(&d0, &d0);
     let (e1, e2) = (
-        [xs[1][0] - xs[0][0], xs[1][1] - xs[0][1], xs[1][2] - xs[0][2]],
-        [xs[2][0] - xs[0][0], xs[2][1] - xs[0][1], xs[2][2] - xs[0][2]],
+        [
+            xs[1][0] - xs[0][0],
+            xs[1][1] - xs[0][1],
+            xs[1][2] - xs[0][2],
+        ],
+        [
+            xs[2][0] - xs[0][0],
+            xs[2][1] - xs[0][1],
+            xs[2][2] - xs[0][2],
+        ],
     );
     let reach = p.radius + dot(&e1, &e1).max(dot(&e2, &e2)).sqrt();
     if r0 >= reach * reach {
@@ -304,11 +312,21 @@ impl ProjectileContact {
             for x in w.iter_mut().take(n) {
                 *x = 1.0 / n as f64;
             }
-            samples.push(SamplePoint { nodes, w, n, mass: 0.5 * mf });
+            samples.push(SamplePoint {
+                nodes,
+                w,
+                n,
+                mass: 0.5 * mf,
+            });
             for a in 0..n {
                 let (p, q) = (f[a], f[(a + 1) % n]);
                 let k = *edge_at.entry((p.min(q), p.max(q))).or_insert_with(|| {
-                    samples.push(SamplePoint { nodes: [p, q, 0, 0], w: [0.5, 0.5, 0.0, 0.0], n: 2, mass: 0.0 });
+                    samples.push(SamplePoint {
+                        nodes: [p, q, 0, 0],
+                        w: [0.5, 0.5, 0.0, 0.0],
+                        n: 2,
+                        mass: 0.0,
+                    });
                     samples.len() - 1
                 });
                 samples[k].mass += 0.5 * mf / n as f64;
@@ -317,12 +335,23 @@ impl ProjectileContact {
         let mut face_tris = Vec::new();
         for &(f, m) in faces {
             if f.len() == 3 {
-                face_tris.push(FaceTri { nodes: [f[0], f[1], f[2]], mass: m });
+                face_tris.push(FaceTri {
+                    nodes: [f[0], f[1], f[2]],
+                    mass: m,
+                });
             } else {
                 // Both diagonals, so that the split has no handedness (a mirrored mesh,
                 // e.g. across a symmetry plane, gets the mirrored contact).
-                for t in [[f[0], f[1], f[2]], [f[0], f[2], f[3]], [f[1], f[2], f[3]], [f[1], f[3], f[0]]] {
-                    face_tris.push(FaceTri { nodes: t, mass: 0.25 * m });
+                for t in [
+                    [f[0], f[1], f[2]],
+                    [f[0], f[2], f[3]],
+                    [f[1], f[2], f[3]],
+                    [f[1], f[3], f[0]],
+                ] {
+                    face_tris.push(FaceTri {
+                        nodes: t,
+                        mass: 0.25 * m,
+                    });
                 }
             }
         }
@@ -343,7 +372,10 @@ impl ProjectileContact {
 
     /// Node penalties κ_c m_i/Δt², once the step is known.
     pub fn set_step(&mut self, mass: &[f64], dt: f64) {
-        self.k_node = mass.iter().map(|m| PENALTY_FACTOR * m / (dt * dt)).collect();
+        self.k_node = mass
+            .iter()
+            .map(|m| PENALTY_FACTOR * m / (dt * dt))
+            .collect();
     }
 
     /// Penalty contact of every projectile against every node with mass and (when
@@ -393,8 +425,9 @@ impl ProjectileContact {
                     let fnorm = kp * g;
                     let mut f = [n[0] * fnorm, n[1] * fnorm, n[2] * fnorm];
                     if p.friction > 0.0 {
-                        let vq: [f64; 3] =
-                            std::array::from_fn(|d| (0..3).map(|a| w[a] * v[t.nodes[a] as usize][d]).sum());
+                        let vq: [f64; 3] = std::array::from_fn(|d| {
+                            (0..3).map(|a| w[a] * v[t.nodes[a] as usize][d]).sum()
+                        });
                         let vr = [vq[0] - p.v[0], vq[1] - p.v[1], vq[2] - p.v[2]];
                         let (ft, power) = friction(&n, fnorm, &vr, p.friction);
                         f = [f[0] + ft[0], f[1] + ft[1], f[2] + ft[2]];
@@ -410,16 +443,18 @@ impl ProjectileContact {
             } else if p.segments {
                 for sp in &self.samples {
                     let nodes = &sp.nodes[..sp.n];
-                    let pos: [f64; 3] =
-                        std::array::from_fn(|d| (0..sp.n).map(|a| sp.w[a] * x[nodes[a] as usize][d]).sum());
+                    let pos: [f64; 3] = std::array::from_fn(|d| {
+                        (0..sp.n).map(|a| sp.w[a] * x[nodes[a] as usize][d]).sum()
+                    });
                     let Some((g, n)) = p.penetration(&pos) else {
                         continue;
                     };
                     let fnorm = sample_penalty(p, sp, dt2) * g;
                     let mut f = [n[0] * fnorm, n[1] * fnorm, n[2] * fnorm];
                     if p.friction > 0.0 {
-                        let vp: [f64; 3] =
-                            std::array::from_fn(|d| (0..sp.n).map(|a| sp.w[a] * v[nodes[a] as usize][d]).sum());
+                        let vp: [f64; 3] = std::array::from_fn(|d| {
+                            (0..sp.n).map(|a| sp.w[a] * v[nodes[a] as usize][d]).sum()
+                        });
                         let vr = [vp[0] - p.v[0], vp[1] - p.v[1], vp[2] - p.v[2]];
                         let (ft, power) = friction(&n, fnorm, &vr, p.friction);
                         f = [f[0] + ft[0], f[1] + ft[1], f[2] + ft[2]];
@@ -427,7 +462,10 @@ impl ProjectileContact {
                     }
                     for a in 0..sp.n {
                         let i = nodes[a] as usize;
-                        add(&mut fcon[i], &[sp.w[a] * f[0], sp.w[a] * f[1], sp.w[a] * f[2]]);
+                        add(
+                            &mut fcon[i],
+                            &[sp.w[a] * f[0], sp.w[a] * f[1], sp.w[a] * f[2]],
+                        );
                         touched.push(i);
                     }
                     ftot = [ftot[0] - f[0], ftot[1] - f[1], ftot[2] - f[2]];
@@ -452,8 +490,9 @@ impl ProjectileContact {
             }
             for sp in &self.samples {
                 let nodes = &sp.nodes[..sp.n];
-                let pos: [f64; 3] =
-                    std::array::from_fn(|d| (0..sp.n).map(|a| sp.w[a] * x[nodes[a] as usize][d]).sum());
+                let pos: [f64; 3] = std::array::from_fn(|d| {
+                    (0..sp.n).map(|a| sp.w[a] * x[nodes[a] as usize][d]).sum()
+                });
                 if let Some((g, _)) = p.penetration(&pos) {
                     e += 0.5 * sample_penalty(p, sp, dt2) * g * g;
                 }
@@ -483,8 +522,13 @@ impl ProjectileContact {
                 p.v_full = p.v;
             } else {
                 // In a symmetric model the projectile stays on the symmetry planes.
-                let a: [f64; 3] =
-                    std::array::from_fn(|d| if self.fixed[d] { 0.0 } else { p.force[d] / p.mass });
+                let a: [f64; 3] = std::array::from_fn(|d| {
+                    if self.fixed[d] {
+                        0.0
+                    } else {
+                        p.force[d] / p.mass
+                    }
+                });
                 let vn: [f64; 3] = std::array::from_fn(|d| p.v[d] + 0.5 * dt_prev * a[d]);
                 ke += 0.5 * p.mass * dot(&vn, &vn);
                 p.v = std::array::from_fn(|d| vn[d] + 0.5 * dt_next * a[d]);

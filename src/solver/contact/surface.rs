@@ -56,7 +56,11 @@ pub fn closest_on_face(p: &[f64; 3], x: &[[f64; 3]; 4], n: usize) -> [f64; 4] {
         2 => {
             let e = sub(&x[1], &x[0]);
             let ee = dot(&e, &e);
-            let t = if ee > 0.0 { (dot(&sub(p, &x[0]), &e) / ee).clamp(0.0, 1.0) } else { 0.0 };
+            let t = if ee > 0.0 {
+                (dot(&sub(p, &x[0]), &e) / ee).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
             [1.0 - t, t, 0.0, 0.0]
         }
         3 => {
@@ -129,7 +133,15 @@ pub struct Friction {
 /// and the pair's output. `g` > 0 the penetration, `n` the normal, `k` the penalty,
 /// `vt` the tangential relative velocity over the last step Δt^{n−½}.
 #[inline]
-pub fn pair_force(g: f64, n: &[f64; 3], k: f64, vt: &[f64; 3], dt_prev: f64, fr: &Friction, st: &mut SlaveState) -> ([f64; 3], f64, f64) {
+pub fn pair_force(
+    g: f64,
+    n: &[f64; 3],
+    k: f64,
+    vt: &[f64; 3],
+    dt_prev: f64,
+    fr: &Friction,
+    st: &mut SlaveState,
+) -> ([f64; 3], f64, f64) {
     let fnorm = k * g;
     let mut stored = 0.5 * k * g * g;
     let mut diss = 0.0;
@@ -157,7 +169,15 @@ pub fn pair_force(g: f64, n: &[f64; 3], k: f64, vt: &[f64; 3], dt_prev: f64, fr:
     }
     st.ft = ft;
     st.k = k;
-    ([n[0] * fnorm + ft[0], n[1] * fnorm + ft[1], n[2] * fnorm + ft[2]], stored, diss)
+    (
+        [
+            n[0] * fnorm + ft[0],
+            n[1] * fnorm + ft[1],
+            n[2] * fnorm + ft[2],
+        ],
+        stored,
+        diss,
+    )
 }
 
 /// A recorded initial penetration.
@@ -239,9 +259,15 @@ fn nodal_thickness(m: &Model, part: Option<usize>) -> Vec<f64> {
             for a in 0..npe {
                 let t = match kind {
                     ElementKind::Tri | ElementKind::Quad => {
-                        if b.thickness.is_empty() { p.thickness.unwrap_or(0.0) } else { b.thickness[npe * e + a] }
+                        if b.thickness.is_empty() {
+                            p.thickness.unwrap_or(0.0)
+                        } else {
+                            b.thickness[npe * e + a]
+                        }
                     }
-                    ElementKind::Truss => (4.0 * p.area.unwrap_or(0.0) / std::f64::consts::PI).sqrt(),
+                    ElementKind::Truss => {
+                        (4.0 * p.area.unwrap_or(0.0) / std::f64::consts::PI).sqrt()
+                    }
                     ElementKind::Beam => p.height.unwrap_or(0.0),
                     _ => continue,
                 };
@@ -251,7 +277,15 @@ fn nodal_thickness(m: &Model, part: Option<usize>) -> Vec<f64> {
             }
         }
     }
-    (0..nn).map(|i| if cnt[i] > 0 { sum[i] / cnt[i] as f64 } else { 0.0 }).collect()
+    (0..nn)
+        .map(|i| {
+            if cnt[i] > 0 {
+                sum[i] / cnt[i] as f64
+            } else {
+                0.0
+            }
+        })
+        .collect()
 }
 
 /// The largest total penalty factor that can act on one node: Σ κ_c over the contact
@@ -267,7 +301,11 @@ pub fn guard_kappa(m: &Model) -> f64 {
         let kappa = PENALTY_FACTOR * d.penalty_scale;
         let slaves: Vec<u32> = match &d.slave {
             Slave::Part(p) => part_nodes(m, *p),
-            Slave::Set(s) => m.node_sets.get(s).map(|v| v.iter().map(|&n| n as u32).collect()).unwrap_or_default(),
+            Slave::Set(s) => m
+                .node_sets
+                .get(s)
+                .map(|v| v.iter().map(|&n| n as u32).collect())
+                .unwrap_or_default(),
         };
         let roles = if d.two_way { 2.0 } else { 1.0 };
         for n in slaves {
@@ -277,7 +315,11 @@ pub fn guard_kappa(m: &Model) -> f64 {
             k[n as usize] += roles * kappa;
         }
     }
-    let proj = if m.projectiles.is_empty() { 0.0 } else { 2.0 * PENALTY_FACTOR };
+    let proj = if m.projectiles.is_empty() {
+        0.0
+    } else {
+        2.0 * PENALTY_FACTOR
+    };
     k.iter().cloned().fold(0.0, f64::max) + proj
 }
 
@@ -287,7 +329,10 @@ fn part_nodes(m: &Model, part: usize) -> Vec<u32> {
     let mut v: Vec<u32> = match m.elements.get(&kind) {
         Some(b) => {
             let npe = kind.nodes_per_element();
-            (0..b.len()).filter(|&e| b.part[e] == part).flat_map(|e| b.nodes[npe * e..npe * e + npe].iter().map(|&n| n as u32)).collect()
+            (0..b.len())
+                .filter(|&e| b.part[e] == part)
+                .flat_map(|e| b.nodes[npe * e..npe * e + npe].iter().map(|&n| n as u32))
+                .collect()
         }
         None => vec![],
     };
@@ -308,8 +353,17 @@ impl Side {
                 v
             }
         };
-        let st = nodal_thickness(m, match slave { Slave::Part(p) => Some(*p), Slave::Set(_) => None });
-        let slave_t: Vec<f64> = slaves.iter().map(|&s| d.slave_thickness.unwrap_or(st[s as usize])).collect();
+        let st = nodal_thickness(
+            m,
+            match slave {
+                Slave::Part(p) => Some(*p),
+                Slave::Set(_) => None,
+            },
+        );
+        let slave_t: Vec<f64> = slaves
+            .iter()
+            .map(|&s| d.slave_thickness.unwrap_or(st[s as usize]))
+            .collect();
         let kind = m.parts[master].kind;
         let b = &m.elements[&kind];
         let npe = kind.nodes_per_element();
@@ -326,7 +380,9 @@ impl Side {
                 let n = b.nodes[npe * e + a];
                 f[a] = n as u32;
                 t[a] = d.master_thickness.unwrap_or(match kind {
-                    ElementKind::Tri | ElementKind::Quad if !b.thickness.is_empty() => b.thickness[npe * e + a],
+                    ElementKind::Tri | ElementKind::Quad if !b.thickness.is_empty() => {
+                        b.thickness[npe * e + a]
+                    }
                     _ => mt[n],
                 });
                 msum += mass[n];
@@ -343,7 +399,13 @@ impl Side {
             row,
             slave_m: slaves.iter().map(|&s| mass[s as usize]).collect(),
             state: vec![SlaveState::default(); slaves.len()],
-            out: vec![PairOut { face: u32::MAX, ..Default::default() }; slaves.len()],
+            out: vec![
+                PairOut {
+                    face: u32::MAX,
+                    ..Default::default()
+                };
+                slaves.len()
+            ],
             slaves,
             slave_t,
             faces,
@@ -351,7 +413,11 @@ impl Side {
             face_t,
             face_m,
             face_id,
-            friction: Friction { mu_s: d.static_friction, mu_d: d.dynamic_friction, decay: d.friction_decay },
+            friction: Friction {
+                mu_s: d.static_friction,
+                mu_d: d.dynamic_friction,
+                decay: d.friction_decay,
+            },
             kappa: PENALTY_FACTOR * d.penalty_scale,
             on_initial: d.initial_penetration,
             reach: 0.5 * (ts_max + tf_max),
@@ -384,11 +450,19 @@ impl Side {
             .iter()
             .map(|f| {
                 let (lo, hi) = bbox(f, nf, x);
-                ([lo[0] - r, lo[1] - r, lo[2] - r], [hi[0] + r, hi[1] + r, hi[2] + r])
+                (
+                    [lo[0] - r, lo[1] - r, lo[2] - r],
+                    [hi[0] + r, hi[1] + r, hi[2] + r],
+                )
             })
             .collect();
-        let h = boxes.iter().map(|(lo, hi)| (0..3).map(|d| hi[d] - lo[d]).fold(0.0, f64::max)).fold(0.0, f64::max).max(1e-12);
-        let cell = |p: &[f64; 3]| -> [i64; 3] { std::array::from_fn(|d| (p[d] / h).floor() as i64) };
+        let h = boxes
+            .iter()
+            .map(|(lo, hi)| (0..3).map(|d| hi[d] - lo[d]).fold(0.0, f64::max))
+            .fold(0.0, f64::max)
+            .max(1e-12);
+        let cell =
+            |p: &[f64; 3]| -> [i64; 3] { std::array::from_fn(|d| (p[d] / h).floor() as i64) };
         let key = |c: [i64; 3]| -> u64 {
             let m = |v: i64| ((v + (1 << 20)) as u64) & ((1 << 21) - 1);
             (m(c[0]) << 42) | (m(c[1]) << 21) | m(c[2])
@@ -418,7 +492,9 @@ impl Side {
                     break;
                 }
                 let (lo, hi) = &boxes[e.1 as usize];
-                if (0..3).all(|d| p[d] >= lo[d] && p[d] <= hi[d]) && !faces[e.1 as usize][..nf].contains(&s) {
+                if (0..3).all(|d| p[d] >= lo[d] && p[d] <= hi[d])
+                    && !faces[e.1 as usize][..nf].contains(&s)
+                {
                     (&mut f)(e.1);
                 }
             }
@@ -468,7 +544,13 @@ impl Side {
         let nchunks = self.slaves.len().div_ceil(SLAVE_CHUNK);
         self.chunk_active.resize_with(nchunks, Vec::new);
         self.chunk_sums.resize(nchunks, [0.0; 2]);
-        type Chunk<'c> = (usize, (((&'c mut [PairOut], &'c mut [SlaveState]), &'c mut Vec<u32>), &'c mut [f64; 2]));
+        type Chunk<'c> = (
+            usize,
+            (
+                ((&'c mut [PairOut], &'c mut [SlaveState]), &'c mut Vec<u32>),
+                &'c mut [f64; 2],
+            ),
+        );
         let body = |(ci, (((outs, sts), active), sums)): Chunk| {
             active.clear();
             *sums = [0.0; 2];
@@ -481,7 +563,8 @@ impl Side {
                 let reach = 0.5 * (slave_t[si] + face_t_max);
                 for &fi in &cand[cand_ptr[si] as usize..cand_ptr[si + 1] as usize] {
                     let f = &faces[fi as usize];
-                    let xf: [[f64; 3]; 4] = std::array::from_fn(|a| if a < nf { x[f[a] as usize] } else { [0.0; 3] });
+                    let xf: [[f64; 3]; 4] =
+                        std::array::from_fn(|a| if a < nf { x[f[a] as usize] } else { [0.0; 3] });
                     // Cheap rejection: the distance to the face's current bounding box.
                     let mut d2 = 0.0;
                     for d in 0..3 {
@@ -502,23 +585,29 @@ impl Side {
                         let wa = super::closest_on_triangle(&p, &xf[0], &xf[1], &xf[2]);
                         let wb = super::closest_on_triangle(&p, &xf[0], &xf[2], &xf[3]);
                         let da = {
-                            let qa: [f64; 3] = std::array::from_fn(|d| wa[0] * xf[0][d] + wa[1] * xf[1][d] + wa[2] * xf[2][d]);
+                            let qa: [f64; 3] = std::array::from_fn(|d| {
+                                wa[0] * xf[0][d] + wa[1] * xf[1][d] + wa[2] * xf[2][d]
+                            });
                             let r = sub(&p, &qa);
                             dot(&r, &r)
                         };
                         let db = {
-                            let qb: [f64; 3] = std::array::from_fn(|d| wb[0] * xf[0][d] + wb[1] * xf[2][d] + wb[2] * xf[3][d]);
+                            let qb: [f64; 3] = std::array::from_fn(|d| {
+                                wb[0] * xf[0][d] + wb[1] * xf[2][d] + wb[2] * xf[3][d]
+                            });
                             let r = sub(&p, &qb);
                             dot(&r, &r)
                         };
-                        let warp: [f64; 3] = std::array::from_fn(|d| xf[0][d] - xf[1][d] + xf[2][d] - xf[3][d]);
+                        let warp: [f64; 3] =
+                            std::array::from_fn(|d| xf[0][d] - xf[1][d] + xf[2][d] - xf[3][d]);
                         let lim = reach + 0.5 * dot(&warp, &warp).sqrt();
                         if da.min(db) > lim * lim {
                             continue;
                         }
                     }
                     let w = closest_on_face(&p, &xf, nf);
-                    let q: [f64; 3] = std::array::from_fn(|d| (0..nf).map(|a| w[a] * xf[a][d]).sum());
+                    let q: [f64; 3] =
+                        std::array::from_fn(|d| (0..nf).map(|a| w[a] * xf[a][d]).sum());
                     let tf: f64 = (0..nf).map(|a| w[a] * face_t[fi as usize][a]).sum();
                     let r = sub(&p, &q);
                     let dist = dot(&r, &r).sqrt();
@@ -529,12 +618,19 @@ impl Side {
                         } else {
                             let c = cross(&sub(&xf[1], &xf[0]), &sub(&xf[nf - 1], &xf[0]));
                             let cn = dot(&c, &c).sqrt();
-                            if cn > 0.0 { [c[0] / cn, c[1] / cn, c[2] / cn] } else { [0.0, 0.0, 1.0] }
+                            if cn > 0.0 {
+                                [c[0] / cn, c[1] / cn, c[2] / cn]
+                            } else {
+                                [0.0, 0.0, 1.0]
+                            }
                         };
                         best = Some((fi, w, g, n));
                     }
                 }
-                let mut out = PairOut { face: u32::MAX, ..Default::default() };
+                let mut out = PairOut {
+                    face: u32::MAX,
+                    ..Default::default()
+                };
                 let g_raw = best.as_ref().map_or(f64::NEG_INFINITY, |b| b.2);
                 if initial {
                     st.g0 = if keep { 0.0 } else { g_raw.max(0.0) };
@@ -556,12 +652,21 @@ impl Side {
                         let mf = face_m[fi as usize];
                         let mstar = if ms > 0.0 { ms.min(mf) } else { mf };
                         let k = kappa * mstar / dt2;
-                        let vf: [f64; 3] = std::array::from_fn(|d| (0..nf).map(|a| w[a] * v[f[a] as usize][d]).sum());
+                        let vf: [f64; 3] = std::array::from_fn(|d| {
+                            (0..nf).map(|a| w[a] * v[f[a] as usize][d]).sum()
+                        });
                         let vr = sub(&v[s], &vf);
                         let vn = dot(&vr, &n);
                         let vt = [vr[0] - vn * n[0], vr[1] - vn * n[1], vr[2] - vn * n[2]];
                         let (force, stored, diss) = pair_force(g, &n, k, &vt, dt_prev, &fr, st);
-                        out = PairOut { face: fi, w, f: force, stored, dissipated: diss, g };
+                        out = PairOut {
+                            face: fi,
+                            w,
+                            f: force,
+                            stored,
+                            dissipated: diss,
+                            g,
+                        };
                     }
                     _ => {
                         // Open: what the stick spring stored is dissipated.
@@ -648,15 +753,38 @@ impl SurfaceContact {
                 }
             }
         }
-        let mut nodes: Vec<u32> = sides.iter().flat_map(|s| s.slaves.iter().copied().chain(s.faces.iter().flat_map(|f| f[..s.nf].to_vec()))).collect();
+        let mut nodes: Vec<u32> = sides
+            .iter()
+            .flat_map(|s| {
+                s.slaves
+                    .iter()
+                    .copied()
+                    .chain(s.faces.iter().flat_map(|f| f[..s.nf].to_vec()))
+            })
+            .collect();
         nodes.sort_unstable();
         nodes.dedup();
         // Skin: a quarter of the mean face size of the finest surface (a larger skin
         // means fewer rebuilds but more candidates per slave).
-        let skin = sides.iter().map(|s| s.mean_face_size(&m.coords)).filter(|&h| h > 0.0).fold(f64::INFINITY, f64::min);
+        let skin = sides
+            .iter()
+            .map(|s| s.mean_face_size(&m.coords))
+            .filter(|&h| h > 0.0)
+            .fold(f64::INFINITY, f64::min);
         let skin = if skin.is_finite() { 0.25 * skin } else { 0.0 };
         let kappa_max = sides.iter().map(|s| s.kappa).fold(0.0, f64::max);
-        SurfaceContact { sides, nodes, x_ref: vec![], skin, kappa_max, builds: 0, dissipated: 0.0, stored: 0.0, initial: vec![], ..Default::default() }
+        SurfaceContact {
+            sides,
+            nodes,
+            x_ref: vec![],
+            skin,
+            kappa_max,
+            builds: 0,
+            dissipated: 0.0,
+            stored: 0.0,
+            initial: vec![],
+            ..Default::default()
+        }
     }
 
     pub fn is_empty(&self) -> bool {
@@ -679,10 +807,12 @@ impl SurfaceContact {
         self.nodes
             .par_chunks(4096)
             .zip(self.x_ref.par_chunks(4096))
-            .any(|(ns, xr)| ns.iter().zip(xr).any(|(&n, r)| {
-                let d = sub(&x[n as usize], r);
-                dot(&d, &d) > lim
-            }))
+            .any(|(ns, xr)| {
+                ns.iter().zip(xr).any(|(&n, r)| {
+                    let d = sub(&x[n as usize], r);
+                    dot(&d, &d) > lim
+                })
+            })
     }
 
     /// Setup at the reference positions: the broad phase, and the nodes that start
@@ -700,7 +830,12 @@ impl SurfaceContact {
                 if s.on_initial == InitialPenetration::Keep {
                     continue;
                 }
-                let pen = InitialPen { contact_id: s.contact_id, node, element: s.face_id[o.face as usize], depth: s.state[si].g0 };
+                let pen = InitialPen {
+                    contact_id: s.contact_id,
+                    node,
+                    element: s.face_id[o.face as usize],
+                    depth: s.state[si].g0,
+                };
                 if s.on_initial == InitialPenetration::Error {
                     let kind = m.parts[m.contacts[s.row].master].kind;
                     return Err(WeftError::input(format!(
@@ -727,7 +862,15 @@ impl SurfaceContact {
     /// left alone); the stored
     /// energy and the dissipated work are booked.
     #[allow(clippy::too_many_arguments)]
-    pub fn forces(&mut self, x: &[[f64; 3]], v: &[[f64; 3]], dt: f64, dt_prev: f64, fcon: &mut [[f64; 3]], touched: &mut Vec<usize>) {
+    pub fn forces(
+        &mut self,
+        x: &[[f64; 3]],
+        v: &[[f64; 3]],
+        dt: f64,
+        dt_prev: f64,
+        fcon: &mut [[f64; 3]],
+        touched: &mut Vec<usize>,
+    ) {
         let t0 = std::time::Instant::now();
         if self.stale(x) {
             self.rebuild(x);
@@ -749,9 +892,16 @@ impl SurfaceContact {
         // split: bit-identical for any thread count, and parallel. `fcon` must be zero at
         // the slaves' and faces' nodes before (the operator clears it).
         let sides = &self.sides;
-        let active: usize = sides.iter().map(|s| s.chunk_active.iter().map(|a| a.len()).sum::<usize>()).sum();
+        let active: usize = sides
+            .iter()
+            .map(|s| s.chunk_active.iter().map(|a| a.len()).sum::<usize>())
+            .sum();
         // Small jobs stay on one thread (same sums, no scheduling cost).
-        let blocks = if active < 2048 { 1 } else { rayon::current_num_threads().max(1) };
+        let blocks = if active < 2048 {
+            1
+        } else {
+            rayon::current_num_threads().max(1)
+        };
         let bs = fcon.len().div_ceil(blocks).max(1);
         let gather = |(b, block): (usize, &mut [[f64; 3]])| {
             let (lo, hi) = (b * bs, b * bs + block.len());
@@ -767,7 +917,10 @@ impl SurfaceContact {
                     for a in 0..s.nf {
                         let n = f[a] as usize;
                         if (lo..hi).contains(&n) {
-                            add(&mut block[n - lo], &[-o.w[a] * o.f[0], -o.w[a] * o.f[1], -o.w[a] * o.f[2]]);
+                            add(
+                                &mut block[n - lo],
+                                &[-o.w[a] * o.f[0], -o.w[a] * o.f[1], -o.w[a] * o.f[2]],
+                            );
                         }
                     }
                 }
@@ -785,9 +938,17 @@ impl SurfaceContact {
 
     /// A summary for reports.
     pub fn report(&self, node_id: &[i64]) -> ContactReport {
-        let deepest = self.initial.iter().max_by(|a, b| a.depth.total_cmp(&b.depth));
+        let deepest = self
+            .initial
+            .iter()
+            .max_by(|a, b| a.depth.total_cmp(&b.depth));
         ContactReport {
-            definitions: self.sides.iter().map(|s| s.row).collect::<std::collections::BTreeSet<_>>().len(),
+            definitions: self
+                .sides
+                .iter()
+                .map(|s| s.row)
+                .collect::<std::collections::BTreeSet<_>>()
+                .len(),
             slaves: self.sides.iter().map(|s| s.slaves.len()).sum(),
             faces: self.sides.iter().map(|s| s.faces.len()).sum(),
             builds: self.builds,
@@ -810,10 +971,22 @@ impl SurfaceContact {
                 if o.face == u32::MAX {
                     continue;
                 }
-                let reach = 0.5 * (s.slave_t[si] + s.face_t[o.face as usize].iter().take(s.nf).cloned().fold(0.0, f64::max));
+                let reach = 0.5
+                    * (s.slave_t[si]
+                        + s.face_t[o.face as usize]
+                            .iter()
+                            .take(s.nf)
+                            .cloned()
+                            .fold(0.0, f64::max));
                 let r = o.g / reach.max(f64::MIN_POSITIVE);
                 if best.as_ref().map_or(true, |b| r > b.0) {
-                    best = Some((r, o.g, s.contact_id, s.slaves[si] as usize, s.face_id[o.face as usize]));
+                    best = Some((
+                        r,
+                        o.g,
+                        s.contact_id,
+                        s.slaves[si] as usize,
+                        s.face_id[o.face as usize],
+                    ));
                 }
             }
         }
@@ -822,6 +995,9 @@ impl SurfaceContact {
 
     /// Slaves in contact after the last force evaluation.
     pub fn active(&self) -> usize {
-        self.sides.iter().map(|s| s.out.iter().filter(|o| o.face != u32::MAX).count()).sum()
+        self.sides
+            .iter()
+            .map(|s| s.out.iter().filter(|o| o.face != u32::MAX).count())
+            .sum()
     }
 }
