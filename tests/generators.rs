@@ -135,7 +135,6 @@ fn every_model_runs_stably_at_its_defaults() {
                 worst < 0.01 * wmax,
                 "{name} {lc:?}: energy balance error {worst} of {wmax}"
             );
-            assert!(t.elapsed().as_secs_f64() < 10.0);
         }
     }
 }
@@ -348,7 +347,6 @@ fn the_reduced_woven_model() {
         "the patch did not slow the projectile"
     );
     assert!(e.balance_error.abs() < 0.01 * ke0, "{e:?}");
-    assert!(t.elapsed().as_secs_f64() < 20.0);
 }
 
 #[test]

@@ -267,7 +267,9 @@ outputs = { o = "out/2.txt" }
         s1 < e2 && s2 < e1,
         "intervals [{s1}, {e1}] and [{s2}, {e2}] do not overlap"
     );
-    assert!(wall < 1.9, "two 1 s stages took {wall} s with -j 2");
+    // Speed is not asserted (the machine is shared): the records' overlap above is the
+    // proof of parallelism.
+    eprintln!("two 1 s stages took {wall:.2} s with -j 2");
 }
 
 #[test]
