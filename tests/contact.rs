@@ -408,3 +408,40 @@ fn two_crossing_layers_are_bit_identical_on_one_and_two_threads() {
     // Friction and penalty keep the balance: measured 3e-4.
     assert!(bal < 1e-2, "energy balance {bal}");
 }
+
+/// `keep` (a formed state): the penalty acts from the first step with the full depth,
+/// f = k g with k = κ_c m/Δt² (the ball is far lighter than the band's nodes), and
+/// nothing is reported as an initial penetration.
+#[test]
+fn keep_mode_pushes_from_the_first_step_with_the_full_depth() {
+    let t = 1e-4;
+    let (mut m, band) = fixed_band(1e-3, 1e-3, 4, 4, t, 1e6);
+    let (depth, mass, dt) = (0.3 * t, 1e-6, 1e-8);
+    let b = ball(&mut m, [0.5e-3, 0.5e-3, t - depth], mass);
+    let mut c = ContactDef::new(1, Slave::Set("ball".into()), band);
+    c.slave_thickness = Some(t);
+    c.initial_penetration = InitialPenetration::Keep;
+    m.contacts.push(c);
+    m.analysis = Analysis {
+        end_time: 1e-6,
+        output_interval: 1e-6,
+        time_step: Some(dt),
+        ..Analysis::default()
+    };
+    // The contact forces at t = 0.
+    let mut s = Solver::new(&m).unwrap();
+    let (st, mass_n) = (s.state.clone(), s.mass.clone());
+    s.op.contact_and_ties(&st, &mass_n, dt);
+    let f = s.op.fcon[b];
+    let closed = 0.1 * mass / (dt * dt) * depth;
+    println!(
+        "keep: initial contact force {:.9e} N vs κ m g/Δt² = {closed:.9e} N",
+        f[2]
+    );
+    // Measured to round-off.
+    assert!(
+        rel(f[2], closed) < 1e-9 && f[0].abs() < 1e-9 * closed && f[1].abs() < 1e-9 * closed,
+        "{f:?}"
+    );
+    assert!(s.op.surfaces.initial.is_empty());
+}

@@ -121,14 +121,8 @@ fn impossible_geometry_is_refused_with_the_parameter_named() {
 /// in y (a 1-D yarn, as Smith's), hit at the middle by a flat nose at constant V.
 fn band(half: f64, along: f64) -> (Model, usize, usize) {
     let p = WovenBandParams::default();
-    let lens = Lenticular::new(p.width, p.thickness);
     let na = 2;
-    let offs: Vec<f64> = (0..=na)
-        .map(|k| -0.5 * p.width + p.width * k as f64 / na as f64)
-        .collect();
-    let t: Vec<f64> = offs.iter().map(|&y| lens.thickness(y)).collect();
-    let trap: f64 = (0..na).map(|k| 0.25 * p.width * (t[k] + t[k + 1])).sum();
-    let t: Vec<f64> = t.iter().map(|x| x * lens.area() / trap).collect();
+    let (offs, t, _) = Lenticular::new(p.width, p.thickness).band(na);
     let mut m = Model::default();
     let part = m.add_part(
         1,

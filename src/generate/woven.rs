@@ -148,6 +148,19 @@ impl Lenticular {
         let y = y.abs().min(0.5 * self.w);
         (2.0 * ((self.r * self.r - y * y).sqrt() - self.r + 0.5 * self.h)).max(0.0)
     }
+    /// A band of `across` quads across the width: the node offsets from the centre line,
+    /// their thickness t(y) scaled so that the one-point quads (mean of their nodal
+    /// thicknesses) carry exactly [`Self::area`], and that scale.
+    pub fn band(&self, across: usize) -> (Vec<f64>, Vec<f64>, f64) {
+        let offs: Vec<f64> = (0..=across)
+            .map(|k| -0.5 * self.w + self.w * k as f64 / across as f64)
+            .collect();
+        let t: Vec<f64> = offs.iter().map(|&y| self.thickness(y)).collect();
+        let dy = self.w / across as f64;
+        let trapezoid: f64 = (0..across).map(|k| 0.5 * dy * (t[k] + t[k + 1])).sum();
+        let scale = self.area() / trapezoid;
+        (offs, t.iter().map(|x| x * scale).collect(), scale)
+    }
     /// Exact area of the two circular segments of chord w and height h/2.
     pub fn area(&self) -> f64 {
         let d = self.r - 0.5 * self.h;
@@ -254,14 +267,7 @@ pub fn woven(p: &WovenBandParams) -> Result<(Model, WovenInfo)> {
     let lens = Lenticular::new(p.width, p.thickness);
     // Offsets across the band and the trapezoid area of the nodal profile.
     let na = p.across;
-    let offs: Vec<f64> = (0..=na)
-        .map(|k| -0.5 * p.width + p.width * k as f64 / na as f64)
-        .collect();
-    let t_raw: Vec<f64> = offs.iter().map(|&y| lens.thickness(y)).collect();
-    let dy = p.width / na as f64;
-    let a_trap: f64 = (0..na).map(|k| 0.5 * dy * (t_raw[k] + t_raw[k + 1])).sum();
-    let scale = lens.area() / a_trap;
-    let t_node: Vec<f64> = t_raw.iter().map(|t| t * scale).collect();
+    let (offs, t_node, scale) = lens.band(na);
     let t_centre = t_node[na / 2];
     let amp = p.crimp_amplitude.unwrap_or(0.5 * t_centre + 1e-9);
     if amp < 0.5 * t_centre {

@@ -175,11 +175,6 @@ impl<const N: usize> Reference<N> {
 
 /// Deformation gradient F (3×2 as two columns) and Green strain in Voigt form.
 #[inline(always)]
-/// Green strain [E₁₁, E₂₂, 2E₁₂] in material axes at the positions x.
-pub fn green_strain<const N: usize>(x: &[[f64; 3]; N], r: &Reference<N>) -> [f64; 3] {
-    kinematics(x, r).1
-}
-
 fn kinematics<const N: usize>(x: &[[f64; 3]; N], r: &Reference<N>) -> ([[f64; 3]; 2], [f64; 3]) {
     let mut f = [[0.0; 3]; 2];
     for a in 0..N {

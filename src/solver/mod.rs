@@ -698,18 +698,6 @@ impl Solver {
         sink: &mut (dyn Sink + Send),
         progress: &mut (dyn FnMut(f64) + Send),
     ) -> Result<RunStats> {
-        self.run_until(sink, progress, &mut |_, _| false)
-    }
-
-    /// [`Solver::run`], stopping early after the first step at which `stop(t, energies)`
-    /// (asked at every output sample) says so: dynamic relaxation, convergence checks.
-    pub fn run_until(
-        &mut self,
-        sink: &mut (dyn Sink + Send),
-        progress: &mut (dyn FnMut(f64) + Send),
-        stop: &mut dyn FnMut(f64, &Energies) -> bool,
-    ) -> Result<RunStats> {
-        let mut stopped = false;
         let a = self.analysis.clone();
         let n_out = (a.end_time / a.output_interval).round() as u64;
         let dt = self.stable.dt;
@@ -842,7 +830,6 @@ impl Solver {
                         )),
                     });
                 }
-                stopped = stop(self.state.t, &e);
                 for (j, &i) in self.output_nodes.iter().enumerate() {
                     let (x, x0) = (self.state.xn[i], self.x0[i]);
                     sampler.cur.u[j] = [x[0] - x0[0], x[1] - x0[1], x[2] - x0[2]];
@@ -867,9 +854,6 @@ impl Solver {
             self.state.t += dt_next;
             self.state.dt_prev = dt_next;
             self.state.step += 1;
-            if stopped {
-                break;
-            }
         }
         progress(1.0);
         Ok(RunStats {

@@ -215,14 +215,8 @@ impl Operator {
             );
         }
         if !self.surfaces.is_empty() {
-            self.surfaces.forces(
-                &st.x,
-                &st.v,
-                dt,
-                st.dt_prev,
-                &mut self.fcon,
-                &mut self.touched,
-            );
+            self.surfaces
+                .forces(&st.x, &st.v, dt, st.dt_prev, &mut self.fcon);
         }
         let (fext, fe, gather) = (&self.fext, &self.fe, &self.gather);
         self.ties.transfer(

@@ -106,8 +106,6 @@ pub struct PairOut {
     pub stored: f64,
     /// Friction work dissipated this step [J].
     pub dissipated: f64,
-    /// Penetration g (beyond a tracked initial one) [m].
-    pub g: f64,
 }
 
 /// Per-slave history.
@@ -232,6 +230,8 @@ pub struct Side {
     on_initial: InitialPenetration,
     /// Inflation of the face boxes beyond the skin: t_s,max/2 + t_F,max/2 [m].
     reach: f64,
+    /// Largest face thickness: no face farther than (t_s + this)/2 can touch [m].
+    face_t_max: f64,
     /// Candidates per slave (CSR), from the last broad phase.
     cand_ptr: Vec<u32>,
     cand: Vec<u32>,
@@ -421,6 +421,7 @@ impl Side {
             kappa: PENALTY_FACTOR * d.penalty_scale,
             on_initial: d.initial_penetration,
             reach: 0.5 * (ts_max + tf_max),
+            face_t_max: tf_max,
             cand_ptr: vec![],
             cand: vec![],
             chunk_active: vec![],
@@ -538,8 +539,7 @@ impl Side {
         let (cand_ptr, cand) = (&self.cand_ptr, &self.cand);
         let (fr, kappa) = (self.friction, self.kappa);
         let keep = self.on_initial == InitialPenetration::Keep;
-        // Largest face thickness: no face farther than (t_s + this)/2 can touch.
-        let face_t_max = self.reach * 2.0 - self.slave_t.iter().cloned().fold(0.0, f64::max);
+        let face_t_max = self.face_t_max;
         let dt2 = dt * dt;
         let nchunks = self.slaves.len().div_ceil(SLAVE_CHUNK);
         self.chunk_active.resize_with(nchunks, Vec::new);
@@ -665,7 +665,6 @@ impl Side {
                             f: force,
                             stored,
                             dissipated: diss,
-                            g,
                         };
                     }
                     _ => {
@@ -858,10 +857,8 @@ impl SurfaceContact {
         Ok(())
     }
 
-    /// Contact forces at x^n added into `fcon` (which the caller has cleared; `touched` is
-    /// left alone); the stored
+    /// Contact forces at x^n added into `fcon` (which the caller has cleared); the stored
     /// energy and the dissipated work are booked.
-    #[allow(clippy::too_many_arguments)]
     pub fn forces(
         &mut self,
         x: &[[f64; 3]],
@@ -869,7 +866,6 @@ impl SurfaceContact {
         dt: f64,
         dt_prev: f64,
         fcon: &mut [[f64; 3]],
-        touched: &mut Vec<usize>,
     ) {
         let t0 = std::time::Instant::now();
         if self.stale(x) {
@@ -931,7 +927,6 @@ impl SurfaceContact {
         } else {
             fcon.par_chunks_mut(bs).enumerate().for_each(gather);
         }
-        let _ = touched;
         self.stored = stored;
         self.narrow_time += t1.elapsed();
     }
@@ -960,37 +955,6 @@ impl SurfaceContact {
             build_seconds: self.build_time.as_secs_f64(),
             narrow_seconds: self.narrow_time.as_secs_f64(),
         }
-    }
-
-    /// The deepest penetration after the last force evaluation relative to the contact
-    /// distance (t_s + t_F)/2 ≈ g/reach, with its (contact id, slave node, face element).
-    pub fn deepest(&self) -> Option<(f64, f64, i64, usize, i64)> {
-        let mut best: Option<(f64, f64, i64, usize, i64)> = None;
-        for s in &self.sides {
-            for (si, o) in s.out.iter().enumerate() {
-                if o.face == u32::MAX {
-                    continue;
-                }
-                let reach = 0.5
-                    * (s.slave_t[si]
-                        + s.face_t[o.face as usize]
-                            .iter()
-                            .take(s.nf)
-                            .cloned()
-                            .fold(0.0, f64::max));
-                let r = o.g / reach.max(f64::MIN_POSITIVE);
-                if best.as_ref().map_or(true, |b| r > b.0) {
-                    best = Some((
-                        r,
-                        o.g,
-                        s.contact_id,
-                        s.slaves[si] as usize,
-                        s.face_id[o.face as usize],
-                    ));
-                }
-            }
-        }
-        best
     }
 
     /// Slaves in contact after the last force evaluation.
