@@ -12,6 +12,7 @@ pub mod analysis;
 pub mod cli;
 pub mod error;
 pub mod fit;
+pub mod form;
 pub mod generate;
 pub mod model;
 pub mod pipeline;

@@ -22,8 +22,8 @@
 //! thickness, so that crossing yarns just touch at their centre lines; a larger
 //! `crimp_amplitude` leaves a gap that a formed weave would close.
 //!
-//! What is not here yet: forming the weave by contact equilibrium and residual tension
-//! (the yarns start stress-free in the geometric crimp).
+//! The yarns start stress-free in this geometric crimp; `weft-form` (`crate::form`) forms
+//! the weave by contact equilibrium under a residual tension.
 
 use serde::Serialize;
 

@@ -93,6 +93,24 @@ fn read_model_inner(dir: &Path) -> Result<Model> {
     m.node_id = t.i64("node_id", NODES)?;
     let (x, y, z) = (t.f64("x", NODES)?, t.f64("y", NODES)?, t.f64("z", NODES)?);
     m.coords = (0..x.len()).map(|i| [x[i], y[i], z[i]]).collect();
+    // Initial displacement ux0, uy0, uz0 (a formed state): all three or none, null → 0.
+    let u0: Vec<_> = ["ux0", "uy0", "uz0"]
+        .iter()
+        .map(|c| t.f64_opt(c))
+        .collect::<Result<Vec<_>>>()?;
+    let present = u0.iter().filter(|c| c.is_some()).count();
+    if present == 3 {
+        let u: Vec<Vec<Option<f64>>> = u0.into_iter().flatten().collect();
+        m.initial_displacement = (0..x.len())
+            .map(|i| std::array::from_fn(|d| u[d][i].unwrap_or(0.0)))
+            .collect();
+    } else if present > 0 {
+        return Err(WeftError::input(format!(
+            "{present} of the initial displacement columns ux0, uy0, uz0 are present"
+        ))
+        .in_file(&t.path)
+        .expected("all three or none"));
+    }
     if m.node_id.is_empty() {
         return Err(WeftError::input("the model has no nodes")
             .in_file(&t.path)
@@ -579,16 +597,21 @@ pub fn write_model(m: &Model, dir: &Path, prov: &Provenance) -> Result<()> {
 
 fn write_tables(m: &Model, dir: &Path, prov: &Provenance) -> Result<()> {
     let ids = |v: &[usize]| v.iter().map(|&i| m.node_id[i]).collect::<Vec<_>>();
-    write_table(
-        &dir.join("nodes.parquet"),
-        &batch(vec![
-            Col::I64("node_id", m.node_id.clone()),
-            Col::F64("x", m.coords.iter().map(|c| c[0]).collect()),
-            Col::F64("y", m.coords.iter().map(|c| c[1]).collect()),
-            Col::F64("z", m.coords.iter().map(|c| c[2]).collect()),
-        ]),
-        prov,
-    )?;
+    let mut cols = vec![
+        Col::I64("node_id", m.node_id.clone()),
+        Col::F64("x", m.coords.iter().map(|c| c[0]).collect()),
+        Col::F64("y", m.coords.iter().map(|c| c[1]).collect()),
+        Col::F64("z", m.coords.iter().map(|c| c[2]).collect()),
+    ];
+    if !m.initial_displacement.is_empty() {
+        for (d, c) in ["ux0", "uy0", "uz0"].into_iter().enumerate() {
+            cols.push(Col::F64(
+                c,
+                m.initial_displacement.iter().map(|u| u[d]).collect(),
+            ));
+        }
+    }
+    write_table(&dir.join("nodes.parquet"), &batch(cols), prov)?;
     let p = &m.parts;
     let mut cols = vec![
         Col::I64("part_id", p.iter().map(|x| x.id).collect()),

@@ -304,8 +304,13 @@ impl Default for Analysis {
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Model {
     pub node_id: Vec<i64>,
-    /// Initial coordinates [m].
+    /// Reference coordinates [m]: the stress-free geometry of the elements.
     pub coords: Vec<[f64; 3]>,
+    /// Initial displacement from the reference [m], one per node, or empty (none): a
+    /// formed state (`weft-form`) starts at coords + u₀ with the strains, contact
+    /// penetrations and hourglass forces of that state; displacements in the outputs are
+    /// measured from coords + u₀.
+    pub initial_displacement: Vec<[f64; 3]>,
     pub parts: Vec<Part>,
     /// Element blocks by kind.
     pub elements: BTreeMap<ElementKind, ElementBlock>,
@@ -439,6 +444,31 @@ impl Model {
                 .at_row(row)
                 .expected("unique node ids")
                 .hint("renumber the nodes or merge coincident ones"));
+            }
+        }
+        if !self.initial_displacement.is_empty()
+            && self.initial_displacement.len() != self.coords.len()
+        {
+            return Err(WeftError::input(format!(
+                "{} initial displacements for {} nodes",
+                self.initial_displacement.len(),
+                self.coords.len()
+            ))
+            .in_file("nodes.parquet")
+            .expected("columns ux0, uy0, uz0 on every row, or none"));
+        }
+        for (row, u) in self.initial_displacement.iter().enumerate() {
+            for (c, v) in ["ux0", "uy0", "uz0"].iter().zip(u) {
+                if !v.is_finite() {
+                    return Err(WeftError::input(format!(
+                        "node `{}` has non-finite initial displacement `{v}`",
+                        self.node_id[row]
+                    ))
+                    .in_file("nodes.parquet")
+                    .in_column(*c)
+                    .at_row(row)
+                    .expected("a finite displacement in m, or null for 0"));
+                }
             }
         }
         for (row, x) in self.coords.iter().enumerate() {

@@ -221,6 +221,20 @@ pub fn stress(m: &Material, e: &[f64; 3]) -> [f64; 3] {
     [s[0] + m.s0[0], s[1] + m.s0[1], s[2] + m.s0[2]]
 }
 
+/// The force per unit reference area across a cut normal to material direction 1,
+/// along the current image of that direction: (P ê₁)·f₁/|f₁| with P = F S the first
+/// Piola–Kirchhoff stress and f₁ = F ê₁ [Pa]. Along a yarn band, times the section area,
+/// the yarn's tension.
+pub fn tension_1<const N: usize>(x: &[[f64; 3]; N], r: &Reference<N>, m: &Material) -> f64 {
+    let (f, e) = kinematics(x, r);
+    let s = stress(m, &e);
+    let l = dot(&f[0], &f[0]).sqrt();
+    if l == 0.0 {
+        return 0.0;
+    }
+    (s[0] * dot(&f[0], &f[0]) + s[2] * dot(&f[1], &f[0])) / l
+}
+
 /// Internal forces on the nodes [N] (membrane and hourglass).
 #[inline(always)]
 pub fn forces<const N: usize>(

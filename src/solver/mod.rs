@@ -34,6 +34,7 @@ pub mod membrane;
 pub mod operator;
 pub mod output;
 pub mod point_mass;
+pub mod relax;
 pub mod stable;
 pub mod statics;
 pub mod ties;
@@ -436,11 +437,22 @@ impl Solver {
         for (n, vel) in &m.initial_velocities {
             v[*n] = *vel;
         }
+        // A formed state starts displaced from the elements' reference; outputs measure
+        // displacements from where it starts.
+        let start: Vec<[f64; 3]> = if m.initial_displacement.is_empty() {
+            m.coords.clone()
+        } else {
+            m.coords
+                .iter()
+                .zip(&m.initial_displacement)
+                .map(|(x, u)| [x[0] + u[0], x[1] + u[1], x[2] + u[2]])
+                .collect()
+        };
         let mut s = Solver {
             node_id: m.node_id.clone(),
-            x0: m.coords.clone(),
+            x0: start.clone(),
             state: State {
-                x: m.coords.clone(),
+                x: start,
                 v,
                 xn: vec![[0.0; 3]; nn],
                 vn: vec![[0.0; 3]; nn],
@@ -472,7 +484,7 @@ impl Solver {
         s.op.projectiles.set_step(&s.mass, s.stable.dt);
         if !m.contacts.is_empty() {
             s.op.surfaces = contact::SurfaceContact::new(m, &s.mass);
-            s.op.surfaces.start(m)?;
+            s.op.surfaces.start(m, &s.state.x)?;
         }
         s.op.ties
             .update_slaves(&mut s.state.x, &mut s.state.v, None);

@@ -1,0 +1,158 @@
+//! `weft-form`: form a yarn-level woven patch by contact equilibrium (the paper's §2).
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use anyhow::Context;
+use clap::Parser;
+use weft::cli::Progress;
+use weft::form::{run, Config, Params};
+
+#[derive(Parser)]
+#[command(
+    name = "weft-form",
+    version,
+    about = "Form a woven patch by contact equilibrium: yarns pulled with their residual tension settle by dynamic relaxation; the formed model starts an impact run at rest and in equilibrium",
+    long_about = "Reads a model from `weft-weave woven`. The yarn ends held at the patch edge are let go along their \
+                  yarn and pulled outwards with the residual tension (N per yarn; warp: parts named `warp…`, along x; \
+                  weft: `weft…`, along y); the projectile is set aside; the weave settles by frictionless contact under \
+                  dynamic relaxation with local damping (each force component loses half its size against the motion; \
+                  Cundall) until the \
+                  largest kinetic energy of a test window is below --kinetic-tolerance of the energy removed and the \
+                  largest residual nodal force below --force-tolerance of the largest contact force.\n\n\
+                  Writes the formed model (the reference geometry unchanged, the formed positions as the nodes' initial \
+                  displacement ux0, uy0, uz0 in nodes.parquet, the yarn ends held where they came to rest, contacts \
+                  `keep` with their friction, the projectile raised by as much as the fabric rose) and form.parquet \
+                  (steps, residual force, crimp and crimp amplitude before and after, the tension measured in the bands \
+                  and at the ends). Nothing is written when forming fails to converge or leaves a yarn through another.\n\n\
+                  Example:\n  weft-weave woven --yarns 10 --out runs/patch\n  \
+                  weft-form --model runs/patch --out runs/patch-formed --warp-tension 0.5 --weft-tension 0.5\n  \
+                  weft-simulate --model runs/patch-formed --out runs/impact"
+)]
+struct Cli {
+    /// Model folder (from `weft-weave woven`, edge clamped).
+    #[arg(long)]
+    model: PathBuf,
+    /// Formed model folder to write.
+    #[arg(long)]
+    out: PathBuf,
+    /// Residual tension per warp yarn [N] (0: the weave settles stress-free).
+    #[arg(long, default_value_t = 0.5)]
+    warp_tension: f64,
+    /// Residual tension per weft yarn [N].
+    #[arg(long, default_value_t = 0.5)]
+    weft_tension: f64,
+    /// Step budget; forming that has not converged by then is an error.
+    #[arg(long, default_value_t = 100_000)]
+    max_steps: u64,
+    /// Converged when the largest kinetic energy of a test window is ≤ this × the energy
+    /// removed so far ...
+    #[arg(long, default_value_t = 1e-6)]
+    kinetic_tolerance: f64,
+    /// ... and the largest residual nodal force is ≤ this × the largest contact force.
+    #[arg(long, default_value_t = 0.05)]
+    force_tolerance: f64,
+    /// Largest contact penetration allowed after forming, as a fraction of the contact
+    /// distance of the thickest slave and face, (t_s,max + t_F,max)/2.
+    #[arg(long, default_value_t = 0.5)]
+    penetration_limit: f64,
+    /// Keep the contacts' friction while forming (default: frictionless, so that each
+    /// yarn's tension is uniform and the impact run starts in equilibrium).
+    #[arg(long)]
+    friction: bool,
+    /// Local damping α of the relaxation, 0 < α < 1.
+    #[arg(long, default_value_t = 0.5)]
+    damping: f64,
+    /// Worker threads [default: all cores]. Results do not depend on it.
+    #[arg(long)]
+    threads: Option<usize>,
+    /// No progress bar.
+    #[arg(long, short)]
+    quiet: bool,
+}
+
+fn main() -> ExitCode {
+    weft::cli::main(run_cli)
+}
+
+fn run_cli() -> anyhow::Result<ExitCode> {
+    let cli = Cli::parse();
+    if let Some(n) = cli.threads {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(n.max(1))
+            .build_global()
+            .context("cannot set up the worker threads")?;
+    }
+    let d = Params::default();
+    let params = Params {
+        warp_tension: cli.warp_tension,
+        weft_tension: cli.weft_tension,
+        max_steps: cli.max_steps,
+        kinetic_tolerance: cli.kinetic_tolerance,
+        force_tolerance: cli.force_tolerance,
+        penetration_limit: cli.penetration_limit,
+        friction: cli.friction,
+        damping: cli.damping,
+        ..d
+    };
+    let progress = Progress::new(
+        cli.quiet,
+        params.max_steps,
+        "{spinner} form [{bar:40}] {pos}/{len} steps {elapsed_precise} {msg}",
+    );
+    let max = params.max_steps as f64;
+    let res = run(
+        &Config {
+            model: cli.model.clone(),
+            out: cli.out.clone(),
+            params,
+        },
+        &mut |s| {
+            if progress.protocol() {
+                progress.line(s.steps as f64 / max);
+            } else {
+                progress.bar().set_position(s.steps);
+                progress.bar().set_message(format!(
+                    "residual {:.2e} N, contact {:.2e} N",
+                    s.residual, s.contact_force
+                ));
+            }
+        },
+    );
+    progress.finish();
+    let r = res.with_context(|| {
+        format!(
+            "form `{}` failed; nothing was written to `{}`",
+            cli.model.display(),
+            cli.out.display()
+        )
+    })?;
+    eprintln!(
+        "weft-form: equilibrium after {} steps of {:.3e} s (local damping): kinetic energy {:.2e} of the forming work {:.3e} J; largest residual force {:.3e} N against contact forces up to {:.3e} N",
+        r.steps, r.time_step, r.kinetic_over_work, r.forming_work, r.max_residual_force, r.max_contact_force
+    );
+    eprintln!(
+        "  warp: crimp {:.3} % → {:.3} %, amplitude {:.4e} → {:.4e} m; weft: crimp {:.3} % → {:.3} %, amplitude {:.4e} → {:.4e} m; a string over the crossings: {:.3} %",
+        100.0 * r.crimp_warp_before,
+        100.0 * r.crimp_warp_after,
+        r.amplitude_warp_before,
+        r.amplitude_warp_after,
+        100.0 * r.crimp_weft_before,
+        100.0 * r.crimp_weft_after,
+        r.amplitude_weft_before,
+        r.amplitude_weft_after,
+        100.0 * r.crimp_target,
+    );
+    eprintln!(
+        "  tension per yarn in the bands: warp {:.4} N, weft {:.4} N (at the ends {:.4} N, {:.4} N); deepest contact {:.1} % of its contact distance; fabric top rose {:.3e} m; {:.1} s",
+        r.warp_tension,
+        r.weft_tension,
+        r.warp_end_tension,
+        r.weft_end_tension,
+        100.0 * r.max_penetration_ratio,
+        r.top_rise,
+        r.wall_seconds
+    );
+    eprintln!("  wrote {} (formed model, form.parquet)", cli.out.display());
+    Ok(ExitCode::SUCCESS)
+}

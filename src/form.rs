@@ -1,0 +1,565 @@
+//! Forming a woven patch by contact equilibrium (`weft-form`; the paper's §2, after
+//! Barauskas & Abraitienė, IJIE 34(7), 2007): the yarns are pulled at their held ends
+//! with their residual tension, the weave settles by contact, and the equilibrium is
+//! written as a model whose impact run starts at rest and in equilibrium.
+//!
+//! Glossary: T_w, T_f the residual tension per warp and weft yarn [N]; A the yarn's
+//! section area [m²]; K kinetic energy; W the forming work (the energy the relaxation
+//! removed); P ê₁ the force per reference area across a cut of a band (first
+//! Piola–Kirchhoff stress along the yarn).
+//!
+//! Why pull the ends rather than give the yarns an initial stress T/A: the axial
+//! stiffness E·A of a yarn (5300 N for the default aramid) is 10⁴ × its tension, so a
+//! residual tension of 0.5 N is a strain of 10⁻⁴, the change of crimp that a contact
+//! penalty's sub-micrometre give already makes: clamped yarns with an initial stress
+//! relax it almost entirely (to 3·10⁻⁴ N in the 6 × 6 quarter, measured). Pulled by a
+//! force, a yarn carries exactly T whatever its crimp becomes (a string over
+//! frictionless supports; Irvine, *Cable Structures*, 1981, §1).
+//!
+//! Steps:
+//! 1. the yarn ends held in x, y and z (parts named `warp…` run along x, `weft…` along y)
+//!    are let go along their yarn and pulled outwards by T, shared over the end
+//!    section's nodes in proportion to the section each carries (Σ = T); projectiles,
+//!    loads and initial velocities are set aside; contacts are frictionless (the
+//!    equilibrium must hold without friction, whose stick state an impact run does not
+//!    inherit) and act on the full depth of any initial overlap (`keep`);
+//! 2. dynamic relaxation with local damping ([`crate::solver::relax`]) until the largest
+//!    kinetic energy of a test window is ≤ `kinetic_tolerance` × W and the largest
+//!    residual force on a free degree of freedom ≤ `force_tolerance` × the largest
+//!    contact force seen (or the largest pull); an error after `max_steps`;
+//! 3. checks: no contact deeper than `penetration_limit` of its contact distance (a yarn
+//!    went through another: an error naming the node and the element);
+//! 4. the formed model: the reference geometry unchanged, the formed positions as the
+//!    nodes' initial displacement u₀ (so strains, contact overlaps and hourglass forces
+//!    are exactly those of the equilibrium), the yarn ends held again where they came
+//!    to rest, contacts `keep` with their friction back, the projectile moved up by as
+//!    much as the fabric's top rose;
+//! 5. a report (`form.parquet`): steps, K/W, residual and contact forces, the crimp and
+//!    crimp amplitude of the warp and the weft on the x axis before and after, the yarn
+//!    tension measured in the bands (volume mean of (P ê₁)·f̂₁ × A) and at the held ends.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use serde::Serialize;
+
+use crate::error::{Result, WeftError};
+use crate::model::contacts::InitialPenetration;
+use crate::model::io::{read_model, write_model};
+use crate::model::{ElementKind, Load, Model, TimeLaw};
+use crate::solver::membrane::tension_1;
+use crate::solver::relax::{RelaxOptions, RelaxStats};
+use crate::solver::vec3::{norm, sub};
+use crate::solver::Solver;
+use crate::table::{batch, write_table, Col, Provenance};
+
+/// Forming parameters.
+#[derive(Debug, Clone, Serialize)]
+pub struct Params {
+    /// Residual tension per warp and per weft yarn [N].
+    pub warp_tension: f64,
+    pub weft_tension: f64,
+    pub max_steps: u64,
+    pub min_steps: u64,
+    pub check_every: u64,
+    /// Converged when the largest K of a test window ≤ this × W ...
+    pub kinetic_tolerance: f64,
+    /// ... and the residual force ≤ this × the largest contact force.
+    pub force_tolerance: f64,
+    /// Largest contact penetration after forming, as a fraction of the contact distance.
+    pub penetration_limit: f64,
+    /// Normal contact damping during forming, fraction of critical.
+    pub contact_damping: f64,
+    /// Local damping α of the relaxation (Cundall; 0 < α < 1). FLAC's 0.8 left the
+    /// 6 × 6 quarter chattering at 20 % residual; 0.5 converges (measured).
+    pub damping: f64,
+    /// Keep the contacts' friction while forming (by default the weave settles
+    /// frictionless, so that a yarn's tension is uniform and the impact run, which does
+    /// not inherit the friction's stick state, starts in equilibrium).
+    pub friction: bool,
+}
+
+impl Default for Params {
+    fn default() -> Self {
+        Params {
+            warp_tension: 0.5,
+            weft_tension: 0.5,
+            max_steps: 100_000,
+            min_steps: 1_000,
+            check_every: 100,
+            kinetic_tolerance: 1e-6,
+            force_tolerance: 0.05,
+            penetration_limit: 0.5,
+            contact_damping: 0.5,
+            damping: 0.5,
+            friction: false,
+        }
+    }
+}
+
+/// What forming did.
+#[derive(Debug, Clone, Default, Serialize)]
+pub struct Report {
+    pub steps: u64,
+    pub time_step: f64,
+    pub kinetic_over_work: f64,
+    pub forming_work: f64,
+    pub max_residual_force: f64,
+    pub max_contact_force: f64,
+    pub crimp_warp_before: f64,
+    pub crimp_warp_after: f64,
+    pub crimp_weft_before: f64,
+    pub crimp_weft_after: f64,
+    /// The crimp of a string pulled over point supports at the crossings: straight
+    /// segments between heights ±a, √(1 + (2a/p)²) − 1, with a the amplitude before.
+    pub crimp_target: f64,
+    /// Half the peak-to-peak height of the centre line over the crossings [m].
+    pub amplitude_warp_before: f64,
+    pub amplitude_warp_after: f64,
+    pub amplitude_weft_before: f64,
+    pub amplitude_weft_after: f64,
+    /// Tension per yarn in the bands: volume mean of (P ê₁)·f̂₁ times the section area [N].
+    pub warp_tension: f64,
+    pub weft_tension: f64,
+    /// Tension per yarn from the internal forces at the pulled ends [N].
+    pub warp_end_tension: f64,
+    pub weft_end_tension: f64,
+    /// Deepest contact penetration after forming over its contact distance.
+    pub max_penetration_ratio: f64,
+    /// How far the fabric's top rose [m] (the projectile is moved up by as much).
+    pub top_rise: f64,
+    pub wall_seconds: f64,
+}
+
+/// Yarn family of a part: 0 warp (along x), 1 weft (along y).
+fn family(m: &Model, part: usize) -> Option<usize> {
+    let n = &m.parts[part].name;
+    if n.starts_with("warp") {
+        Some(0)
+    } else if n.starts_with("weft") {
+        Some(1)
+    } else {
+        None
+    }
+}
+
+/// The centre line of the yarn of family `fam` through the first node of `set`: the
+/// nodes of its part with the same reference y (warp) or x (weft), along the yarn.
+fn centre_line(m: &Model, set: &str, fam: usize) -> Vec<usize> {
+    let Some(&n0) = m.node_sets.get(set).and_then(|s| s.first()) else {
+        return vec![];
+    };
+    let (across, along) = if fam == 0 { (1, 0) } else { (0, 1) };
+    let c = m.coords[n0][across];
+    let Some(b) = m.elements.get(&ElementKind::Quad) else {
+        return vec![];
+    };
+    let part = (0..b.len())
+        .find(|&e| b.nodes[4 * e..4 * e + 4].contains(&n0))
+        .map(|e| b.part[e]);
+    let mut nodes: Vec<usize> = (0..b.len())
+        .filter(|&e| Some(b.part[e]) == part)
+        .flat_map(|e| b.nodes[4 * e..4 * e + 4].to_vec())
+        .filter(|&n| (m.coords[n][across] - c).abs() < 1e-12)
+        .collect();
+    nodes.sort_unstable_by(|a, b| m.coords[*a][along].total_cmp(&m.coords[*b][along]));
+    nodes.dedup();
+    nodes
+}
+
+/// Crimp (path length over projected length − 1) and amplitude (half the height range
+/// of the nodes at the crossings) of a centre line at positions `x`.
+fn crimp(m: &Model, x: &[[f64; 3]], line: &[usize], fam: usize, crossings: &[usize]) -> (f64, f64) {
+    if line.len() < 2 {
+        return (f64::NAN, f64::NAN);
+    }
+    let along = fam;
+    let path: f64 = line
+        .windows(2)
+        .map(|w| norm(&sub(&x[w[1]], &x[w[0]])))
+        .sum();
+    let straight = (x[*line.last().unwrap()][along] - x[line[0]][along]).abs();
+    // Crossing nodes: the line's nodes at the reference positions of the crossings.
+    let zs: Vec<f64> = line
+        .iter()
+        .filter(|&&n| {
+            crossings
+                .iter()
+                .any(|&c| (m.coords[c][along] - m.coords[n][along]).abs() < 1e-12)
+        })
+        .map(|&n| x[n][2])
+        .collect();
+    let (lo, hi) = zs
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &z| {
+            (l.min(z), h.max(z))
+        });
+    (path / straight - 1.0, 0.5 * (hi - lo))
+}
+
+/// Form `m` (a woven model from `weft-weave woven`): the formed model and the report.
+pub fn form(
+    m: &Model,
+    p: &Params,
+    progress: &mut dyn FnMut(&RelaxStats),
+) -> Result<(Model, Report)> {
+    let t0 = Instant::now();
+    for (n, v) in [
+        ("warp-tension", p.warp_tension),
+        ("weft-tension", p.weft_tension),
+    ] {
+        if !(v.is_finite() && v >= 0.0) {
+            return Err(
+                WeftError::input(format!("--{n} = `{v}`")).expected("a tension ≥ 0 in N per yarn")
+            );
+        }
+    }
+    for (n, v) in [
+        ("kinetic-tolerance", p.kinetic_tolerance),
+        ("force-tolerance", p.force_tolerance),
+        ("penetration-limit", p.penetration_limit),
+    ] {
+        if !(v.is_finite() && v > 0.0) {
+            return Err(WeftError::input(format!("--{n} = `{v}`")).expected("a number > 0"));
+        }
+    }
+    if !(p.damping > 0.0 && p.damping < 1.0) {
+        return Err(WeftError::input(format!("--damping = `{}`", p.damping))
+            .expected("a local damping 0 < α < 1 (0.5 by default)"));
+    }
+    if p.max_steps == 0 || p.check_every == 0 {
+        return Err(
+            WeftError::input("--max-steps and --check-every must be ≥ 1".to_string())
+                .expected("a step budget ≥ 1"),
+        );
+    }
+    let quads = m
+        .elements
+        .get(&ElementKind::Quad)
+        .filter(|b| !b.is_empty())
+        .ok_or_else(|| {
+            WeftError::input("the model has no membrane quads: nothing to form")
+                .hint("form a model from `weft-weave woven`")
+        })?;
+    if !(0..m.parts.len()).any(|i| family(m, i).is_some()) {
+        return Err(WeftError::input(
+            "no part is named `warp…` or `weft…`: no yarns to put under tension",
+        )
+        .in_file("parts.parquet")
+        .hint("form a model from `weft-weave woven`"));
+    }
+    if !m.initial_displacement.is_empty() {
+        return Err(WeftError::input(
+            "the model is already formed (nodes.parquet has ux0, uy0, uz0)",
+        )
+        .in_file("nodes.parquet")
+        .hint("form the generator's model, not a formed one"));
+    }
+    let tension = [p.warp_tension, p.weft_tension];
+    // The held yarn ends, and the section each end node carries.
+    let held: Vec<bool> = {
+        let mut h = vec![false; m.num_nodes()];
+        for (n, c) in &m.constraints {
+            if *c == [true; 3] {
+                h[*n] = true;
+            }
+        }
+        h
+    };
+    let thick = |e: usize| -> f64 {
+        if quads.thickness.is_empty() {
+            m.parts[quads.part[e]].props.thickness.unwrap_or(0.0)
+        } else {
+            quads.thickness[4 * e..4 * e + 4].iter().sum::<f64>() / 4.0
+        }
+    };
+    // Section share per end node and per yarn end: key (family, end node) → share [m²].
+    let mut share = vec![0.0f64; m.num_nodes()];
+    let mut end_sign = vec![0.0f64; m.num_nodes()];
+    let mut end_fam = vec![usize::MAX; m.num_nodes()];
+    let mut end_part = vec![0usize; m.num_nodes()];
+    for e in 0..quads.len() {
+        let Some(f) = family(m, quads.part[e]) else {
+            continue;
+        };
+        let ns = &quads.nodes[4 * e..4 * e + 4];
+        let hn: Vec<usize> = ns.iter().copied().filter(|&n| held[n]).collect();
+        if hn.len() != 2 {
+            continue;
+        }
+        let w = norm(&sub(&m.coords[hn[1]], &m.coords[hn[0]]));
+        let inner = ns.iter().copied().find(|&n| !held[n]).unwrap_or(hn[0]);
+        let sign = if m.coords[hn[0]][f] >= m.coords[inner][f] {
+            1.0
+        } else {
+            -1.0
+        };
+        for &n in &hn {
+            share[n] += 0.5 * w * thick(e);
+            end_sign[n] = sign;
+            end_fam[n] = f;
+            end_part[n] = quads.part[e];
+        }
+    }
+    // Each yarn end: its nodes (connected held nodes of one part at one edge) share T.
+    // The end section of one yarn is the sum of the shares of its nodes; group the end
+    // nodes by (family, sign, reference across-coordinate rounded to the yarn, part).
+    let mut ends: std::collections::BTreeMap<(usize, i64, i64, usize), Vec<usize>> =
+        Default::default();
+    let spacing = {
+        let s = m.node_sets.get("axis_x").cloned().unwrap_or_default();
+        if s.len() >= 2 {
+            (m.coords[s[1]][0] - m.coords[s[0]][0]).abs()
+        } else {
+            f64::NAN
+        }
+    };
+    if !(spacing > 0.0) {
+        return Err(WeftError::input(
+            "the model has no node set `axis_x` with two crossings: the yarn spacing is unknown",
+        )
+        .hint("form a model from `weft-weave woven`"));
+    }
+    for n in 0..m.num_nodes() {
+        if end_fam[n] == usize::MAX {
+            continue;
+        }
+        let f = end_fam[n];
+        let across = 1 - f;
+        let yarn = (m.coords[n][across] / spacing).round() as i64;
+        ends.entry((f, end_sign[n] as i64, yarn, end_part[n]))
+            .or_default()
+            .push(n);
+    }
+    if ends.is_empty() {
+        return Err(WeftError::input(
+            "no yarn end is held in x, y and z: nothing holds the tension",
+        )
+        .in_file("constraints.parquet")
+        .hint("generate the patch with --edge clamped"));
+    }
+    let mut mm = m.clone();
+    mm.projectiles.clear();
+    mm.loads.clear();
+    mm.initial_velocities.clear();
+    for c in &mut mm.contacts {
+        c.initial_penetration = InitialPenetration::Keep;
+        if !p.friction {
+            c.static_friction = 0.0;
+            c.dynamic_friction = 0.0;
+        }
+    }
+    let mut pull = vec![[0.0f64; 3]; m.num_nodes()];
+    let mut lid = 0;
+    let mut end_nodes = vec![vec![]; 2];
+    // A yarn's section: the largest end section of its family (a yarn centred on a
+    // symmetry plane is half a band and carries half the tension).
+    let mut section = [0.0f64; 2];
+    for ((f, _, _, _), nodes) in &ends {
+        section[*f] = section[*f].max(nodes.iter().map(|&n| share[n]).sum::<f64>());
+    }
+    for ((f, _, _, _), nodes) in &ends {
+        for &n in nodes {
+            pull[n][*f] = end_sign[n] * tension[*f] * share[n] / section[*f];
+            end_nodes[*f].push(n);
+            if tension[*f] > 0.0 {
+                lid += 1;
+                mm.loads.push(Load {
+                    id: lid,
+                    node: n,
+                    force: pull[n],
+                    law: TimeLaw::Step { start: 0.0 },
+                });
+            }
+        }
+    }
+    for (n, c) in mm.constraints.iter_mut() {
+        if end_fam[*n] != usize::MAX {
+            c[end_fam[*n]] = false;
+        }
+    }
+    let mut solver = Solver::new(&mm)?;
+    solver.op.surfaces.set_normal_damping(p.contact_damping);
+    let st = solver.relax(
+        &RelaxOptions {
+            max_steps: p.max_steps,
+            min_steps: p.min_steps.min(p.max_steps),
+            check_every: p.check_every,
+            alpha: p.damping,
+            kinetic_tolerance: p.kinetic_tolerance,
+            force_tolerance: p.force_tolerance,
+            force_scale: pull.iter().map(|f| norm(f)).fold(0.0, f64::max),
+        },
+        progress,
+    )?;
+    let dt = st.dt;
+    let work = st.removed + st.kinetic;
+    let ratio = if work > 0.0 { st.kinetic / work } else { 0.0 };
+    if !st.converged {
+        return Err(WeftError::input(format!(
+            "forming did not reach equilibrium in {} steps ({:.3e} s): kinetic energy {:.2e} of the forming work (asked ≤ {:.1e}), largest residual force {:.3e} N on node `{}` against contact forces up to {:.3e} N (asked ≤ {:.1e} of them)",
+            st.steps, st.steps as f64 * dt, ratio, p.kinetic_tolerance, st.residual, m.node_id[st.residual_node], st.contact_force, p.force_tolerance
+        ))
+        .hint("raise --max-steps, or loosen --kinetic-tolerance / --force-tolerance"));
+    }
+    let x = solver.state.x.clone();
+    let max_pen = solver.op.surfaces.deepest();
+    if let Some((r, g, cid, node, el)) = max_pen {
+        if r > p.penetration_limit {
+            return Err(WeftError::input(format!(
+                "after forming, node `{}` is {g:.3e} m inside the surface of quad `{el}` (contact `{cid}`): {:.0} % of the contact distance",
+                m.node_id[node],
+                100.0 * r
+            ))
+            .expected(format!(
+                "penetrations below {:.0} % of the contact distance (deeper, a yarn may have gone through another)",
+                100.0 * p.penetration_limit
+            ))
+            .hint("lower the tension, or raise the contact penalty_scale in contacts.parquet"));
+        }
+    }
+    // Tension in the bands: volume mean of (P ê₁)·f̂₁ × section area, per family.
+    let fi = solver.internal_forces();
+    let qs = &solver.op.el.quad;
+    let mut tens = [f64::NAN; 2];
+    let mut end_t = [f64::NAN; 2];
+    for f in 0..2 {
+        let (mut sv, mut v) = (0.0, 0.0);
+        for e in 0..qs.id.len() {
+            if family(m, quads.part[e]) != Some(f) {
+                continue;
+            }
+            let xe: [[f64; 3]; 4] = std::array::from_fn(|a| x[qs.nodes[e][a] as usize]);
+            let t = tension_1(&xe, &qs.reference[e], &qs.material[e]);
+            let vol = qs.reference[e].area * qs.thickness[e];
+            sv += t * vol;
+            v += vol;
+        }
+        let a = section[f];
+        if v > 0.0 {
+            tens[f] = sv / v * a;
+        }
+        // At the ends: the internal force along the yarn on the end nodes, per yarn end.
+        let full: Vec<&Vec<usize>> = ends
+            .iter()
+            .filter(|(k, ns)| {
+                k.0 == f && (ns.iter().map(|&n| share[n]).sum::<f64>() - a).abs() < 1e-9 * a
+            })
+            .map(|(_, ns)| ns)
+            .collect();
+        if !full.is_empty() {
+            let s: f64 = full
+                .iter()
+                .flat_map(|ns| ns.iter())
+                .map(|&n| -end_sign[n] * fi[n][f])
+                .sum();
+            end_t[f] = s / full.len() as f64;
+        }
+    }
+    let warp_line = centre_line(m, "axis_x", 0);
+    let weft_line = centre_line(m, "axis_x_weft", 1);
+    let xing_w = m.node_sets.get("axis_x").cloned().unwrap_or_default();
+    let xing_f: Vec<usize> = {
+        // The weft's crossings: along y at the warp centre lines (multiples of p).
+        weft_line
+            .iter()
+            .copied()
+            .filter(|&n| {
+                let r = m.coords[n][1] / spacing;
+                (r - r.round()).abs() < 1e-9
+            })
+            .collect()
+    };
+    let (cw0, aw0) = crimp(m, &m.coords, &warp_line, 0, &xing_w);
+    let (cw1, aw1) = crimp(m, &x, &warp_line, 0, &xing_w);
+    let (cf0, af0) = crimp(m, &m.coords, &weft_line, 1, &xing_f);
+    let (cf1, af1) = crimp(m, &x, &weft_line, 1, &xing_f);
+    // The formed model.
+    let mut out = m.clone();
+    out.initial_displacement = x.iter().zip(&m.coords).map(|(a, b)| sub(a, b)).collect();
+    for c in &mut out.contacts {
+        c.initial_penetration = InitialPenetration::Keep;
+    }
+    let top =
+        |xs: &[[f64; 3]]| -> f64 { xs.iter().map(|x| x[2]).fold(f64::NEG_INFINITY, f64::max) };
+    let rise = (top(&x) - top(&m.coords)).max(0.0);
+    for pr in &mut out.projectiles {
+        pr.tip[2] += rise;
+    }
+    out.validate()?;
+    let report = Report {
+        steps: st.steps,
+        time_step: dt,
+        kinetic_over_work: ratio,
+        forming_work: work,
+        max_residual_force: st.residual,
+        max_contact_force: st.contact_force,
+        crimp_warp_before: cw0,
+        crimp_warp_after: cw1,
+        crimp_weft_before: cf0,
+        crimp_weft_after: cf1,
+        crimp_target: (1.0 + (2.0 * aw0 / spacing).powi(2)).sqrt() - 1.0,
+        amplitude_warp_before: aw0,
+        amplitude_warp_after: aw1,
+        amplitude_weft_before: af0,
+        amplitude_weft_after: af1,
+        warp_tension: tens[0],
+        weft_tension: tens[1],
+        warp_end_tension: end_t[0],
+        weft_end_tension: end_t[1],
+        max_penetration_ratio: max_pen.map_or(0.0, |d| d.0),
+        top_rise: rise,
+        wall_seconds: t0.elapsed().as_secs_f64(),
+    };
+    Ok((out, report))
+}
+
+/// `weft-form`: read, form, write the formed model folder and its `form.parquet`.
+#[derive(Debug, Clone, Serialize)]
+pub struct Config {
+    pub model: PathBuf,
+    pub out: PathBuf,
+    pub params: Params,
+}
+
+pub fn run(c: &Config, progress: &mut dyn FnMut(&RelaxStats)) -> Result<Report> {
+    let m = read_model(&c.model)?;
+    let (formed, r) = form(&m, &c.params, progress)
+        .map_err(|e| e.context(format!("cannot form `{}`", c.model.display())))?;
+    let prov = Provenance::new("form", serde_json::to_value(c).expect("serialise"))
+        .with_input(&c.model.join("nodes.parquet"))?;
+    write_model(&formed, &c.out, &prov)?;
+    write_report(&c.out.join("form.parquet"), &r, &prov)?;
+    Ok(r)
+}
+
+fn write_report(path: &Path, r: &Report, prov: &Provenance) -> Result<()> {
+    write_table(
+        path,
+        &batch(vec![
+            Col::I64("steps", vec![r.steps as i64]),
+            Col::F64("time_step", vec![r.time_step]),
+            Col::F64("kinetic_over_work", vec![r.kinetic_over_work]),
+            Col::F64("forming_work", vec![r.forming_work]),
+            Col::F64("max_residual_force", vec![r.max_residual_force]),
+            Col::F64("max_contact_force", vec![r.max_contact_force]),
+            Col::F64("crimp_warp_before", vec![r.crimp_warp_before]),
+            Col::F64("crimp_warp_after", vec![r.crimp_warp_after]),
+            Col::F64("crimp_weft_before", vec![r.crimp_weft_before]),
+            Col::F64("crimp_weft_after", vec![r.crimp_weft_after]),
+            Col::F64("crimp_target", vec![r.crimp_target]),
+            Col::F64("amplitude_warp_before", vec![r.amplitude_warp_before]),
+            Col::F64("amplitude_warp_after", vec![r.amplitude_warp_after]),
+            Col::F64("amplitude_weft_before", vec![r.amplitude_weft_before]),
+            Col::F64("amplitude_weft_after", vec![r.amplitude_weft_after]),
+            Col::F64("warp_tension", vec![r.warp_tension]),
+            Col::F64("weft_tension", vec![r.weft_tension]),
+            Col::F64("warp_end_tension", vec![r.warp_end_tension]),
+            Col::F64("weft_end_tension", vec![r.weft_end_tension]),
+            Col::F64("max_penetration_ratio", vec![r.max_penetration_ratio]),
+            Col::F64("top_rise", vec![r.top_rise]),
+            Col::F64("wall_seconds", vec![r.wall_seconds]),
+        ]),
+        prov,
+    )
+}
