@@ -296,3 +296,74 @@ fn forming_that_does_not_converge_is_an_error_and_writes_nothing() {
         .to_string();
     assert!(e.contains("no yarn end is held"), "{e}");
 }
+
+#[test]
+fn the_stages_chain_generate_form_and_draw_the_weave() {
+    use std::process::Command;
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let go = |bin: &str, args: &[&str]| {
+        let o = Command::new(bin).args(args).output().unwrap();
+        let e = String::from_utf8_lossy(&o.stderr).to_string();
+        assert!(!e.contains("panicked"), "{e}");
+        (o.status.success(), e)
+    };
+    let s = |p: &std::path::Path| p.to_string_lossy().to_string();
+    let (patch, formed) = (d.join("patch"), d.join("formed"));
+    let (ok, e) = go(
+        env!("CARGO_BIN_EXE_weft-weave"),
+        &["woven", "--yarns", "4", "--out", &s(&patch)],
+    );
+    assert!(ok, "{e}");
+    let (ok, e) = go(
+        env!("CARGO_BIN_EXE_weft-form"),
+        &["--model", &s(&patch), "--out", &s(&formed), "--quiet"],
+    );
+    assert!(ok && e.contains("equilibrium after"), "{e}");
+    // form.parquet: one row, the tension at the ends as asked.
+    let t = weft::table::Table::read(&formed.join("form.parquet")).unwrap();
+    let end = t.f64("warp_end_tension", "").unwrap();
+    assert!((end[0] - 0.5).abs() < 0.005, "{end:?}");
+    let (ok, e) = go(
+        env!("CARGO_BIN_EXE_weft-plot"),
+        &[
+            "weave",
+            "--model",
+            &s(&formed),
+            "--out",
+            &s(&d.join("w.svg")),
+        ],
+    );
+    assert!(ok && d.join("w.svg").exists(), "{e}");
+    // A part that is not there, a section that misses the yarns: named, nothing drawn.
+    let (ok, e) = go(
+        env!("CARGO_BIN_EXE_weft-plot"),
+        &[
+            "weave",
+            "--model",
+            &s(&formed),
+            "--along-part",
+            "warp_9",
+            "--out",
+            &s(&d.join("x.svg")),
+        ],
+    );
+    assert!(
+        !ok && e.contains("no part `warp_9`") && e.contains("parts.parquet"),
+        "{e}"
+    );
+    let (ok, e) = go(
+        env!("CARGO_BIN_EXE_weft-plot"),
+        &[
+            "weave",
+            "--model",
+            &s(&formed),
+            "--y",
+            "0.0003",
+            "--out",
+            &s(&d.join("x.svg")),
+        ],
+    );
+    assert!(!ok && e.contains("has no node on y = 0.0003"), "{e}");
+    assert!(!d.join("x.svg").exists());
+}

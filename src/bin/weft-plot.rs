@@ -37,6 +37,31 @@ enum Figure {
     Error(ErrorArgs),
     /// Best T against evaluations (fit_trace.parquet), one series per trace.
     Fit(FitArgs),
+    /// Section of a woven patch along y = y₀: the yarn along x (centre line and ± t/2
+    /// envelope) and the sections of the yarns across it; reference dashed and formed
+    /// solid for a model from weft-form.
+    Weave(WeaveArgs),
+}
+
+#[derive(Args)]
+struct WeaveArgs {
+    /// Model folder (weft-weave woven or weft-form).
+    #[arg(long)]
+    model: PathBuf,
+    /// The section's y [m] (a warp centre line: a multiple of the spacing).
+    #[arg(long, default_value_t = 0.0)]
+    y: f64,
+    /// Part of the yarn along x.
+    #[arg(long, default_value = "warp_1")]
+    along_part: String,
+    /// Part of the yarns across the section.
+    #[arg(long, default_value = "weft_1")]
+    across_part: String,
+    /// Only x ≤ this [m].
+    #[arg(long)]
+    x_max: Option<f64>,
+    #[command(flatten)]
+    common: Common,
 }
 
 #[derive(Args)]
@@ -165,6 +190,16 @@ fn run() -> anyhow::Result<()> {
                 table: a.table,
                 label: a.label,
                 along: a.along,
+            }),
+            a.common,
+        ),
+        Figure::Weave(a) => (
+            plot::Figure::Weave(plot::WeaveFigure {
+                model: a.model,
+                y: a.y,
+                along_part: a.along_part,
+                across_part: a.across_part,
+                x_max: a.x_max,
             }),
             a.common,
         ),
