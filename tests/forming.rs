@@ -29,11 +29,20 @@ fn formed(m: &Model, p: &Params) -> (Model, Report) {
     form(m, p, &mut |_| {}).unwrap()
 }
 
+/// The 6 × 6 quarter formed with the defaults (once for the tests that look at it).
+fn default_6x6() -> &'static (Model, Model, Report) {
+    static F: std::sync::OnceLock<(Model, Model, Report)> = std::sync::OnceLock::new();
+    F.get_or_init(|| {
+        let m = patch(6);
+        let (f, r) = formed(&m, &Params::default());
+        (m, f, r)
+    })
+}
+
 #[test]
 fn a_formed_weave_is_in_equilibrium_with_its_tension_and_a_string_crimp() {
-    let m = patch(6);
     let p = Params::default();
-    let (f, r) = formed(&m, &p);
+    let (m, f, r) = default_6x6();
     println!(
         "6×6 quarter formed at T = {} N: {} steps, K/W {:.2e}, residual {:.3e} N of contact forces up to {:.3e} N ({:.2} %); tension in the bands {:.4} / {:.4} N, at the ends {:.4} / {:.4} N; crimp {:.3} % → {:.3} % / {:.3} % (string {:.3} %); deepest contact {:.2} %",
         p.warp_tension,
@@ -94,10 +103,8 @@ fn a_formed_weave_is_in_equilibrium_with_its_tension_and_a_string_crimp() {
 }
 
 #[test]
-#[ignore = "not met yet: the crossings drift 1.9 % of h in 50 µs (measured), the fabric's slow out-of-plane mode driven by residuals of ~4e-5 N per node that the relaxation's stop (largest residual ≤ 5 % of the contact forces, K ≤ 1e-6 W) does not see; the kinetic energy floors at 4e-7 W from contact chatter"]
 fn a_formed_weave_left_alone_stays_where_it_is() {
-    let m = patch(6);
-    let (mut f, _) = formed(&m, &Params::default());
+    let mut f = default_6x6().1.clone();
     f.projectiles.clear();
     f.analysis.end_time = 50e-6;
     f.analysis.output_interval = 5e-6;
@@ -127,8 +134,9 @@ fn a_formed_weave_left_alone_stays_where_it_is() {
         100.0 * all / h,
         stats.max_balance_error_relative
     );
-    // The issue asks < 1 % of the yarn thickness over 50 µs, at the crossings where the
-    // studies measure (measured 1.9 %: ignored until it holds).
+    // The issue asks < 1 % of the yarn thickness over 50 µs. Measured: 1.9 % when
+    // forming stopped on kinetic energy and residual force alone, 0.96 % with the creep
+    // criterion at 10⁻³ h per 50 µs, and with its default 3·10⁻⁴ as printed above.
     assert!(at_crossings < 0.01 * h, "moved {at_crossings} m");
 }
 
@@ -140,6 +148,7 @@ fn forming_is_thread_independent() {
         min_steps: 3000,
         kinetic_tolerance: 1.0,
         force_tolerance: 1.0,
+        creep_tolerance: 1.0,
         ..Params::default()
     };
     let go = |n: usize| {
@@ -176,6 +185,9 @@ fn pulling_the_warp_straightens_it_and_crimps_the_weft() {
             &Params {
                 warp_tension: t,
                 kinetic_tolerance: 1e-5,
+                // Off: pulled at 25 N, edge nodes keep moving ~7 µm per 50 µs after
+                // 2·10⁵ steps (measured); the ends' mean displacement is steady.
+                creep_tolerance: 1e3,
                 ..Params::default()
             },
         );

@@ -43,7 +43,7 @@ struct Cli {
     #[arg(long, default_value_t = 0.5)]
     weft_tension: f64,
     /// Step budget; forming that has not converged by then is an error.
-    #[arg(long, default_value_t = 100_000)]
+    #[arg(long, default_value_t = 200_000)]
     max_steps: u64,
     /// Converged when the largest kinetic energy of a test window is ≤ this × the energy
     /// removed so far ...
@@ -52,6 +52,13 @@ struct Cli {
     /// ... and the largest residual nodal force is ≤ this × the largest contact force.
     #[arg(long, default_value_t = 0.05)]
     force_tolerance: f64,
+    /// ... and no node moved more than this × the largest yarn thickness over the last
+    /// --creep-time of relaxation.
+    #[arg(long, default_value_t = 3e-4)]
+    creep_tolerance: f64,
+    /// The creep window [s] of relaxation time.
+    #[arg(long, default_value_t = 50e-6)]
+    creep_time: f64,
     /// Largest contact penetration allowed after forming, as a fraction of the contact
     /// distance of the thickest slave and face, (t_s,max + t_F,max)/2.
     #[arg(long, default_value_t = 0.5)]
@@ -60,6 +67,9 @@ struct Cli {
     /// yarn's tension is uniform and the impact run starts in equilibrium).
     #[arg(long)]
     friction: bool,
+    /// Normal contact damping while forming, as a fraction of critical (≥ 0).
+    #[arg(long, default_value_t = 0.5)]
+    contact_damping: f64,
     /// Local damping α of the relaxation, 0 < α < 1.
     #[arg(long, default_value_t = 0.5)]
     damping: f64,
@@ -93,6 +103,9 @@ fn run_cli() -> anyhow::Result<ExitCode> {
         penetration_limit: cli.penetration_limit,
         friction: cli.friction,
         damping: cli.damping,
+        contact_damping: cli.contact_damping,
+        creep_tolerance: cli.creep_tolerance,
+        creep_time: cli.creep_time,
         ..d
     };
     let progress = Progress::new(
@@ -128,8 +141,8 @@ fn run_cli() -> anyhow::Result<ExitCode> {
         )
     })?;
     eprintln!(
-        "weft-form: equilibrium after {} steps of {:.3e} s (local damping): kinetic energy {:.2e} of the forming work {:.3e} J; largest residual force {:.3e} N against contact forces up to {:.3e} N",
-        r.steps, r.time_step, r.kinetic_over_work, r.forming_work, r.max_residual_force, r.max_contact_force
+        "weft-form: equilibrium after {} steps of {:.3e} s (local damping): kinetic energy {:.2e} of the forming work {:.3e} J; largest residual force {:.3e} N against contact forces up to {:.3e} N; nodes moved ≤ {:.3e} m over the last creep window",
+        r.steps, r.time_step, r.kinetic_over_work, r.forming_work, r.max_residual_force, r.max_contact_force, r.creep
     );
     eprintln!(
         "  warp: crimp {:.3} % → {:.3} %, amplitude {:.4e} → {:.4e} m; weft: crimp {:.3} % → {:.3} %, amplitude {:.4e} → {:.4e} m; a string over the crossings: {:.3} %",

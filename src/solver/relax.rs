@@ -46,6 +46,11 @@ pub struct RelaxOptions {
     pub force_tolerance: f64,
     /// A force scale of the loading [N] (the largest nodal load, say).
     pub force_scale: f64,
+    /// ... and no node moved more than `creep_tolerance` [m] over the last window of
+    /// `creep_window` steps: the slow modes (a pretensioned fabric's drum mode, driven by
+    /// residuals far below the largest) have settled too.
+    pub creep_window: u64,
+    pub creep_tolerance: f64,
 }
 
 /// What the relaxation did.
@@ -65,6 +70,8 @@ pub struct RelaxStats {
     pub contact_force: f64,
     /// Node with the largest residual.
     pub residual_node: usize,
+    /// Largest node displacement over the last full creep window [m] (∞ before one).
+    pub creep: f64,
 }
 
 #[derive(Clone, Copy, Default)]
@@ -96,6 +103,9 @@ impl Solver {
         st.dt = dt;
         let mut ke_window = 0.0f64;
         self.state.dt_prev = dt;
+        let creep_window = o.creep_window.max(1);
+        let mut x_window = self.state.x.clone();
+        st.creep = f64::INFINITY;
         for step in 0..o.max_steps {
             self.op.apply_loads(&self.state);
             self.op.element_forces(&self.state);
@@ -203,6 +213,20 @@ impl Solver {
             ke_window = ke_window.max(ke);
             self.state.step += 1;
             st.steps = step + 1;
+            if st.steps % creep_window == 0 {
+                st.creep = self
+                    .state
+                    .x
+                    .par_iter()
+                    .zip(x_window.par_iter())
+                    .map(|(a, b)| {
+                        let d = [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+                        dot(&d, &d)
+                    })
+                    .reduce(|| 0.0, f64::max)
+                    .sqrt();
+                x_window.copy_from_slice(&self.state.x);
+            }
             if st.steps % o.check_every.max(1) == 0 {
                 st.kinetic = ke_window;
                 st.residual = res.sqrt();
@@ -214,6 +238,7 @@ impl Solver {
                 if st.steps >= o.min_steps
                     && st.kinetic <= o.kinetic_tolerance * w
                     && st.residual <= o.force_tolerance * st.contact_force.max(o.force_scale)
+                    && st.creep <= o.creep_tolerance
                 {
                     st.converged = true;
                     break;
