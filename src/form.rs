@@ -90,7 +90,7 @@ impl Default for Params {
         Params {
             warp_tension: 0.5,
             weft_tension: 0.5,
-            max_steps: 200_000,
+            max_steps: 400_000,
             min_steps: 1_000,
             check_every: 100,
             kinetic_tolerance: 1e-6,

@@ -168,3 +168,36 @@ fn weft_plot_refuses_bad_input_clearly() {
         .collect();
     assert!(left.is_empty(), "{left:?}");
 }
+
+/// The woven patch pipeline (generate, form, impact, figures) at 6 × 6 and 4 µs (the
+/// shipped 10 × 10 forms in minutes): the formed patch carries the asked tension at its
+/// ends (the pull, to the relaxation's residual), the bullet moves the centre crossing
+/// down at about its speed, the figures are written, and a second run is all fresh.
+#[test]
+fn woven_patch_pipeline_forms_and_hits_the_patch() {
+    let dir = project_with("woven_patch.toml");
+    let root = dir.path();
+    let p = root.join("pipelines/woven_patch.toml");
+    let s = std::fs::read_to_string(&p)
+        .unwrap()
+        .replace("yarns = 10", "yarns = 6")
+        .replace("end_time = 1e-5", "end_time = 4e-6");
+    std::fs::write(&p, s).unwrap();
+    weft_run(root, "woven_patch.toml");
+    let out = root.join("runs/woven_patch");
+    let f = Table::read(&out.join("formed/form.parquet")).unwrap();
+    for c in ["warp_end_tension", "weft_end_tension"] {
+        let t = f.f64(c, "").unwrap()[0];
+        assert!((t - 0.5).abs() < 0.005, "{c} = {t}");
+    }
+    let pr = Table::read(&out.join("impact/projectile.parquet")).unwrap();
+    let vz = pr.f64("vz", "").unwrap();
+    // The bullet has slowed, not stopped or reversed, in 4 µs (it started at 400 m/s).
+    let last = *vz.last().unwrap();
+    assert!(last < -300.0 && last > -400.0, "vz = {last}");
+    for fig in ["weave.png", "impact.png"] {
+        assert!(out.join("figures").join(fig).exists(), "{fig}");
+    }
+    let again = weft_run(root, "woven_patch.toml");
+    assert!(again.contains("4 fresh"), "{again}");
+}

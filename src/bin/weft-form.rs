@@ -43,7 +43,7 @@ struct Cli {
     #[arg(long, default_value_t = 0.5)]
     weft_tension: f64,
     /// Step budget; forming that has not converged by then is an error.
-    #[arg(long, default_value_t = 200_000)]
+    #[arg(long, default_value_t = 400_000)]
     max_steps: u64,
     /// Converged when the largest kinetic energy of a test window is ≤ this × the energy
     /// removed so far ...
