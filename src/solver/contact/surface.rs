@@ -109,28 +109,35 @@ pub fn closest_on_face(p: &[f64; 3], x: &[[f64; 3]; 4], n: usize) -> [f64; 4] {
         _ => {
             let a = super::closest_on_triangle(p, &x[0], &x[1], &x[2]);
             let b = super::closest_on_triangle(p, &x[0], &x[2], &x[3]);
-            let c = super::closest_on_triangle(p, &x[1], &x[2], &x[3]);
-            let d = super::closest_on_triangle(p, &x[1], &x[3], &x[0]);
-            // Split 0-2: triangles (0,1,2), (0,2,3); split 1-3: (1,2,3), (1,3,0). Each split
-            // takes its nearer triangle; the two splits are averaged.
-            let q = |w: [f64; 3], i: [usize; 3]| -> ([f64; 4], f64) {
-                let mut ww = [0.0; 4];
-                for k in 0..3 {
-                    ww[i[k]] = w[k];
-                }
-                let qp: [f64; 3] = std::array::from_fn(|dd| (0..4).map(|k| ww[k] * x[k][dd]).sum());
-                let r = sub(p, &qp);
-                (ww, dot(&r, &r))
-            };
-            let (wa, da) = q(a, [0, 1, 2]);
-            let (wb, db) = q(b, [0, 2, 3]);
-            let (wc, dc) = q(c, [1, 2, 3]);
-            let (wd, dd) = q(d, [1, 3, 0]);
-            let s1 = if da <= db { wa } else { wb };
-            let s2 = if dc <= dd { wc } else { wd };
-            std::array::from_fn(|k| 0.5 * (s1[k] + s2[k]))
+            closest_on_quad(p, x, a, b)
         }
     }
+}
+
+/// [`closest_on_face`] for a quad whose split 0-2 triangles (0,1,2) and (0,2,3) have
+/// been evaluated already (`a`, `b`: their barycentric weights).
+#[inline]
+pub fn closest_on_quad(p: &[f64; 3], x: &[[f64; 3]; 4], a: [f64; 3], b: [f64; 3]) -> [f64; 4] {
+    let c = super::closest_on_triangle(p, &x[1], &x[2], &x[3]);
+    let d = super::closest_on_triangle(p, &x[1], &x[3], &x[0]);
+    // Split 0-2: triangles (0,1,2), (0,2,3); split 1-3: (1,2,3), (1,3,0). Each split
+    // takes its nearer triangle; the two splits are averaged.
+    let q = |w: [f64; 3], i: [usize; 3]| -> ([f64; 4], f64) {
+        let mut ww = [0.0; 4];
+        for k in 0..3 {
+            ww[i[k]] = w[k];
+        }
+        let qp: [f64; 3] = std::array::from_fn(|dd| (0..4).map(|k| ww[k] * x[k][dd]).sum());
+        let r = sub(p, &qp);
+        (ww, dot(&r, &r))
+    };
+    let (wa, da) = q(a, [0, 1, 2]);
+    let (wb, db) = q(b, [0, 2, 3]);
+    let (wc, dc) = q(c, [1, 2, 3]);
+    let (wd, dd) = q(d, [1, 3, 0]);
+    let s1 = if da <= db { wa } else { wb };
+    let s2 = if dc <= dd { wc } else { wd };
+    std::array::from_fn(|k| 0.5 * (s1[k] + s2[k]))
 }
 
 /// What one slave's contact gives at one step.
@@ -632,6 +639,7 @@ impl Side {
                     if d2 > reach * reach {
                         continue;
                     }
+                    let mut split = None;
                     if nf == 4 {
                         // One split first: the other differs by at most half the warp
                         // |x₀ − x₁ + x₂ − x₃|/2, so a face out of reach by more is skipped.
@@ -657,8 +665,12 @@ impl Side {
                         if da.min(db) > lim * lim {
                             continue;
                         }
+                        split = Some((wa, wb));
                     }
-                    let w = closest_on_face(&p, &xf, nf);
+                    let w = match split {
+                        Some((wa, wb)) => closest_on_quad(&p, &xf, wa, wb),
+                        None => closest_on_face(&p, &xf, nf),
+                    };
                     let q: [f64; 3] =
                         std::array::from_fn(|d| (0..nf).map(|a| w[a] * xf[a][d]).sum());
                     let tf: f64 = (0..nf).map(|a| w[a] * face_t[fi as usize][a]).sum();
