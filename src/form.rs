@@ -26,7 +26,9 @@
 //! 2. dynamic relaxation with local damping ([`crate::solver::relax`]) until the largest
 //!    kinetic energy of a test window is ≤ `kinetic_tolerance` × W and the largest
 //!    residual force on a free degree of freedom ≤ `force_tolerance` × the largest
-//!    contact force seen (or the largest pull); an error after `max_steps`;
+//!    contact force seen (or the largest pull) and no node moved more than
+//!    `creep_tolerance` × the largest yarn thickness over the last `creep_time` (the
+//!    pretensioned patch's slow drum mode settles last); an error after `max_steps`;
 //! 3. checks: no contact deeper than `penetration_limit` of its contact distance (a yarn
 //!    went through another: an error naming the node and the element);
 //! 4. the formed model: the reference geometry unchanged, the formed positions as the

@@ -45,6 +45,9 @@ struct Cli {
     /// Step budget; forming that has not converged by then is an error.
     #[arg(long, default_value_t = 400_000)]
     max_steps: u64,
+    /// No convergence test before this many steps.
+    #[arg(long, default_value_t = 1000)]
+    min_steps: u64,
     /// Converged when the largest kinetic energy of a test window is ≤ this × the energy
     /// removed so far ...
     #[arg(long, default_value_t = 1e-6)]
@@ -98,6 +101,7 @@ fn run_cli() -> anyhow::Result<ExitCode> {
         warp_tension: cli.warp_tension,
         weft_tension: cli.weft_tension,
         max_steps: cli.max_steps,
+        min_steps: cli.min_steps,
         kinetic_tolerance: cli.kinetic_tolerance,
         force_tolerance: cli.force_tolerance,
         penetration_limit: cli.penetration_limit,
