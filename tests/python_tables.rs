@@ -150,6 +150,69 @@ fn a_generated_woven_model_opens_in_pandas_and_polars() {
     eprintln!("{}", String::from_utf8_lossy(&o.stdout));
 }
 
+/// A formed woven model (initial displacements ux0, uy0, uz0 in nodes.parquet, and
+/// form.parquet) and its impact's tables open in pandas and polars.
+#[test]
+fn a_formed_woven_model_opens_in_pandas_and_polars() {
+    if !python_ok() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let s = |p: &str| d.join(p).to_string_lossy().to_string();
+    let ok = |c: &mut Command| {
+        let o = c.output().unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    };
+    ok(Command::new(env!("CARGO_BIN_EXE_weft-weave")).args([
+        "woven",
+        "--yarns",
+        "4",
+        "--out",
+        &s("patch"),
+    ]));
+    ok(Command::new(env!("CARGO_BIN_EXE_weft-form")).args([
+        "--quiet",
+        "--model",
+        &s("patch"),
+        "--out",
+        &s("formed"),
+    ]));
+    ok(Command::new(env!("CARGO_BIN_EXE_weft-simulate")).args([
+        "--quiet",
+        "--model",
+        &s("formed"),
+        "--end-time",
+        "2e-6",
+        "--out",
+        &s("out"),
+    ]));
+    let o = Command::new("python3")
+        .arg(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/read_tables.py"))
+        .arg(env!("CARGO_BIN_EXE_weft-simulate"))
+        .arg(d.join("formed"))
+        .arg(d.join("out"))
+        .arg(d)
+        .arg("open-only")
+        .output()
+        .unwrap();
+    assert!(
+        o.status.success(),
+        "read_tables.py failed:\n{}\n{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let cols = Command::new("python3")
+        .args([
+            "-c",
+            "import sys, pandas as pd; print(list(pd.read_parquet(sys.argv[1]).columns))",
+        ])
+        .arg(d.join("formed/nodes.parquet"))
+        .output()
+        .unwrap();
+    assert!(String::from_utf8_lossy(&cols.stdout).contains("'uz0'"));
+}
+
 /// The fit and error stages' tables open in pandas and polars, with a parameter's name
 /// (`membrane.G12`) as a column and nulls where documented.
 #[test]

@@ -46,9 +46,13 @@ EXPECT = {
                            "T": "float64", "T_initial": "float64", "expected": "float64", "at_bound": "bool"},
     "error.parquet": {"node_id": "int64", "x": "float64", "peak_relative_error": "float64"},
     "error_summary.parquet": {"T": "float64", "max_peak_relative_error": "float64"},
+    "form.parquet": {"steps": "int64", "kinetic_over_work": "float64", "max_residual_force": "float64",
+                     "creep": "float64", "crimp_target": "float64", "warp_tension": "float64",
+                     "warp_end_tension": "float64", "max_penetration_ratio": "float64"},
 }
 # Optional columns: checked when present.
 OPTIONAL = {
+    "nodes.parquet": {c: "float64" for c in ["ux0", "uy0", "uz0"]},
     "elements_quad.parquet": {c: "float64" for c in ["t1", "t2", "t3", "t4"]},
     "elements_tri.parquet": {c: "float64" for c in ["t1", "t2", "t3"]},
 }
