@@ -379,3 +379,59 @@ fn the_stages_chain_generate_form_and_draw_the_weave() {
     assert!(!ok && e.contains("has no node on y = 0.0003"), "{e}");
     assert!(!d.join("x.svg").exists());
 }
+
+#[test]
+fn bad_initial_displacement_columns_are_named() {
+    use weft::table::{batch, write_table, Col, Provenance};
+    let dir = tempfile::tempdir().unwrap();
+    let model = dir.path().join("m");
+    let prov = Provenance::new("test", serde_json::json!({}));
+    let m = patch(4);
+    weft::model::io::write_model(&m, &model, &prov).unwrap();
+    let nodes = |extra: Vec<Col>| {
+        let mut cols = vec![
+            Col::I64("node_id", m.node_id.clone()),
+            Col::F64("x", m.coords.iter().map(|c| c[0]).collect()),
+            Col::F64("y", m.coords.iter().map(|c| c[1]).collect()),
+            Col::F64("z", m.coords.iter().map(|c| c[2]).collect()),
+        ];
+        cols.extend(extra);
+        write_table(&model.join("nodes.parquet"), &batch(cols), &prov).unwrap();
+        weft::model::io::read_model(&model)
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_default()
+    };
+    let nn = m.num_nodes();
+    // Only one of the three columns.
+    let e = nodes(vec![Col::F64("ux0", vec![0.0; nn])]);
+    assert!(
+        e.contains("1 of the initial displacement columns") && e.contains("nodes.parquet"),
+        "{e}"
+    );
+    // A non-finite value.
+    let mut bad = vec![0.0; nn];
+    bad[7] = f64::NAN;
+    let e = nodes(vec![
+        Col::F64("ux0", vec![0.0; nn]),
+        Col::F64("uy0", bad),
+        Col::F64("uz0", vec![0.0; nn]),
+    ]);
+    // The table reader names the column, the row and the file.
+    assert!(
+        e.contains("`uy0`") && e.contains("row 7") && e.contains("nodes.parquet"),
+        "{e}"
+    );
+    // A formed model cannot be formed again.
+    let e = nodes(vec![
+        Col::F64("ux0", vec![0.0; nn]),
+        Col::F64("uy0", vec![0.0; nn]),
+        Col::F64("uz0", vec![1e-9; nn]),
+    ]);
+    assert!(e.is_empty(), "{e}");
+    let formed = weft::model::io::read_model(&model).unwrap();
+    let e = form(&formed, &Params::default(), &mut |_| {})
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("already formed"), "{e}");
+}
