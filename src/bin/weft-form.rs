@@ -18,8 +18,11 @@ use weft::form::{run, Config, Params};
                   weft: `weft…`, along y); the projectile is set aside; the weave settles by frictionless contact under \
                   dynamic relaxation with local damping (each force component loses half its size against the motion; \
                   Cundall) until the \
-                  largest kinetic energy of a test window is below --kinetic-tolerance of the energy removed and the \
-                  largest residual nodal force below --force-tolerance of the largest contact force.\n\n\
+                  largest kinetic energy of a test window is below --kinetic-tolerance of the energy removed, the \
+                  largest residual nodal force below --force-tolerance of the largest contact force, and no node has \
+                  moved more than --creep-tolerance of the yarn thickness over the last --creep-time (the pretensioned \
+                  patch's slow drum mode settles last: forming takes 28 s for the 6 × 6 quarter and 3 min for the \
+                  10 × 10 on 2 cores; --creep-tolerance 1000 turns the test off).\n\n\
                   Writes the formed model (the reference geometry unchanged, the formed positions as the nodes' initial \
                   displacement ux0, uy0, uz0 in nodes.parquet, the yarn ends held where they came to rest, contacts \
                   `keep` with their friction, the projectile raised by as much as the fabric rose) and form.parquet \
