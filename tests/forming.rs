@@ -435,3 +435,80 @@ fn bad_initial_displacement_columns_are_named() {
         .to_string();
     assert!(e.contains("already formed"), "{e}");
 }
+
+/// `Solver::relax` alone, on the statics forming relies on: a string of trusses fixed at
+/// one end, pulled along its axis at the other by T₀ (free to slide), loaded by P across
+/// at its middle. Equilibrium of the string: the horizontal force is T₀ all along, each
+/// half carries P/2 across and is straight, so the middle sits at δ = x_c P/(2T₀) below
+/// the axis, x_c its distance from the fixed end, whatever the yarn's E·A (statics of a
+/// string; Irvine, *Cable Structures*, §1).
+#[test]
+fn relaxation_finds_the_statics_of_a_pulled_string() {
+    use weft::model::{ElementKind, Load, PartProps, TimeLaw};
+    use weft::solver::relax::RelaxOptions;
+    use weft::solver::Solver;
+    let (n, l, t0, p) = (20usize, 10e-3, 0.5, 0.05);
+    let mut m = Model::default();
+    for i in 0..=n {
+        m.add_node(i as i64 + 1, [i as f64 * l / n as f64, 0.0, 0.0]);
+    }
+    let rod = m.add_part(
+        1,
+        "yarn",
+        ElementKind::Truss,
+        PartProps {
+            youngs_modulus: Some(80e9),
+            density: Some(1440.0),
+            area: Some(6.6e-8),
+            ..Default::default()
+        },
+    );
+    for i in 0..n {
+        m.add_element(i as i64 + 1, rod, &[i, i + 1]);
+    }
+    m.constraints.push((0, [true; 3]));
+    m.constraints.push((n, [false, true, true]));
+    for i in 1..n {
+        m.constraints.push((i, [false, true, false]));
+    }
+    let step = TimeLaw::Step { start: 0.0 };
+    m.loads.push(Load {
+        id: 1,
+        node: n,
+        force: [t0, 0.0, 0.0],
+        law: step.clone(),
+    });
+    m.loads.push(Load {
+        id: 2,
+        node: n / 2,
+        force: [0.0, 0.0, -p],
+        law: step,
+    });
+    let mut s = Solver::new(&m).unwrap();
+    let st = s
+        .relax(
+            &RelaxOptions {
+                max_steps: 2_000_000,
+                min_steps: 1000,
+                check_every: 100,
+                alpha: 0.5,
+                kinetic_tolerance: 1e-12,
+                force_tolerance: 1e-8,
+                force_scale: t0,
+                creep_window: 1000,
+                creep_tolerance: 1e-15,
+            },
+            &mut |_| {},
+        )
+        .unwrap();
+    let c = s.state.x[n / 2];
+    let expect = c[0] * p / (2.0 * t0);
+    let err = (-c[2] - expect).abs() / expect;
+    println!(
+        "pulled string: {} steps, residual {:.2e} N; δ = {:.6e} m against x_c P/(2T₀) = {expect:.6e} m ({err:.1e})",
+        st.steps, st.residual, -c[2]
+    );
+    assert!(st.converged);
+    // Measured 6.9e-11 (the residual 5.5e-11 N against P = 0.05 N).
+    assert!(err < 1e-9, "{err}");
+}
