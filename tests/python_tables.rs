@@ -24,6 +24,26 @@ fn python_ok() -> bool {
     ok
 }
 
+/// Runs `tests/read_tables.py` on a model folder and its results (`open_only`: check
+/// the tables only, skip the rod's write-back check).
+fn read_tables(
+    model: &std::path::Path,
+    out: &std::path::Path,
+    scratch: &std::path::Path,
+    open_only: bool,
+) -> std::process::Output {
+    let mut c = Command::new("python3");
+    c.arg(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/read_tables.py"))
+        .arg(env!("CARGO_BIN_EXE_weft-simulate"))
+        .arg(model)
+        .arg(out)
+        .arg(scratch);
+    if open_only {
+        c.arg("open-only");
+    }
+    c.output().unwrap()
+}
+
 #[test]
 fn tables_open_in_pandas_and_polars() {
     if !python_ok() {
@@ -47,14 +67,7 @@ fn tables_open_in_pandas_and_polars() {
         .status()
         .unwrap();
     assert!(st.success());
-    let o = Command::new("python3")
-        .arg(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/read_tables.py"))
-        .arg(env!("CARGO_BIN_EXE_weft-simulate"))
-        .arg(&model)
-        .arg(&out)
-        .arg(dir.path())
-        .output()
-        .unwrap();
+    let o = read_tables(&model, &out, &dir.path(), false);
     let so = String::from_utf8_lossy(&o.stdout);
     let se = String::from_utf8_lossy(&o.stderr);
     assert!(o.status.success(), "read_tables.py failed:\n{so}\n{se}");
@@ -92,15 +105,7 @@ fn a_model_with_every_feature_opens_in_pandas_and_polars() {
         assert!(model.join(t).exists(), "{t}");
     }
     assert!(out.join("projectile.parquet").exists());
-    let o = Command::new("python3")
-        .arg(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/read_tables.py"))
-        .arg(env!("CARGO_BIN_EXE_weft-simulate"))
-        .arg(&model)
-        .arg(&out)
-        .arg(dir.path())
-        .arg("open-only")
-        .output()
-        .unwrap();
+    let o = read_tables(&model, &out, &dir.path(), true);
     assert!(
         o.status.success(),
         "read_tables.py failed:\n{}\n{}",
@@ -132,15 +137,7 @@ fn a_generated_woven_model_opens_in_pandas_and_polars() {
         .status()
         .unwrap();
     assert!(st.success());
-    let o = Command::new("python3")
-        .arg(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/read_tables.py"))
-        .arg(env!("CARGO_BIN_EXE_weft-simulate"))
-        .arg(&model)
-        .arg(&out)
-        .arg(dir.path())
-        .arg("open-only")
-        .output()
-        .unwrap();
+    let o = read_tables(&model, &out, &dir.path(), true);
     assert!(
         o.status.success(),
         "read_tables.py failed:\n{}\n{}",
@@ -187,15 +184,7 @@ fn a_formed_woven_model_opens_in_pandas_and_polars() {
         "--out",
         &s("out"),
     ]));
-    let o = Command::new("python3")
-        .arg(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/read_tables.py"))
-        .arg(env!("CARGO_BIN_EXE_weft-simulate"))
-        .arg(d.join("formed"))
-        .arg(d.join("out"))
-        .arg(d)
-        .arg("open-only")
-        .output()
-        .unwrap();
+    let o = read_tables(&d.join("formed"), &d.join("out"), &d, true);
     assert!(
         o.status.success(),
         "read_tables.py failed:\n{}\n{}",
@@ -286,15 +275,7 @@ fn fit_and_error_tables_open_in_pandas_and_polars() {
         "--out-dir",
         &s("fit"),
     ]));
-    let o = Command::new("python3")
-        .arg(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/read_tables.py"))
-        .arg(env!("CARGO_BIN_EXE_weft-simulate"))
-        .arg(d.join("fit/models/cand"))
-        .arg(d.join("fit"))
-        .arg(d)
-        .arg("open-only")
-        .output()
-        .unwrap();
+    let o = read_tables(&d.join("fit/models/cand"), &d.join("fit"), &d, true);
     assert!(
         o.status.success(),
         "read_tables.py failed:\n{}\n{}",

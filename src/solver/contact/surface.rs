@@ -54,12 +54,10 @@ const SLAVE_CHUNK: usize = 256;
 /// Gradient in the face's plane of its interpolated nodal thickness, at the face centre
 /// (exact for a thickness linear over the face, as across a lenticular band's quads); zero
 /// for a uniform thickness or a segment.
-pub fn thickness_gradient(t: &[f64; 4], f: &[u32; 4], x: &[[f64; 3]], nf: usize) -> [f64; 3] {
+pub fn thickness_gradient(t: &[f64; 4], xa: &[[f64; 3]; 4], nf: usize) -> [f64; 3] {
     if nf < 3 || (0..nf).all(|a| t[a] == t[0]) {
         return [0.0; 3];
     }
-    let xa: [[f64; 3]; 4] =
-        std::array::from_fn(|a| if a < nf { x[f[a] as usize] } else { [0.0; 3] });
     // Tangents and thickness derivatives in the face's parameters.
     let (xs, xe, ts, te) = if nf == 4 {
         (
@@ -291,8 +289,8 @@ pub struct Side {
     friction: Friction,
     kappa: f64,
     /// Normal viscous damping as a fraction ζ of the pair's critical damping
-    /// 2√(k m*) (0 in impact runs; dynamic relaxation sets it).
-    pub damping: f64,
+    /// 2√(k m*) (0 in impact runs; `set_normal_damping` sets it for a relaxation).
+    damping: f64,
     on_initial: InitialPenetration,
     /// Inflation of the face boxes beyond the skin: t_s,max/2 + t_F,max/2 [m].
     reach: f64,
@@ -691,7 +689,7 @@ impl Side {
                     let dist = dot(&r, &r).sqrt();
                     let g = 0.5 * (slave_t[si] + tf) - dist;
                     if g > 0.0 && dist > 0.0 {
-                        let tg = thickness_gradient(&face_t[fi as usize], f, x, nf);
+                        let tg = thickness_gradient(&face_t[fi as usize], &xf, nf);
                         for d in 0..3 {
                             n_sum[d] += g * r[d] / dist;
                             tg_sum[d] += g * tg[d];
