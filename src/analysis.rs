@@ -143,16 +143,31 @@ pub struct WaveSpeeds {
     pub node_speed: Vec<Option<f64>>,
 }
 
-/// Level: absolute, or a fraction of each node's peak |value|.
+/// The level whose arrival times a wave's front.
 #[derive(Debug, Clone, Copy)]
 pub enum Level {
+    /// One absolute level for all nodes [m or m/s].
     Absolute(f64),
+    /// One level for all nodes: this fraction of the largest |value| anywhere on the line
+    /// at any time (the paper's "pre-selected level").
+    Line(f64),
+    /// A fraction of each node's own peak |value|. Only for a clean single pulse: where a
+    /// reflection adds to the incident wave (near a clamp) a node's peak is not the
+    /// incident one, and a node that hardly moves (at the clamp) reaches half its tiny
+    /// peak with the first ripple (the §4 figure showed −10 000 to −49 000 m/s there
+    /// where the lattice's speed is 3180 m/s).
     Relative(f64),
 }
 
 /// Arrival times of a level along the line and the speeds between nodes (the paper's §3:
 /// v = Δx/(t₂ − t₁), a node's speed the mean of its two segments). The speed is signed:
 /// positive when the wave runs in the set's order.
+///
+/// The incident front only: from the node the level reaches first, the arrival times
+/// must not decrease outwards along the line in either direction; the first node where
+/// one does (or that the level never reaches) and every node beyond it count as not
+/// reached by the incident front (a later crossing is a reflection, or a wave that came
+/// another way).
 pub fn wave_speeds(s: &Series, component: usize, level: Level) -> WaveSpeeds {
     let n = s.node_id.len();
     let mut position = vec![0.0; n];
@@ -163,11 +178,17 @@ pub fn wave_speeds(s: &Series, component: usize, level: Level) -> WaveSpeeds {
             .sqrt();
         position[j] = position[j - 1] + d;
     }
-    let arrival: Vec<Option<f64>> = (0..n)
+    let line_peak = s
+        .values
+        .iter()
+        .flat_map(|v| v.iter().map(|u| u[component].abs()))
+        .fold(0.0, f64::max);
+    let mut arrival: Vec<Option<f64>> = (0..n)
         .map(|j| {
             let y: Vec<f64> = s.values.iter().map(|v| v[j][component]).collect();
             let lv = match level {
                 Level::Absolute(a) => a,
+                Level::Line(f) => f * line_peak,
                 Level::Relative(f) => f * y.iter().map(|v| v.abs()).fold(0.0, f64::max),
             };
             if lv <= 0.0 {
@@ -177,6 +198,28 @@ pub fn wave_speeds(s: &Series, component: usize, level: Level) -> WaveSpeeds {
             }
         })
         .collect();
+    let first = (0..n)
+        .filter_map(|j| arrival[j].map(|a| (j, a)))
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .map(|(j, _)| j);
+    if let Some(j0) = first {
+        for dir in [1isize, -1] {
+            let mut last = arrival[j0].unwrap_or(f64::NEG_INFINITY);
+            let mut cut = false;
+            let mut j = j0 as isize + dir;
+            while j >= 0 && (j as usize) < n {
+                let a = &mut arrival[j as usize];
+                match *a {
+                    Some(t) if !cut && t >= last => last = t,
+                    _ => {
+                        cut = true;
+                        *a = None;
+                    }
+                }
+                j += dir;
+            }
+        }
+    }
     let segment_speed: Vec<Option<f64>> = (0..n)
         .map(|j| {
             if j == 0 {

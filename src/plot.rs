@@ -83,6 +83,8 @@ pub struct WavespeedFigure {
     pub label: Vec<String>,
     /// Segment speeds instead of node speeds.
     pub segments: bool,
+    /// Closed-form speeds drawn as dashed lines across the plot: (label, speed [m/s]).
+    pub expected: Vec<(String, f64)>,
 }
 
 /// Per-node peak relative errors, one series per error.parquet.
@@ -373,6 +375,22 @@ fn wavespeed(a: &WavespeedFigure) -> Result<Chart> {
             style: Style::LinePoints,
             color: k,
         });
+    }
+    let (lo, hi) = series
+        .iter()
+        .flat_map(|s| s.points.iter().map(|p| p.0))
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), x| {
+            (l.min(x), h.max(x))
+        });
+    if lo < hi {
+        for (j, (name, v)) in a.expected.iter().enumerate() {
+            series.push(Series {
+                label: name.clone(),
+                points: vec![(lo, *v), (hi, *v)],
+                style: Style::Dashed,
+                color: a.table.len() + j,
+            });
+        }
     }
     Ok(Chart {
         title: None,

@@ -21,9 +21,12 @@ pub struct Config {
     pub set: String,
     /// Component: ux, uy, uz, vx, vy or vz.
     pub component: String,
-    /// Level as a fraction of each node's peak |value| (when `level` is `None`).
-    pub relative_level: f64,
-    /// Absolute level [m or m/s].
+    /// One level for all nodes: this fraction of the largest |value| on the line (unless
+    /// one of the two below is given).
+    pub line_level: f64,
+    /// A fraction of each node's own peak |value| instead (a clean single pulse only).
+    pub relative_level: Option<f64>,
+    /// One absolute level [m or m/s] instead.
     pub level: Option<f64>,
     /// Output table.
     pub out: PathBuf,
@@ -46,10 +49,28 @@ pub fn run(c: &Config) -> Result<Report> {
             c.component
         )));
     }
-    let level = match c.level {
-        Some(a) => Level::Absolute(a),
-        None => Level::Relative(c.relative_level),
+    let level = match (c.level, c.relative_level) {
+        (Some(a), _) => Level::Absolute(a),
+        (None, Some(f)) => Level::Relative(f),
+        (None, None) => Level::Line(c.line_level),
     };
+    for (name, v) in [
+        ("--line-level", Some(c.line_level)),
+        ("--relative-level", c.relative_level),
+    ] {
+        if let Some(v) = v {
+            if !(v > 0.0 && v < 1.0) {
+                return Err(WeftError::input(format!("{name} = `{v}`"))
+                    .expected("a fraction of the peak, 0 < f < 1"));
+            }
+        }
+    }
+    if let Some(a) = c.level {
+        if !(a.is_finite() && a > 0.0) {
+            return Err(WeftError::input(format!("--level = `{a}`"))
+                .expected("a level > 0 in the component's unit (m or m/s)"));
+        }
+    }
     let s = read_series(&c.model, &c.history, &c.set)
         .map_err(|e| e.context("cannot read the node set's history"))?;
     let w = wave_speeds(&s, comp[0], level);

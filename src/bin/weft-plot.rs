@@ -117,8 +117,26 @@ struct WavespeedArgs {
     /// Plot segment speeds instead of node speeds.
     #[arg(long)]
     segments: bool,
+    /// A closed-form speed to draw as a dashed line, `LABEL=SPEED` in m/s (signed like
+    /// the table's speeds; repeat), e.g. `--expected 'lattice √(E/ρ(2 − b/a))=-3181'`.
+    #[arg(long, value_parser = parse_expected)]
+    expected: Vec<(String, f64)>,
     #[command(flatten)]
     common: Common,
+}
+
+fn parse_expected(s: &str) -> Result<(String, f64), String> {
+    let (l, v) = s
+        .rsplit_once('=')
+        .ok_or_else(|| format!("`{s}`: expected LABEL=SPEED, e.g. 'closed form=-3181'"))?;
+    let v: f64 = v
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{v}` in `{s}` is not a number (a speed in m/s)"))?;
+    if !v.is_finite() {
+        return Err(format!("`{s}`: the speed must be finite"));
+    }
+    Ok((l.trim().to_string(), v))
 }
 
 #[derive(Args)]
@@ -182,6 +200,7 @@ fn run() -> anyhow::Result<()> {
                 table: a.table,
                 label: a.label,
                 segments: a.segments,
+                expected: a.expected,
             }),
             a.common,
         ),

@@ -12,10 +12,14 @@ use weft::analysis::wavespeed;
     version,
     about = "Wave arrival times and speeds along an ordered node set (the paper's §3)",
     long_about = "For each node of an ordered node set (e.g. `axis_x`), the first time the chosen component reaches a \
-                  level (absolute, or a fraction of that node's peak), linearly interpolated between output samples; \
-                  the speed of each segment Δx/Δt, and each node's speed as the mean of its two segments. Speeds are \
-                  signed: positive when the wave runs in the set's order. Nodes the wave never reaches are kept, with \
-                  null times and speeds.\n\nExample:\n  weft-wavespeed --model runs/rod --history runs/rod-out/history.parquet \
+                  level, linearly interpolated between output samples: by default one level for all nodes, \
+                  --line-level (0.2) of the largest |value| on the line; or an absolute --level; or a fraction of each \
+                  node's own peak (--relative-level, for a clean single pulse only). The incident front only: from \
+                  the node reached first, arrival times must not decrease outwards along the line; the first node \
+                  where one does, and every node beyond, count as not reached (a later crossing is a reflection). \
+                  Then the speed of each segment Δx/Δt, and each node's speed as the mean of its two segments. Speeds \
+                  are signed: positive when the wave runs in the set's order. Nodes the incident front does not \
+                  reach are kept, with null times and speeds.\n\nExample:\n  weft-wavespeed --model runs/rod --history runs/rod-out/history.parquet \
                   --set axis_x --component vx --relative-level 0.5 --out runs/rod-out/wavespeeds.parquet"
 )]
 struct Cli {
@@ -31,10 +35,15 @@ struct Cli {
     /// Component: ux, uy, uz, vx, vy or vz.
     #[arg(long, default_value = "uz")]
     component: String,
-    /// Level as a fraction of each node's peak |value|.
-    #[arg(long, conflicts_with = "level", default_value_t = 0.5)]
-    relative_level: f64,
-    /// Absolute level [m or m/s] instead of a fraction of the peak.
+    /// One level for all nodes: this fraction of the largest |value| anywhere on the
+    /// line (the paper's pre-selected level).
+    #[arg(long, default_value_t = 0.2)]
+    line_level: f64,
+    /// Instead, a fraction of each node's own peak |value| (a clean single pulse only:
+    /// near a clamp the reflection, or the first ripple, reaches it).
+    #[arg(long, conflicts_with = "level")]
+    relative_level: Option<f64>,
+    /// Instead, one absolute level [m or m/s] for all nodes.
     #[arg(long)]
     level: Option<f64>,
     /// Output table.
@@ -53,6 +62,7 @@ fn run() -> anyhow::Result<ExitCode> {
         history: cli.history,
         set: cli.set,
         component: cli.component,
+        line_level: cli.line_level,
         relative_level: cli.relative_level,
         level: cli.level,
         out: cli.out.clone(),
