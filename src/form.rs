@@ -26,9 +26,10 @@
 //! 2. dynamic relaxation with local damping ([`crate::solver::relax`]) until the largest
 //!    kinetic energy of a test window is ≤ `kinetic_tolerance` × W and the largest
 //!    residual force on a free degree of freedom ≤ `force_tolerance` × the largest
-//!    contact force seen (or the largest pull) and no node moved more than
-//!    `creep_tolerance` × the largest yarn thickness over the last `creep_time` (the
-//!    pretensioned patch's slow drum mode settles last); an error after `max_steps`;
+//!    contact force seen (or the largest pull), and then, left alone at rest (a free,
+//!    undamped probe run from there), no node moves more than `creep_tolerance` × the
+//!    largest yarn thickness within `creep_time` (the pretensioned patch's slow drum
+//!    mode settles last); an error after `max_steps`;
 //! 3. checks: no contact deeper than `penetration_limit` of its contact distance (a yarn
 //!    went through another: an error naming the node and the element);
 //! 4. the formed model: the reference geometry unchanged, the formed positions as the
@@ -53,7 +54,7 @@ use crate::solver::membrane::tension_1;
 use crate::solver::relax::{RelaxOptions, RelaxStats};
 use crate::solver::vec3::{norm, sub};
 use crate::solver::Solver;
-use crate::table::{batch, write_table, Col, Provenance};
+use crate::table::{batch, write_table, Col, Provenance, Table};
 
 /// Forming parameters.
 #[derive(Debug, Clone, Serialize)]
@@ -72,10 +73,14 @@ pub struct Params {
     pub penetration_limit: f64,
     /// Normal contact damping during forming, fraction of critical.
     pub contact_damping: f64,
-    /// ... and no node moved more than this × the largest yarn thickness over the last
-    /// `creep_time` of relaxation (the slow drum mode of the pretensioned patch settles
-    /// last: stopped without it, the 6 × 6 quarter then drifted 1.9 % of h in 50 µs at
-    /// rest; with 10⁻³, 0.96 %; measured).
+    /// ... and, left alone at rest (a free probe run), no node moves more than this ×
+    /// the largest yarn thickness within `creep_time`: the issue's "less than 1 % of the
+    /// yarn thickness over 50 µs", tested directly. (Stopped on the first two tests
+    /// alone, the 6 × 6 quarter drifted 1.9 % of h in 50 µs at rest, measured. A
+    /// tolerance on the motion during the damped relaxation instead held the 10 × 10
+    /// quarter for 10⁵ steps while its drum mode crawled, under the damping, from one
+    /// equilibrium to another; a free probe at 3·10⁻³ h never passed in 4·10⁵ steps:
+    /// the contacts' free vibration alone is 0.4 % of h.)
     pub creep_tolerance: f64,
     pub creep_time: f64,
     /// Local damping α of the relaxation (Cundall; 0 < α < 1). FLAC's 0.8 left the
@@ -99,7 +104,7 @@ impl Default for Params {
             force_tolerance: 0.05,
             penetration_limit: 0.5,
             contact_damping: 0.5,
-            creep_tolerance: 3e-4,
+            creep_tolerance: 1e-2,
             creep_time: 50e-6,
             damping: 0.5,
             friction: false,
@@ -114,9 +119,13 @@ pub struct Report {
     pub time_step: f64,
     pub kinetic_over_work: f64,
     pub forming_work: f64,
+    /// Of which credited to the start (a tiled smaller patch's forming work scaled by
+    /// the element count; 0 from the generated geometry) [J].
+    pub start_work: f64,
     pub max_residual_force: f64,
     pub max_contact_force: f64,
-    /// Largest node displacement over the last creep window [m].
+    /// Largest node displacement in the last rest test (a free run of `creep_time` from
+    /// the relaxed state at rest) [m].
     pub creep: f64,
     pub crimp_warp_before: f64,
     pub crimp_warp_after: f64,
@@ -209,10 +218,183 @@ fn crimp(m: &Model, x: &[[f64; 3]], line: &[usize], fam: usize, crossings: &[usi
     (path / straight - 1.0, 0.5 * (hi - lo))
 }
 
+/// A start for the relaxation other than the generated geometry.
+#[derive(Debug, Clone)]
+pub struct Start {
+    /// Displacement of every node of the model to form [m].
+    pub u: Vec<[f64; 3]>,
+    /// Forming work credited to it [J] (the work that formed the state it came from).
+    pub work: f64,
+}
+
 /// Form `m` (a woven model from `weft-weave woven`): the formed model and the report.
 pub fn form(
     m: &Model,
     p: &Params,
+    progress: &mut dyn FnMut(&RelaxStats),
+) -> Result<(Model, Report)> {
+    form_from(m, p, None, progress)
+}
+
+/// Quad part name of each node (the first quad that holds it), or "".
+fn node_parts(m: &Model) -> Vec<&str> {
+    let mut out = vec![""; m.num_nodes()];
+    if let Some(b) = m.elements.get(&ElementKind::Quad) {
+        for e in 0..b.len() {
+            for &n in &b.nodes[4 * e..4 * e + 4] {
+                if out[n].is_empty() {
+                    out[n] = &m.parts[b.part[e]].name;
+                }
+            }
+        }
+    }
+    out
+}
+
+/// The yarn spacing from the node set `axis_x` (its first two crossings).
+fn spacing_of(m: &Model) -> Option<f64> {
+    let s = m.node_sets.get("axis_x")?;
+    (s.len() >= 2)
+        .then(|| (m.coords[s[1]][0] - m.coords[s[0]][0]).abs())
+        .filter(|d| *d > 0.0)
+}
+
+/// A start for forming the quarter patch `m` from a formed smaller quarter patch `cell`
+/// of the same weave (same spacing, yarn section, mesh and layers; `weft-form
+/// --start-from`). A plain weave repeats every two spacings, so away from its edges a
+/// formed patch's displacement is periodic in 2p plus a mean stretch ε̄ (the yarns'
+/// strain and de-crimping). Along x (and likewise y), with X and X_c the two patches'
+/// extents, D = X − X_c (a whole number of 2p: the weave's phase at the ends must
+/// agree) and s = 2p·round(X_c / 4p): nodes at x < s take the displacement of the cell's
+/// node at x, nodes within X_c − s of the end that of the cell's node at x − D, and nodes
+/// between that of the cell's node at x − 2p·j in [s − 2p, s); to each the stretch
+/// ε̄·(x − x_cell) is added, with ε̄ the cell's mean over [s − 2p, s) of
+/// (u(x + 2p) − u(x)) / 2p. Nodes are matched by part name and reference position.
+pub fn tile_start(m: &Model, cell: &Model, cell_name: &str) -> Result<Vec<[f64; 3]>> {
+    let bad = |what: String| WeftError::input(what).in_file(cell_name.to_string());
+    if cell.initial_displacement.is_empty() {
+        return Err(bad(
+            "the start model is not formed (its nodes.parquet has no ux0, uy0, uz0)".into(),
+        )
+        .hint("start from the output of `weft-form` on a smaller patch"));
+    }
+    let (Some(p), Some(pc)) = (spacing_of(m), spacing_of(cell)) else {
+        return Err(bad(
+            "a node set `axis_x` with two crossings is missing: the yarn spacing is unknown".into(),
+        )
+        .hint("both models must come from `weft-weave woven`"));
+    };
+    if (p - pc).abs() > 1e-9 * p {
+        return Err(bad(format!("the start model's yarn spacing is {pc:e} m"))
+            .expected(format!("the spacing of the model to form, {p:e} m")));
+    }
+    let ext = |mm: &Model, d: usize| {
+        mm.coords
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), c| {
+                (l.min(c[d]), h.max(c[d]))
+            })
+    };
+    let tol = 1e-6 * p;
+    let mut maps = vec![];
+    for d in 0..2 {
+        let (lo, hi) = ext(m, d);
+        let (loc, hic) = ext(cell, d);
+        let axis = ["x", "y"][d];
+        if lo.abs() > tol || loc.abs() > tol {
+            return Err(bad(format!(
+                "the patches start at {axis} = {lo:e} m and {loc:e} m"
+            ))
+            .expected("quarter patches with symmetry planes x = 0 and y = 0")
+            .hint("generate both with `weft-weave woven` (quarter, the default)"));
+        }
+        let dd = hi - hic;
+        let periods = dd / (2.0 * p);
+        let s = 2.0 * p * (hic / (4.0 * p)).round();
+        if dd < -tol || (periods - periods.round()).abs() > 1e-6 || s < 2.0 * p - tol {
+            return Err(bad(format!(
+                "the start patch reaches {axis} = {hic:e} m and the patch to form {hi:e} m"
+            ))
+            .expected("a start patch at least 4 yarns wide and smaller by an even number of yarns (the weave repeats every 2 yarns)"));
+        }
+        maps.push((s, dd));
+    }
+    let map = |c: f64, (s, dd): (f64, f64)| -> f64 {
+        if c < s - tol {
+            c
+        } else if c >= s + dd - tol {
+            c - dd
+        } else {
+            let j = ((c - s + tol) / (2.0 * p)).floor() + 1.0;
+            c - 2.0 * p * j
+        }
+    };
+    let q = 1e-6 * p;
+    let key = |x: f64, y: f64| ((x / q).round() as i64, (y / q).round() as i64);
+    let mut index: std::collections::HashMap<(i64, i64), Vec<usize>> = Default::default();
+    for (n, c) in cell.coords.iter().enumerate() {
+        index.entry(key(c[0], c[1])).or_default().push(n);
+    }
+    let cell_parts = node_parts(cell);
+    let parts = node_parts(m);
+    let find = |x: f64, y: f64, z: f64, part: &str| -> Option<usize> {
+        index
+            .get(&key(x, y))?
+            .iter()
+            .copied()
+            .find(|&n| cell_parts[n] == part && (cell.coords[n][2] - z).abs() < 1e-6 * p)
+    };
+    // The cell's mean stretch over its interior period along x and y.
+    let mut strain = [0.0f64; 2];
+    for d in 0..2 {
+        let (s, _) = maps[d];
+        let (mut sum, mut count) = (0.0, 0usize);
+        for (n, c) in cell.coords.iter().enumerate() {
+            if c[d] < s - 2.0 * p - tol || c[d] >= s - tol {
+                continue;
+            }
+            let mut c2 = *c;
+            c2[d] += 2.0 * p;
+            if let Some(k) = find(c2[0], c2[1], c2[2], cell_parts[n]) {
+                sum +=
+                    (cell.initial_displacement[k][d] - cell.initial_displacement[n][d]) / (2.0 * p);
+                count += 1;
+            }
+        }
+        if count == 0 {
+            return Err(bad(
+                "the start patch has no node pairs one period (2 spacings) apart in its interior"
+                    .into(),
+            )
+            .hint("start from a formed patch of at least 4 yarns per side"));
+        }
+        strain[d] = sum / count as f64;
+    }
+    let mut u = vec![[0.0; 3]; m.num_nodes()];
+    for (n, c) in m.coords.iter().enumerate() {
+        let (xc, yc) = (map(c[0], maps[0]), map(c[1], maps[1]));
+        let k = find(xc, yc, c[2], parts[n]).ok_or_else(|| {
+            bad(format!(
+                "node `{}` ({}, at x = {:e}, y = {:e}, z = {:e} m) has no counterpart at x = {xc:e}, y = {yc:e} m in the start patch",
+                m.node_id[n], parts[n], c[0], c[1], c[2]
+            ))
+            .hint("the start patch must be the same weave (spacing, section, crimp, mesh, layers) with fewer yarns")
+        })?;
+        let uc = cell.initial_displacement[k];
+        u[n] = [
+            uc[0] + strain[0] * (c[0] - xc),
+            uc[1] + strain[1] * (c[1] - yc),
+            uc[2],
+        ];
+    }
+    Ok(u)
+}
+
+/// [`form`] from a start other than the generated geometry (a tiled smaller patch).
+pub fn form_from(
+    m: &Model,
+    p: &Params,
+    start: Option<&Start>,
     progress: &mut dyn FnMut(&RelaxStats),
 ) -> Result<(Model, Report)> {
     let t0 = Instant::now();
@@ -406,8 +588,23 @@ pub fn form(
     } else {
         quads.thickness.iter().cloned().fold(0.0, f64::max)
     };
+    let credited = start.map_or(0.0, |s| s.work);
+    if let Some(s) = start {
+        if s.u.len() != m.num_nodes() {
+            return Err(WeftError::input(format!(
+                "the start has {} displacements for {} nodes",
+                s.u.len(),
+                m.num_nodes()
+            )));
+        }
+        mm.initial_displacement = s.u.clone();
+    }
     let mut solver = Solver::new(&mm)?;
-    solver.op.surfaces.set_normal_damping(p.contact_damping);
+    // In the rest test, the pulled ends are held as the formed model holds them.
+    let hold: Vec<(usize, u8)> = (0..m.num_nodes())
+        .filter(|&n| end_fam[n] != usize::MAX)
+        .map(|n| (n, 1u8 << end_fam[n]))
+        .collect();
     let st = solver.relax(
         &RelaxOptions {
             max_steps: p.max_steps,
@@ -421,22 +618,26 @@ pub fn form(
                 as u64)
                 .max(1),
             creep_tolerance: p.creep_tolerance * t_max,
+            work_offset: credited,
+            contact_damping: p.contact_damping,
+            hold_in_rest_test: hold,
         },
         progress,
     )?;
     let dt = st.dt;
-    let work = st.removed + st.kinetic;
+    let work = st.removed + st.kinetic + credited;
     let ratio = if work > 0.0 { st.kinetic / work } else { 0.0 };
     let creep_msg = if st.creep.is_finite() {
         format!(
-            "; nodes still moved up to {:.3e} m over the last {:.1e} s (asked ≤ {:.3e} m)",
+            "; left alone at rest, node `{}` moved {:.3e} m within {:.1e} s (asked ≤ {:.3e} m)",
+            m.node_id.get(st.creep_node).copied().unwrap_or(-1),
             st.creep,
             p.creep_time,
             p.creep_tolerance * t_max
         )
     } else {
         format!(
-            "; not one creep window of {:.1e} s was completed",
+            "; the kinetic energy and residual force tests never passed together, so the rest test (a free run of {:.1e} s) never ran",
             p.creep_time
         )
     };
@@ -537,6 +738,7 @@ pub fn form(
         time_step: dt,
         kinetic_over_work: ratio,
         forming_work: work,
+        start_work: credited,
         max_residual_force: st.residual,
         max_contact_force: st.contact_force,
         creep: st.creep,
@@ -566,14 +768,34 @@ pub struct Config {
     pub model: PathBuf,
     pub out: PathBuf,
     pub params: Params,
+    /// A formed smaller patch of the same weave to start from ([`tile_start`]).
+    pub start_from: Option<PathBuf>,
 }
 
 pub fn run(c: &Config, progress: &mut dyn FnMut(&RelaxStats)) -> Result<Report> {
     let m = read_model(&c.model)?;
-    let (formed, r) = form(&m, &c.params, progress)
+    let start = match &c.start_from {
+        None => None,
+        Some(dir) => {
+            let cell = read_model(dir)?;
+            let name = dir.display().to_string();
+            let u = tile_start(&m, &cell, &name)
+                .map_err(|e| e.context(format!("cannot start from `{name}`")))?;
+            let rp = dir.join("form.parquet");
+            let w = Table::read(&rp)?.f64("forming_work", "forming_work (from weft-form)")?;
+            let quads = |mm: &Model| mm.elements.get(&ElementKind::Quad).map_or(0, |b| b.len());
+            let work =
+                w.first().copied().unwrap_or(0.0) * quads(&m) as f64 / quads(&cell).max(1) as f64;
+            Some(Start { u, work })
+        }
+    };
+    let (formed, r) = form_from(&m, &c.params, start.as_ref(), progress)
         .map_err(|e| e.context(format!("cannot form `{}`", c.model.display())))?;
-    let prov = Provenance::new("form", serde_json::to_value(c).expect("serialise"))
+    let mut prov = Provenance::new("form", serde_json::to_value(c).expect("serialise"))
         .with_input(&c.model.join("nodes.parquet"))?;
+    if let Some(dir) = &c.start_from {
+        prov = prov.with_input(&dir.join("nodes.parquet"))?;
+    }
     write_model(&formed, &c.out, &prov)?;
     write_report(&c.out.join("form.parquet"), &r, &prov)?;
     Ok(r)
@@ -587,6 +809,7 @@ fn write_report(path: &Path, r: &Report, prov: &Provenance) -> Result<()> {
             Col::F64("time_step", vec![r.time_step]),
             Col::F64("kinetic_over_work", vec![r.kinetic_over_work]),
             Col::F64("forming_work", vec![r.forming_work]),
+            Col::F64("start_work", vec![r.start_work]),
             Col::F64("max_residual_force", vec![r.max_residual_force]),
             Col::F64("max_contact_force", vec![r.max_contact_force]),
             Col::F64("creep", vec![r.creep]),
