@@ -212,8 +212,15 @@ pub fn closest_on_triangle(p: &[f64; 3], a: &[f64; 3], b: &[f64; 3], c: &[f64; 3
 // Projectile contact during a run: the projectiles, the face sample points and face
 // triangles they meet, and the force and energy passes.
 
+use rayon::prelude::*;
+
 use crate::model::Model;
 use crate::solver::vec3::{add, dot};
+
+/// Skin of the projectile's list of nearby face triangles, as a fraction of its radius:
+/// the list holds every triangle that could come within the radius before the nose
+/// centre and the nodes together have moved this far (a Verlet list).
+const SKIN: f64 = 0.2;
 
 /// A face triangle with its tributary mass (a quad gives four, along both diagonals).
 #[derive(Debug, Clone, Copy)]
@@ -293,6 +300,11 @@ pub struct ProjectileContact {
     pub prescribed_work: f64,
     /// Directions normal to the symmetry planes: projectiles cannot move along them.
     fixed: [bool; 3],
+    /// Per projectile, the face triangles (indices into `face_tris`) that may touch its
+    /// spherical nose, with the node positions and nose centres they were listed at.
+    near: Vec<Vec<u32>>,
+    near_x: Vec<[f64; 3]>,
+    near_c: Vec<[f64; 3]>,
 }
 
 impl ProjectileContact {
@@ -363,6 +375,9 @@ impl ProjectileContact {
             friction_work: 0.0,
             prescribed_work: 0.0,
             fixed: std::array::from_fn(|d| m.symmetry.iter().any(|sp| sp.normal == d)),
+            near: vec![],
+            near_x: vec![],
+            near_c: vec![],
         }
     }
 
@@ -392,17 +407,25 @@ impl ProjectileContact {
         fcon: &mut [[f64; 3]],
         touched: &mut Vec<usize>,
     ) {
+        self.update_near(x);
         let kc = &self.k_node;
         let dt2 = dt * dt;
-        for p in self.projectiles.iter_mut() {
+        for (k, p) in self.projectiles.iter_mut().enumerate() {
             let mut ftot = [0.0; 3];
-            for i in 0..x.len() {
-                if mass[i] <= 0.0 {
-                    continue;
-                }
-                let Some((g, n)) = p.penetration(&x[i]) else {
-                    continue;
-                };
+            // The nodes inside, found in parallel and applied in node order (the same
+            // sums whatever the threads).
+            let pp = &*p;
+            let inside: Vec<(usize, f64, [f64; 3])> = (0..x.len())
+                .into_par_iter()
+                .with_min_len(4096)
+                .filter_map(|i| {
+                    if mass[i] <= 0.0 {
+                        return None;
+                    }
+                    pp.penetration(&x[i]).map(|(g, n)| (i, g, n))
+                })
+                .collect();
+            for (i, g, n) in inside {
                 let fnorm = p.stiffness.unwrap_or(kc[i]) * g;
                 let mut f = [n[0] * fnorm, n[1] * fnorm, n[2] * fnorm];
                 if p.friction > 0.0 {
@@ -418,7 +441,9 @@ impl ProjectileContact {
             if p.segments && p.nose_centre().is_some() {
                 // Exact: the sphere against the closest point of every face triangle.
                 let c = p.nose_centre().expect("spherical nose");
-                for t in &self.face_tris {
+                // Only the listed triangles: the others are farther than the radius.
+                for &ti in &self.near[k] {
+                    let t = &self.face_tris[ti as usize];
                     let Some((w, n, g, kp)) = sphere_face(p, &c, t, x, dt2) else {
                         continue;
                     };
@@ -473,6 +498,83 @@ impl ProjectileContact {
             }
             p.force = ftot;
         }
+    }
+
+    /// Keep each spherical nose's list of nearby face triangles valid: a triangle left
+    /// out was at least R + skin from the nose centre when listed, and the distance from
+    /// a point to a triangle changes by at most the point's move plus the largest move of
+    /// the triangle's nodes; so the list stands while the nose centre's move plus the
+    /// largest node move stay within the skin, and is rebuilt when they do not.
+    fn update_near(&mut self, x: &[[f64; 3]]) {
+        let spheres: Vec<Option<([f64; 3], f64)>> = self
+            .projectiles
+            .iter()
+            .map(|p| {
+                p.nose_centre()
+                    .filter(|_| p.segments)
+                    .map(|c| (c, SKIN * p.radius))
+            })
+            .collect();
+        if spheres.iter().all(|s| s.is_none()) {
+            return;
+        }
+        let fresh = self.near_x.len() == x.len() && self.near.len() == spheres.len() && {
+            let moved = x
+                .par_iter()
+                .zip(self.near_x.par_iter())
+                .map(|(a, b)| {
+                    let d = [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+                    dot(&d, &d)
+                })
+                .reduce(|| 0.0, f64::max)
+                .sqrt();
+            spheres.iter().zip(&self.near_c).all(|(s, cb)| match s {
+                Some((c, skin)) => {
+                    let d = [c[0] - cb[0], c[1] - cb[1], c[2] - cb[2]];
+                    moved + dot(&d, &d).sqrt() <= *skin
+                }
+                None => true,
+            })
+        };
+        if fresh {
+            return;
+        }
+        self.near_x = x.to_vec();
+        self.near_c = spheres
+            .iter()
+            .map(|s| s.map_or([0.0; 3], |s| s.0))
+            .collect();
+        let tris = &self.face_tris;
+        self.near = spheres
+            .iter()
+            .zip(&self.projectiles)
+            .map(|(s, p)| {
+                let Some((c, skin)) = s else {
+                    return vec![];
+                };
+                let reach = p.radius + skin;
+                tris.par_iter()
+                    .enumerate()
+                    .filter(|(_, t)| {
+                        let xs = t.nodes.map(|n| x[n as usize]);
+                        let d0 = [xs[0][0] - c[0], xs[0][1] - c[1], xs[0][2] - c[2]];
+                        let e = (1..3)
+                            .map(|a| {
+                                let d = [
+                                    xs[a][0] - xs[0][0],
+                                    xs[a][1] - xs[0][1],
+                                    xs[a][2] - xs[0][2],
+                                ];
+                                dot(&d, &d)
+                            })
+                            .fold(0.0, f64::max)
+                            .sqrt();
+                        dot(&d0, &d0).sqrt() < reach + e
+                    })
+                    .map(|(i, _)| i as u32)
+                    .collect()
+            })
+            .collect();
     }
 
     /// Stored penalty energy ½ Σ k g² at the positions `x`.
