@@ -27,6 +27,11 @@ pub struct Config {
     pub mass_damping: Option<f64>,
     pub history_sets: Option<Vec<String>>,
     pub max_energy_error: Option<f64>,
+    /// Step budget of an explicit run (default [`DEFAULT_MAX_STEPS`]): a run that would
+    /// need more is refused before it starts, naming the element that sets the step
+    /// (LS-DYNA stops below a minimum step, DTMIN, for the same reason).
+    #[serde(default)]
+    pub max_steps: Option<u64>,
     /// Linear static solve instead of the explicit dynamic run.
     #[serde(rename = "static")]
     pub static_solve: bool,
@@ -83,6 +88,10 @@ pub fn controlling_name(s: &Solver) -> String {
     }
 }
 
+/// Default step budget of an explicit run: 10⁹ steps, days for any model of more than a
+/// few elements; a Young's modulus of 10³⁰⁸ in a rod asks for ~10¹⁵⁰.
+pub const DEFAULT_MAX_STEPS: u64 = 1_000_000_000;
+
 /// Run the stage. `progress` receives the fraction of simulated time done.
 pub fn run(c: &Config, progress: &mut (dyn FnMut(f64) + Send)) -> Result<Report> {
     let t_setup = Instant::now();
@@ -104,8 +113,23 @@ pub fn run(c: &Config, progress: &mut (dyn FnMut(f64) + Send)) -> Result<Report>
             prov = prov.with_input(&p)?;
         }
     }
-    std::fs::create_dir_all(&c.out).map_err(|e| WeftError::io(&c.out, e))?;
     let mut solver = Solver::new(&m)?;
+    if !c.static_solve {
+        let budget = c.max_steps.unwrap_or(DEFAULT_MAX_STEPS);
+        let steps = (m.analysis.end_time / solver.stable.dt).ceil();
+        if !(steps <= budget as f64) {
+            return Err(WeftError::input(format!(
+                "the run would take {steps:.3e} steps of {:.3e} s to reach the end time {:e} s: more than the budget of {budget} steps",
+                solver.stable.dt, m.analysis.end_time
+            ))
+            .hint(format!(
+                "the step is set by {} (stable step {:.3e} s): check its Young's modulus, density and size (or a link's stiffness and masses), or raise --max-steps",
+                controlling_name(&solver),
+                solver.stable.dt_stable
+            )));
+        }
+    }
+    std::fs::create_dir_all(&c.out).map_err(|e| WeftError::io(&c.out, e))?;
     if c.static_solve {
         return run_static(c, &m, &solver, &prov, t_setup);
     }

@@ -54,6 +54,10 @@ struct Cli {
     /// Stop when the energy balance error exceeds this fraction [model default 0.1].
     #[arg(long)]
     max_energy_error: Option<f64>,
+    /// Step budget: a run that would need more steps is refused before it starts, naming
+    /// the element that sets the step (like LS-DYNA's minimum step DTMIN).
+    #[arg(long, default_value_t = weft::simulate::DEFAULT_MAX_STEPS)]
+    max_steps: u64,
     /// Linear static solve (K u = F with the load amplitudes) instead of the explicit run:
     /// history.parquet gets one sample at t = 0.
     #[arg(long = "static")]
@@ -81,6 +85,7 @@ fn run_cli() -> anyhow::Result<ExitCode> {
         mass_damping: cli.mass_damping,
         history_sets: (!cli.history_sets.is_empty()).then_some(cli.history_sets.clone()),
         max_energy_error: cli.max_energy_error,
+        max_steps: Some(cli.max_steps),
         static_solve: cli.static_solve,
     };
     let progress = Progress::new(
