@@ -325,8 +325,12 @@ impl Solver {
             self.fixed[n] = f0;
         }
         self.op.surfaces.set_normal_damping(o.contact_damping);
-        // Leave the state at rest, with forces and velocities consistent.
+        // Leave the state at rest, with forces and velocities consistent (the contacts'
+        // last evaluation, which reports such as the deepest overlap read, at the state
+        // returned: a passed rest test returns the state it started from).
         self.state.v.iter_mut().for_each(|v| *v = [0.0; 3]);
+        self.op
+            .contact_and_ties(&self.state, &self.mass, self.stable.dt);
         Ok(st)
     }
 }
