@@ -508,20 +508,12 @@ pub fn form_from(
     // nodes by (family, sign, reference across-coordinate rounded to the yarn, part).
     let mut ends: std::collections::BTreeMap<(usize, i64, i64, usize), Vec<usize>> =
         Default::default();
-    let spacing = {
-        let s = m.node_sets.get("axis_x").cloned().unwrap_or_default();
-        if s.len() >= 2 {
-            (m.coords[s[1]][0] - m.coords[s[0]][0]).abs()
-        } else {
-            f64::NAN
-        }
-    };
-    if !(spacing > 0.0) {
+    let Some(spacing) = spacing_of(m) else {
         return Err(WeftError::input(
             "the model has no node set `axis_x` with two crossings: the yarn spacing is unknown",
         )
         .hint("form a model from `weft-weave woven`"));
-    }
+    };
     for n in 0..m.num_nodes() {
         if end_fam[n] == usize::MAX {
             continue;

@@ -25,13 +25,14 @@ fn python_ok() -> bool {
 }
 
 /// Runs `tests/read_tables.py` on a model folder and its results (`open_only`: check
-/// the tables only, skip the rod's write-back check).
+/// the tables only, skip the rod's write-back check); it must pass, and what it prints
+/// is shown.
 fn read_tables(
     model: &std::path::Path,
     out: &std::path::Path,
     scratch: &std::path::Path,
     open_only: bool,
-) -> std::process::Output {
+) {
     let mut c = Command::new("python3");
     c.arg(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/read_tables.py"))
         .arg(env!("CARGO_BIN_EXE_weft-simulate"))
@@ -41,7 +42,21 @@ fn read_tables(
     if open_only {
         c.arg("open-only");
     }
-    c.output().unwrap()
+    let o = c.output().unwrap();
+    let so = String::from_utf8_lossy(&o.stdout);
+    let se = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "read_tables.py failed:\n{so}\n{se}");
+    eprintln!("{so}");
+}
+
+/// Runs a weft binary, which must succeed.
+fn run_ok(exe: &str, args: &[&str]) {
+    let o = Command::new(exe).args(args).output().unwrap();
+    assert!(
+        o.status.success(),
+        "{exe} {args:?}: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
 }
 
 #[test]
@@ -67,11 +82,7 @@ fn tables_open_in_pandas_and_polars() {
         .status()
         .unwrap();
     assert!(st.success());
-    let o = read_tables(&model, &out, &dir.path(), false);
-    let so = String::from_utf8_lossy(&o.stdout);
-    let se = String::from_utf8_lossy(&o.stderr);
-    assert!(o.status.success(), "read_tables.py failed:\n{so}\n{se}");
-    eprintln!("{so}");
+    read_tables(&model, &out, &dir.path(), false);
 }
 
 #[test]
@@ -105,14 +116,7 @@ fn a_model_with_every_feature_opens_in_pandas_and_polars() {
         assert!(model.join(t).exists(), "{t}");
     }
     assert!(out.join("projectile.parquet").exists());
-    let o = read_tables(&model, &out, &dir.path(), true);
-    assert!(
-        o.status.success(),
-        "read_tables.py failed:\n{}\n{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    );
-    eprintln!("{}", String::from_utf8_lossy(&o.stdout));
+    read_tables(&model, &out, &dir.path(), true);
 }
 
 #[test]
@@ -137,14 +141,7 @@ fn a_generated_woven_model_opens_in_pandas_and_polars() {
         .status()
         .unwrap();
     assert!(st.success());
-    let o = read_tables(&model, &out, &dir.path(), true);
-    assert!(
-        o.status.success(),
-        "read_tables.py failed:\n{}\n{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    );
-    eprintln!("{}", String::from_utf8_lossy(&o.stdout));
+    read_tables(&model, &out, &dir.path(), true);
 }
 
 /// A formed woven model (initial displacements ux0, uy0, uz0 in nodes.parquet, and
@@ -157,40 +154,27 @@ fn a_formed_woven_model_opens_in_pandas_and_polars() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let s = |p: &str| d.join(p).to_string_lossy().to_string();
-    let ok = |c: &mut Command| {
-        let o = c.output().unwrap();
-        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    };
-    ok(Command::new(env!("CARGO_BIN_EXE_weft-weave")).args([
-        "woven",
-        "--yarns",
-        "4",
-        "--out",
-        &s("patch"),
-    ]));
-    ok(Command::new(env!("CARGO_BIN_EXE_weft-form")).args([
-        "--quiet",
-        "--model",
-        &s("patch"),
-        "--out",
-        &s("formed"),
-    ]));
-    ok(Command::new(env!("CARGO_BIN_EXE_weft-simulate")).args([
-        "--quiet",
-        "--model",
-        &s("formed"),
-        "--end-time",
-        "2e-6",
-        "--out",
-        &s("out"),
-    ]));
-    let o = read_tables(&d.join("formed"), &d.join("out"), &d, true);
-    assert!(
-        o.status.success(),
-        "read_tables.py failed:\n{}\n{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
+    run_ok(
+        env!("CARGO_BIN_EXE_weft-weave"),
+        &["woven", "--yarns", "4", "--out", &s("patch")],
     );
+    run_ok(
+        env!("CARGO_BIN_EXE_weft-form"),
+        &["--quiet", "--model", &s("patch"), "--out", &s("formed")],
+    );
+    run_ok(
+        env!("CARGO_BIN_EXE_weft-simulate"),
+        &[
+            "--quiet",
+            "--model",
+            &s("formed"),
+            "--end-time",
+            "2e-6",
+            "--out",
+            &s("out"),
+        ],
+    );
+    read_tables(&d.join("formed"), &d.join("out"), &d, true);
     let cols = Command::new("python3")
         .args([
             "-c",
@@ -212,75 +196,79 @@ fn fit_and_error_tables_open_in_pandas_and_polars() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let s = |p: &str| d.join(p).to_string_lossy().to_string();
-    let ok = |c: &mut Command| {
-        let o = c.output().unwrap();
-        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    };
-    ok(Command::new(env!("CARGO_BIN_EXE_weft-weave")).args([
-        "membrane",
-        "--cells",
-        "3",
-        "--load-case",
-        "shear",
-        "--out",
-        &s("ref"),
-    ]));
-    ok(Command::new(env!("CARGO_BIN_EXE_weft-weave")).args([
-        "membrane",
-        "--cells",
-        "3",
-        "--load-case",
-        "shear",
-        "--shear-modulus",
-        "1e9",
-        "--out",
-        &s("cand"),
-    ]));
-    ok(Command::new(env!("CARGO_BIN_EXE_weft-simulate")).args([
-        "--static",
-        "--quiet",
-        "--model",
-        &s("ref"),
-        "--out",
-        &s("refout"),
-    ]));
-    ok(Command::new(env!("CARGO_BIN_EXE_weft-fit")).args([
-        "--reference-model",
-        &s("ref"),
-        "--reference-history",
-        &s("refout/history.parquet"),
-        "--model",
-        &s("cand"),
-        "--static",
-        "--components",
-        "ux,uy",
-        "--quiet",
-        "--param",
-        "membrane.G12:1e8:1e10:log",
-        "--expected",
-        "membrane.G12=7.5e8",
-        "--out",
-        &s("fit"),
-    ]));
-    ok(Command::new(env!("CARGO_BIN_EXE_weft-error")).args([
-        "--reference-model",
-        &s("ref"),
-        "--reference-history",
-        &s("refout/history.parquet"),
-        "--model",
-        &s("ref"),
-        "--history",
-        &s("refout/history.parquet"),
-        "--static",
-        "--out-dir",
-        &s("fit"),
-    ]));
-    let o = read_tables(&d.join("fit/models/cand"), &d.join("fit"), &d, true);
-    assert!(
-        o.status.success(),
-        "read_tables.py failed:\n{}\n{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
+    run_ok(
+        env!("CARGO_BIN_EXE_weft-weave"),
+        &[
+            "membrane",
+            "--cells",
+            "3",
+            "--load-case",
+            "shear",
+            "--out",
+            &s("ref"),
+        ],
     );
-    eprintln!("{}", String::from_utf8_lossy(&o.stdout));
+    run_ok(
+        env!("CARGO_BIN_EXE_weft-weave"),
+        &[
+            "membrane",
+            "--cells",
+            "3",
+            "--load-case",
+            "shear",
+            "--shear-modulus",
+            "1e9",
+            "--out",
+            &s("cand"),
+        ],
+    );
+    run_ok(
+        env!("CARGO_BIN_EXE_weft-simulate"),
+        &[
+            "--static",
+            "--quiet",
+            "--model",
+            &s("ref"),
+            "--out",
+            &s("refout"),
+        ],
+    );
+    run_ok(
+        env!("CARGO_BIN_EXE_weft-fit"),
+        &[
+            "--reference-model",
+            &s("ref"),
+            "--reference-history",
+            &s("refout/history.parquet"),
+            "--model",
+            &s("cand"),
+            "--static",
+            "--components",
+            "ux,uy",
+            "--quiet",
+            "--param",
+            "membrane.G12:1e8:1e10:log",
+            "--expected",
+            "membrane.G12=7.5e8",
+            "--out",
+            &s("fit"),
+        ],
+    );
+    run_ok(
+        env!("CARGO_BIN_EXE_weft-error"),
+        &[
+            "--reference-model",
+            &s("ref"),
+            "--reference-history",
+            &s("refout/history.parquet"),
+            "--model",
+            &s("ref"),
+            "--history",
+            &s("refout/history.parquet"),
+            "--static",
+            "--out-dir",
+            &s("fit"),
+        ],
+    );
+    read_tables(&d.join("fit/models/cand"), &d.join("fit"), &d, true);
 }
