@@ -50,9 +50,6 @@ use crate::solver::vec3::{add, cross, dot, sub};
 /// Slaves per parallel chunk of the narrow phase.
 const SLAVE_CHUNK: usize = 256;
 
-/// Closest point of the mid-surface of a face (`n` = 2, 3 or 4 nodes) to `p`: the weights
-/// of its nodes. Quads average the two diagonal splits, so the result has no handedness.
-#[inline]
 /// Gradient in the face's plane of its interpolated nodal thickness, at the face centre
 /// (exact for a thickness linear over the face, as across a lenticular band's quads); zero
 /// for a uniform thickness or a segment.
@@ -103,6 +100,9 @@ pub fn thickness_gradient(t: &[f64; 4], xa: &[[f64; 3]; 4], nf: usize) -> [f64; 
 /// Largest |∇t_F| the contact force takes (an envelope slope of 1).
 pub const MAX_THICKNESS_GRADIENT: f64 = 2.0;
 
+/// Closest point of the mid-surface of a face (`n` = 2, 3 or 4 nodes) to `p`: the weights
+/// of its nodes. Quads average the two diagonal splits, so the result has no handedness.
+#[inline]
 pub fn closest_on_face(p: &[f64; 3], x: &[[f64; 3]; 4], n: usize) -> [f64; 4] {
     match n {
         2 => {
@@ -266,8 +266,8 @@ pub struct ContactReport {
     pub friction_work: f64,
     /// Broad-phase skin [m].
     pub skin: f64,
-    /// Wall time of the broad phase (with the staleness check) and of the narrow phase
-    /// with the scatter [s].
+    /// Wall time of the broad phase (with the per-step face boxes and the staleness
+    /// check) and of the narrow phase with the scatter [s].
     pub build_seconds: f64,
     pub narrow_seconds: f64,
 }
@@ -512,18 +512,35 @@ impl Side {
         s / self.faces.len() as f64
     }
 
-    /// Broad phase: candidates of every slave at the positions `x`.
+    /// The faces' bounding boxes at `x`, once per step, in parallel (each candidate of the
+    /// narrow phase then reads one box instead of gathering its face's nodes; measured:
+    /// those gathers were ~40 % of the narrow phase of the woven patch).
+    fn update_boxes(&mut self, x: &[[f64; 3]]) {
+        let (faces, nf) = (&self.faces, self.nf);
+        self.face_box.resize(faces.len(), [0.0; 6]);
+        self.face_box
+            .par_chunks_mut(4096)
+            .enumerate()
+            .for_each(|(c, bs)| {
+                for (j, b) in bs.iter_mut().enumerate() {
+                    let (lo, hi) = bbox(&faces[c * 4096 + j], nf, x);
+                    *b = [lo[0], lo[1], lo[2], hi[0], hi[1], hi[2]];
+                }
+            });
+    }
+
+    /// Broad phase: candidates of every slave at the positions `x`, whose face boxes
+    /// [`Side::update_boxes`] has computed.
     fn build(&mut self, x: &[[f64; 3]], skin: f64) {
         let r = self.reach + skin;
         let nf = self.nf;
         let boxes: Vec<([f64; 3], [f64; 3])> = self
-            .faces
-            .iter()
-            .map(|f| {
-                let (lo, hi) = bbox(f, nf, x);
+            .face_box
+            .par_iter()
+            .map(|b| {
                 (
-                    [lo[0] - r, lo[1] - r, lo[2] - r],
-                    [hi[0] + r, hi[1] + r, hi[2] + r],
+                    [b[0] - r, b[1] - r, b[2] - r],
+                    [b[3] + r, b[4] + r, b[5] + r],
                 )
             })
             .collect();
@@ -577,24 +594,24 @@ impl Side {
     /// Narrow phase and friction for every slave, in parallel chunks, into `out`.
     /// `initial`: report penetrations instead of pushing (setup).
     fn narrow(&mut self, x: &[[f64; 3]], v: &[[f64; 3]], dt: f64, dt_prev: f64, initial: bool) {
-        // The faces' bounding boxes at x, once per step (each candidate then reads one
-        // box instead of gathering its face's nodes; measured: the gathers were ~40 % of
-        // the narrow phase of the woven patch).
-        {
-            let (faces, nf) = (&self.faces, self.nf);
-            self.face_box.resize(faces.len(), [0.0; 6]);
-            self.face_box
-                .par_chunks_mut(4096)
-                .enumerate()
-                .for_each(|(c, bs)| {
-                    for (j, b) in bs.iter_mut().enumerate() {
-                        let (lo, hi) = bbox(&faces[c * 4096 + j], nf, x);
-                        *b = [lo[0], lo[1], lo[2], hi[0], hi[1], hi[2]];
-                    }
-                });
+        // One copy per face kind, so that the loops over a face's nodes are unrolled.
+        match self.nf {
+            2 => self.narrow_n::<2>(x, v, dt, dt_prev, initial),
+            3 => self.narrow_n::<3>(x, v, dt, dt_prev, initial),
+            _ => self.narrow_n::<4>(x, v, dt, dt_prev, initial),
         }
+    }
+
+    fn narrow_n<const NF: usize>(
+        &mut self,
+        x: &[[f64; 3]],
+        v: &[[f64; 3]],
+        dt: f64,
+        dt_prev: f64,
+        initial: bool,
+    ) {
         let face_box = &self.face_box;
-        let (faces, nf, face_t, face_m) = (&self.faces, self.nf, &self.face_t, &self.face_m);
+        let (faces, nf, face_t, face_m) = (&self.faces, NF, &self.face_t, &self.face_m);
         let (slaves, slave_t, slave_m) = (&self.slaves, &self.slave_t, &self.slave_m);
         let (cand_ptr, cand) = (&self.cand_ptr, &self.cand);
         let (fr, kappa, zeta) = (self.friction, self.kappa, self.damping);
@@ -1063,6 +1080,9 @@ impl SurfaceContact {
     /// the broad phase, and the nodes that start inside a surface (recorded, or an error
     /// when their definition says so).
     pub fn start(&mut self, m: &Model, x: &[[f64; 3]]) -> Result<()> {
+        for s in &mut self.sides {
+            s.update_boxes(x);
+        }
         self.rebuild(x);
         let zero = vec![[0.0; 3]; m.num_nodes()];
         for s in &mut self.sides {
@@ -1114,6 +1134,9 @@ impl SurfaceContact {
         fcon: &mut [[f64; 3]],
     ) {
         let t0 = std::time::Instant::now();
+        for s in &mut self.sides {
+            s.update_boxes(x);
+        }
         if self.stale(x) {
             self.rebuild(x);
         }
