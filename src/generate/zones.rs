@@ -336,7 +336,9 @@ pub fn combined(p: &CombinedParams) -> Result<Model> {
             // of everything: half the modulus and half the density at the full section
             // halve every stiffness (axial, both bendings, torsion) and the mass alike.
             let half = m.add_part(2, "half_rods", ElementKind::Beam, rod(0.5));
-            let on_line = |k: usize| k == n || (p.quarter && k == 0) || (!p.quarter && k == 0);
+            // k = 0 is a symmetry plane in a quarter and the hole's other boundary in a
+            // full model: half rods either way.
+            let on_line = |k: usize| k == n || k == 0;
             let mut eid = 1;
             for j in 0..=n {
                 for i in 0..=n {
