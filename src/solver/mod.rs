@@ -85,9 +85,12 @@ pub struct Energies {
     pub external_work: f64,
     /// kinetic + internal + damping + friction + hourglass + contact − initial − external work.
     pub balance_error: f64,
-    /// |balance_error| over the reference energy max(initial, |external work|,
-    /// kinetic + internal).
+    /// |balance_error| over the energy scale so far, [`Energies::scale`].
     pub balance_error_relative: f64,
+    /// Energy scale so far: max(|initial|, |external work|, kinetic + |internal|) over
+    /// the samples up to this one, and never below the round-off floor of the model (the
+    /// kinetic energy of its whole mass moving 10⁻¹² of its size per step) [J].
+    pub scale: f64,
 }
 
 impl Energies {
@@ -103,6 +106,7 @@ impl Energies {
             external_work: l(self.external_work, o.external_work),
             balance_error: l(self.balance_error, o.balance_error),
             balance_error_relative: l(self.balance_error_relative, o.balance_error_relative),
+            scale: l(self.scale, o.scale),
         }
     }
 }
@@ -175,8 +179,12 @@ struct Ledger {
     mass_damping: f64,
     /// Total energy at the first sample.
     e0: Option<f64>,
-    /// Reference energy max(|E₀|, |W_ext|, E_kin + |E_int|) so far.
+    /// Reference energy max(|E₀|, |W_ext|, E_kin + |E_int|) so far, at least `floor`.
     reference: f64,
+    /// Round-off floor of the reference [J] (see [`Energies::scale`]): a model with no
+    /// load and no initial velocity has only round-off energies (~1e-27 J), which must
+    /// not be judged against each other.
+    floor: f64,
     max_rel: f64,
     last_rel: f64,
 }
@@ -198,6 +206,7 @@ impl Ledger {
         // |E_int|: with initial stresses the stored energy ½E·DE + S₀·E can be negative.
         self.reference = self
             .reference
+            .max(self.floor)
             .max(e_init.abs())
             .max(w_ext.abs())
             .max(ke + ie.abs());
@@ -220,6 +229,7 @@ impl Ledger {
             external_work: w_ext,
             balance_error: err,
             balance_error_relative: rel,
+            scale: self.reference,
         }
     }
     /// The run's balance: the worst after ENERGY_CHECK_AFTER steps, else the last.
@@ -230,6 +240,27 @@ impl Ledger {
             self.last_rel
         }
     }
+}
+
+/// Round-off floor of the energy scale [J]: ½ M (10⁻¹² L/Δt)², the kinetic energy of
+/// the model's mass M moving 10⁻¹² of its size L (bounding-box diagonal) per step. Round-off
+/// motion (positions to ~2·10⁻¹⁶ L) is ~10⁸ times below it; a loaded model's energies are
+/// many orders above it.
+fn energy_floor(x: &[[f64; 3]], mass: &[f64], dt: f64) -> f64 {
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for p in x {
+        for d in 0..3 {
+            lo[d] = lo[d].min(p[d]);
+            hi[d] = hi[d].max(p[d]);
+        }
+    }
+    let l2: f64 = (0..3).map(|d| (hi[d] - lo[d]).powi(2)).sum();
+    let m: f64 = mass.iter().filter(|m| m.is_finite()).sum();
+    if !(dt > 0.0) || !l2.is_finite() {
+        return 0.0;
+    }
+    0.5 * m * 1e-24 * l2 / (dt * dt)
 }
 
 /// One snapshot of the output nodes at a step.
@@ -481,6 +512,7 @@ impl Solver {
         };
         let kappa = contact::surface::guard_kappa(m);
         s.set_time_step(kappa)?;
+        s.ledger.floor = energy_floor(&s.x0, &s.mass, s.stable.dt);
         s.op.projectiles.set_step(&s.mass, s.stable.dt);
         if !m.contacts.is_empty() {
             s.op.surfaces = contact::SurfaceContact::new(m, &s.mass);

@@ -136,6 +136,20 @@ impl ParquetSink {
         self.flush()?;
         let e = &self.energy;
         let col = |f: fn(&Energies) -> f64| e.iter().map(f).collect::<Vec<_>>();
+        // The written relative error is taken against the whole run's energy scale (its
+        // last, largest value), so that the first samples, where the scale so far is
+        // small, do not read as large errors.
+        let scale = e.iter().map(|x| x.scale).fold(0.0, f64::max);
+        let relative: Vec<f64> = e
+            .iter()
+            .map(|x| {
+                if scale > 0.0 {
+                    x.balance_error.abs() / scale
+                } else {
+                    0.0
+                }
+            })
+            .collect();
         let eb = batch(vec![
             Col::F64("t", self.energy_t.clone()),
             Col::F64("kinetic", col(|x| x.kinetic)),
@@ -146,7 +160,8 @@ impl ParquetSink {
             Col::F64("contact", col(|x| x.contact)),
             Col::F64("external_work", col(|x| x.external_work)),
             Col::F64("balance_error", col(|x| x.balance_error)),
-            Col::F64("balance_error_relative", col(|x| x.balance_error_relative)),
+            Col::F64("balance_error_relative", relative),
+            Col::F64("energy_scale", col(|x| x.scale)),
         ]);
         let mut ew = AtomicTableWriter::create(&out.join("energy.parquet"), eb.schema(), prov)?;
         ew.write(&eb)?;
