@@ -25,6 +25,8 @@ use crate::table::{Col, Table};
 pub enum Rule {
     /// Must be given, finite and > 0.
     Required,
+    /// Must be given, finite and ≥ 0 (a truss's density: 0 makes it a massless spring).
+    RequiredNonNegative,
     /// May be null; when given, finite and > 0.
     Positive,
     /// May be null; when given, finite and ≥ 0.
@@ -179,7 +181,10 @@ part_properties! {
     },
     density: f64 {
         unit: "kg/m³",
-        kinds: [Truss: Rule::Required, Tri: Rule::Required, Quad: Rule::Required, Beam: Rule::Required],
+        // A truss may be a massless spring (SPRINGA in other codes) between nodes that
+        // have mass from elsewhere (point masses): ρ = 0 is allowed, and the solver
+        // refuses a free node that then has no mass at all.
+        kinds: [Truss: Rule::RequiredNonNegative, Tri: Rule::Required, Quad: Rule::Required, Beam: Rule::Required],
         null: None,
         aliases: ["rho"],
         meaning: "mass density ρ",
@@ -414,18 +419,28 @@ impl Property {
             None => s,
         };
         match (rule, v) {
-            (Rule::Required, None) => Err(WeftError::input(format!(
+            (Rule::Required | Rule::RequiredNonNegative, None) => Err(WeftError::input(format!(
                 "part `{}` ({}) has no {col}",
                 p.name,
                 p.kind.name()
             ))
             .in_column(col)
-            .expected(format!("a value > 0{}", self.in_unit()))
+            .expected(format!(
+                "a value {}{}",
+                if rule == Rule::Required {
+                    "> 0"
+                } else {
+                    "≥ 0"
+                },
+                self.in_unit()
+            ))
             .hint(format!("every {} part needs `{col}`", p.kind.name()))),
             (Rule::Required | Rule::Positive, Some(x)) if !(x > 0.0 && x.is_finite()) => {
                 Err(bad(x).expected(or_null(format!("a value > 0{}", self.in_unit()))))
             }
-            (Rule::NonNegative, Some(x)) if x < 0.0 || !x.is_finite() => {
+            (Rule::NonNegative | Rule::RequiredNonNegative, Some(x))
+                if x < 0.0 || !x.is_finite() =>
+            {
                 Err(bad(x).expected(or_null(format!("a value ≥ 0{}", self.in_unit()))))
             }
             (Rule::Open { lo, hi, expected }, Some(x)) if !(x > lo && x < hi) => {
@@ -444,6 +459,7 @@ impl Property {
             Rule::Required => "required, > 0".into(),
             Rule::Positive => "> 0".into(),
             Rule::NonNegative => "≥ 0".into(),
+            Rule::RequiredNonNegative => "required, ≥ 0".into(),
             Rule::Open { expected, .. } => expected.into(),
             Rule::Finite => "finite".into(),
             Rule::Free => String::new(),
