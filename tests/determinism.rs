@@ -156,3 +156,107 @@ fn one_two_and_three_threads_give_bit_identical_tables() {
     let fric = fric.as_any().downcast_ref::<Float64Array>().unwrap();
     assert!(fric.value(fric.len() - 1) > 0.0, "the slider never slipped");
 }
+
+/// Every element family, ties and contact above their parallel chunk sizes (1024
+/// elements per family chunk, 256 slaves per contact chunk), so that their parallel paths
+/// run, on 1, 2 and 3 threads: bit-identical histories and energies. Models: the
+/// combined girder (beams) and membrane-centre (quads) models tied into a graded membrane,
+/// and the quarter 12 × 12 yarn-level woven patch (band quads, yarn–yarn contact with
+/// friction, the projectile).
+#[test]
+fn every_family_ties_and_contact_are_thread_independent_above_their_chunks() {
+    use weft::generate::woven::{woven, WovenBandParams};
+    use weft::generate::zones::{combined, Centre, CombinedParams, MembraneProps};
+    use weft::solver::{run_in_memory, CHUNK};
+    let combined_model = |centre: Centre| {
+        let (a, b) = (0.02 / 48.0, 0.02 / 480.0);
+        let c = (7800.0f64 / 1.5e11).sqrt();
+        combined(&CombinedParams {
+            centre,
+            centre_length: 0.02,
+            centre_cells: 48,
+            length: 0.06,
+            coarsening: 4,
+            growth: 1.2,
+            quarter: false,
+            youngs_modulus: 1.5e11,
+            density: 7800.0,
+            rod_width: b,
+            membrane: MembraneProps {
+                youngs_modulus: 1.5e11,
+                poisson_ratio: 0.3,
+                shear_modulus: 1.5e11 * (b / a).powi(2) / 2.0,
+                thickness: b * b / a,
+                density: 7800.0 * (2.0 - b / a),
+            },
+            force: 10.0,
+            pulse: 0.005 * c,
+            end_time: 0.02 * c,
+            output_interval: 0.002 * c,
+        })
+        .unwrap()
+    };
+    let (woven_model, _) = woven(&WovenBandParams {
+        yarns: 12,
+        end_time: 3e-6,
+        output_interval: 3e-7,
+        ..WovenBandParams::default()
+    })
+    .unwrap();
+    let models = [
+        ("combined girder", combined_model(Centre::Girder)),
+        ("combined membrane", combined_model(Centre::Membrane)),
+        ("woven 12 × 12", woven_model),
+    ];
+    let count = |m: &weft::model::Model, k: ElementKind| m.elements.get(&k).map_or(0, |b| b.len());
+    let beams = count(&models[0].1, ElementKind::Beam);
+    let quads = count(&models[1].1, ElementKind::Quad);
+    let ties = models[0].1.ties.len();
+    let slaves = models[2].1.num_nodes();
+    eprintln!("beams {beams}, quads {quads}, ties {ties}, contact slaves {slaves}");
+    assert!(
+        beams > 2 * CHUNK && quads > 2 * CHUNK && slaves > 4 * 256,
+        "models too small"
+    );
+    assert!(ties > 0 && !models[2].1.contacts.is_empty());
+    for (name, m) in &models {
+        let run = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            pool.install(|| {
+                let (_s, out, _) = run_in_memory(m).unwrap();
+                (out.u, out.v, out.energy, out.projectile)
+            })
+        };
+        let one = run(1);
+        let moved = one
+            .0
+            .iter()
+            .flatten()
+            .filter(|u| u[2] != 0.0 || u[0] != 0.0)
+            .count();
+        assert!(moved > 10, "{name}: nothing moved");
+        for threads in [2, 3] {
+            let r = run(threads);
+            // Bit for bit (f64 == is exact; no NaN can occur in a finished run).
+            assert!(
+                r.0 == one.0,
+                "{name}: displacements differ with {threads} threads"
+            );
+            assert!(
+                r.1 == one.1,
+                "{name}: velocities differ with {threads} threads"
+            );
+            assert!(
+                r.2 == one.2,
+                "{name}: energies differ with {threads} threads"
+            );
+            assert!(
+                r.3 == one.3,
+                "{name}: projectile differs with {threads} threads"
+            );
+        }
+    }
+}
