@@ -68,7 +68,9 @@ fn cantilever_tip_deflection_is_pl3_over_3ei() {
             "cantilever ({}): {tip:.6e} m vs PL³/3EI = {exact:.6e} m",
             ["x", "y", "z"][dir]
         );
-        assert!(rel(tip, exact) < 0.01, "{tip} vs {exact}");
+        // Cubic Hermite beams reproduce the cubic deflection exactly: measured < 1e-7
+        // (the printout agrees to 7 digits); round-off of the static solve aside.
+        assert!(rel(tip, exact) < 1e-6, "{tip} vs {exact}");
     }
 }
 
@@ -100,7 +102,8 @@ fn cantilever_first_natural_frequency() {
     let measured = 2.0 * std::f64::consts::PI * k as f64 / (ups[k] - ups[0]);
     eprintln!("cantilever ω₁: {measured:.2} rad/s vs {w1:.2} rad/s over {k} periods");
     assert!(k >= 4);
-    assert!(rel(measured, w1) < 0.01, "{measured} vs {w1}");
+    // Measured 5.1e-4 (40 elements, the period read from 4 zero crossings).
+    assert!(rel(measured, w1) < 1e-3, "{measured} vs {w1}");
     let e = out.energy.last().unwrap();
     assert!(
         e.balance_error.abs() < 0.01 * (e.kinetic + e.internal),
@@ -182,7 +185,9 @@ fn rigid_jointed_grid_has_the_lattice_shear_stiffness() {
         "grid shear stiffness {gs:.1} N/m vs E h b³/(2a³) = {expect:.1} N/m ({:.2e})",
         rel(gs, expect)
     );
-    assert!(rel(gs, expect) < 0.05, "{gs} vs {expect}");
+    // Measured 1.82e-2: the closed form is the infinite lattice's, the grid is finite
+    // (its boundary rows shear differently).
+    assert!(rel(gs, expect) < 0.03, "{gs} vs {expect}");
 }
 
 #[test]

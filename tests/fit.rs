@@ -218,10 +218,13 @@ fn section4_errors(cells: usize, static_mode: bool) -> (Vec<f64>, f64, usize) {
 fn section4_fitted_membrane_matches_the_lattice_closed_forms() {
     for static_mode in [true, false] {
         let (errs, t, _) = section4_errors(10, static_mode);
-        for (e, name) in errs.iter().zip(["G", "s", "ρ"]) {
+        // Per parameter, a small factor above what was measured (static, dynamic): G
+        // 2.6 %, 3.2 % (a discretisation effect of the N = 10 girder: 1.3 % at N = 20, see
+        // the convergence test); s 0.017 %, 0.039 %; ρ 0.15 %.
+        for ((e, name), tol) in errs.iter().zip(["G", "s", "ρ"]).zip([0.045, 1e-3, 5e-3]) {
             assert!(
-                e.abs() < 0.05,
-                "N = 10, static {static_mode}: {name} off by {e:.4}"
+                e.abs() < tol,
+                "N = 10, static {static_mode}: {name} off by {e:.4} (tolerance {tol})"
             );
         }
         assert!(
