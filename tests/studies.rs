@@ -54,7 +54,10 @@ fn girder_membrane_study_recovers_the_lattice_closed_forms() {
             // As tests/fit.rs (the same fit at N = 10): G measured 2.6–3.2 %, s and ρ
             // ≤ 0.15 %.
             let tol = if n.contains("G12") { 0.045 } else { 5e-3 };
-            assert!(d.abs() < tol, "{mode}: {n} differs by {d} (tolerance {tol})");
+            assert!(
+                d.abs() < tol,
+                "{mode}: {n} differs by {d} (tolerance {tol})"
+            );
         }
         assert!(t0 > 0.5 && t < 1e-3, "{mode}: T {t0} -> {t}");
     }

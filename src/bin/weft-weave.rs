@@ -110,9 +110,31 @@ struct WovenBandArgs {
     #[arg(long, default_value_t = 0.01e-3)]
     layer_gap: f64,
     /// Yarn ends at the patch edge: clamped (all nodes held), pinned (centre-line node
-    /// held) or free.
+    /// held) or free. Ignored with --membrane-length (the ends are tied).
     #[arg(long, value_enum, default_value_t = weft::generate::woven::Edge::Clamped)]
     edge: weft::generate::woven::Edge,
+    /// The paper's §3 combined model: tie the quarter patch's yarn ends to a graded
+    /// orthotropic membrane around it, out to this half-size [m] (e.g. 0.06, the
+    /// 60 × 60-yarn reference's), clamped at its outer edge. Adds the node sets
+    /// `interface` (the tied yarn ends) and `axis_x_all` (the x axis through both).
+    #[arg(long)]
+    membrane_length: Option<f64>,
+    /// Growth ratio of the membrane's cells (p/2 at the patch) outwards.
+    #[arg(long, default_value_t = 1.2)]
+    membrane_growth: f64,
+    /// Membrane areal density / the patch's (the paper's §3: 0.8).
+    #[arg(long, default_value_t = 0.8)]
+    membrane_density_ratio: f64,
+    /// Membrane E₁ = E₂ / the yarns' E (the paper's §3: 0.3).
+    #[arg(long, default_value_t = 0.3)]
+    membrane_modulus_ratio: f64,
+    /// Membrane G₁₂ / its E (the paper's §3: 0.0042).
+    #[arg(long, default_value_t = 0.0042)]
+    membrane_shear_ratio: f64,
+    /// Membrane thickness [m] (an assumption; default 2A/p per layer, the yarns' section
+    /// per unit width of both families).
+    #[arg(long)]
+    membrane_thickness: Option<f64>,
     /// Projectile nose shape.
     #[arg(long, value_enum, default_value_t = weft::model::ProjectileShape::Round)]
     projectile_shape: weft::model::ProjectileShape,
@@ -551,6 +573,16 @@ fn run() -> anyhow::Result<ExitCode> {
                 projectile_friction: a.projectile_friction,
                 end_time: a.end_time,
                 output_interval: a.output_interval,
+                surround: a
+                    .membrane_length
+                    .map(|length| weft::generate::woven::Surround {
+                        length,
+                        growth: a.membrane_growth,
+                        density_ratio: a.membrane_density_ratio,
+                        modulus_ratio: a.membrane_modulus_ratio,
+                        shear_ratio: a.membrane_shear_ratio,
+                        thickness: a.membrane_thickness,
+                    }),
             };
             let m = weave::run(&Spec::Woven(p), &a.out, &mut warn)?;
             eprintln!(

@@ -90,6 +90,47 @@ pub struct WovenBandParams {
     /// Simulated time [s] (the paper's Fig. 4: 6·10⁻⁵ s) and output interval [s].
     pub end_time: f64,
     pub output_interval: f64,
+    /// The paper's §3 combined model: the patch's yarn ends tied to a graded orthotropic
+    /// membrane around it (None: the patch alone, its ends held by `edge`).
+    pub surround: Option<Surround>,
+}
+
+/// A graded orthotropic membrane around a quarter patch (the paper's §3: a small woven
+/// patch coupled to a membrane whose ρ, E and G carry the waves on). The band ends at
+/// x = c and y = c, c = (N − ½)p, are tied to the membrane's inner edge (each end node to
+/// the membrane edge it lies on, linear weights); the membrane is clamped at its outer
+/// edge; `edge` no longer applies. Membrane cells are p/2 at the patch and grow by
+/// `growth` outwards. Defaults: the paper's fitted §3 ratios.
+#[derive(Debug, Clone, Serialize)]
+pub struct Surround {
+    /// Outer half-size of the model [m] (the reference patch's: 60 mm for 60 yarns).
+    pub length: f64,
+    /// Growth ratio of the membrane cells away from the patch (≥ 1).
+    pub growth: f64,
+    /// Membrane areal density / the patch's (all layers; paper 0.8).
+    pub density_ratio: f64,
+    /// Membrane E₁ = E₂ / the yarns' E (paper 0.3).
+    pub modulus_ratio: f64,
+    /// Membrane G₁₂ / its E (paper 0.0042).
+    pub shear_ratio: f64,
+    /// Membrane thickness [m]. An assumption (the paper states none): None takes 2A/p per
+    /// layer, the yarns' cross-section per unit width of both families, so that the
+    /// membrane's stress is the yarns' at the same strain when E_m = E/2.
+    pub thickness: Option<f64>,
+}
+
+impl Surround {
+    /// The paper's §3 ratios around a patch, out to `length`.
+    pub fn paper(length: f64) -> Surround {
+        Surround {
+            length,
+            growth: 1.2,
+            density_ratio: 0.8,
+            modulus_ratio: 0.3,
+            shear_ratio: 0.0042,
+            thickness: None,
+        }
+    }
 }
 
 impl Default for WovenBandParams {
@@ -123,6 +164,7 @@ impl Default for WovenBandParams {
             projectile_friction: 0.1,
             end_time: 6e-5,
             output_interval: 1e-6,
+            surround: None,
         }
     }
 }
@@ -512,16 +554,87 @@ pub fn woven(p: &WovenBandParams) -> Result<(Model, WovenInfo)> {
         ],
         ..Analysis::default()
     };
-    m.validate()?;
     let area = lens.area();
-    Ok((
-        m,
-        WovenInfo {
-            thickness_scale: scale,
-            crimp_amplitude: amp,
-            crimp,
-            area,
-            areal_density: 2.0 * p.density * area * (1.0 + crimp) / p.spacing,
-        },
-    ))
+    let info = WovenInfo {
+        thickness_scale: scale,
+        crimp_amplitude: amp,
+        crimp,
+        area,
+        areal_density: 2.0 * p.density * area * (1.0 + crimp) / p.spacing,
+    };
+    if let Some(s) = &p.surround {
+        surround(&mut m, p, s, &info)?;
+    }
+    m.validate()?;
+    Ok((m, info))
+}
+
+/// Ties the quarter patch's yarn ends into a graded membrane (see [`Surround`]).
+fn surround(m: &mut Model, p: &WovenBandParams, s: &Surround, info: &WovenInfo) -> Result<()> {
+    use crate::generate::zones::{coarse_membrane, graded_lines, tie_to_hole, MembraneProps};
+    if !p.quarter {
+        return Err(WeftError::input("--membrane-length with --full".to_string())
+            .expected("a quarter patch: a full patch's yarn ends lie at the crimp's crests, off the membrane's plane")
+            .hint("leave out --full"));
+    }
+    let c = (p.yarns as f64 - 0.5) * p.spacing;
+    let bad = |name: &str, v: f64, exp: &str| {
+        Err(WeftError::input(format!("--{name} = `{v}`")).expected(exp.to_string()))
+    };
+    if !(s.length > c + 0.5 * p.spacing) || !s.length.is_finite() {
+        return bad(
+            "membrane-length",
+            s.length,
+            &format!("a half-size larger than the patch's {c:.4e} m + p/2"),
+        );
+    }
+    if !(s.growth >= 1.0 && s.growth <= 3.0) {
+        return bad("membrane-growth", s.growth, "a growth ratio in [1, 3]");
+    }
+    for (name, v) in [
+        ("membrane-density-ratio", s.density_ratio),
+        ("membrane-modulus-ratio", s.modulus_ratio),
+        ("membrane-shear-ratio", s.shear_ratio),
+    ] {
+        if !(v > 0.0 && v.is_finite()) {
+            return bad(name, v, "a ratio > 0");
+        }
+    }
+    let layers = p.layers as f64;
+    let thickness = s.thickness.unwrap_or(2.0 * info.area * layers / p.spacing);
+    if !(thickness > 0.0 && thickness.is_finite()) {
+        return bad("membrane-thickness", thickness, "a thickness > 0 in m");
+    }
+    let e_m = s.modulus_ratio * p.modulus;
+    let props = MembraneProps {
+        youngs_modulus: e_m,
+        poisson_ratio: 0.0,
+        shear_modulus: s.shear_ratio * e_m,
+        thickness,
+        density: s.density_ratio * info.areal_density * layers / thickness,
+    };
+    // The yarn ends are tied, not held.
+    let ends = m.node_sets["edge"].clone();
+    let is_end: std::collections::HashSet<usize> = ends.iter().copied().collect();
+    m.constraints.retain(|(n, _)| !is_end.contains(n));
+    let lines = graded_lines(c, 0.5 * p.spacing, s.length, s.growth)?;
+    let first_id = m.node_id.iter().copied().max().unwrap_or(0) + 1;
+    let patch_nodes = m.num_nodes();
+    let coarse = coarse_membrane(m, &lines, true, c, &props, first_id);
+    let tied = tie_to_hole(m, &coarse, &ends)?;
+    for &o in &coarse.outer {
+        m.constraints.push((o, [true, true, true]));
+    }
+    // The x axis line on both sides of the interface: the patch's crossings, then the
+    // membrane's nodes on y = 0 beyond it.
+    let mut axis: Vec<usize> = m.node_sets["axis_x"].clone();
+    let mut beyond: Vec<usize> = (patch_nodes..m.num_nodes())
+        .filter(|&n| m.coords[n][1].abs() < 1e-12 && m.coords[n][0] > c - 1e-12)
+        .collect();
+    beyond.sort_by(|&a, &b| m.coords[a][0].total_cmp(&m.coords[b][0]));
+    axis.extend(beyond);
+    m.node_sets.insert("axis_x_all".into(), axis);
+    m.node_sets.insert("interface".into(), tied);
+    m.analysis.history_sets.push("axis_x_all".into());
+    Ok(())
 }

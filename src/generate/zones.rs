@@ -71,14 +71,14 @@ impl MembraneProps {
 
 /// The coarse graded membrane with a hole; returns, for each side of the hole
 /// (x = c, y = c, and for a full model x = −c, y = −c), its boundary nodes ordered along it.
-struct Coarse {
+pub(crate) struct Coarse {
     /// (fixed coordinate axis, value, nodes ordered by the other coordinate)
-    hole_sides: Vec<(usize, f64, Vec<usize>)>,
+    pub(crate) hole_sides: Vec<(usize, f64, Vec<usize>)>,
     /// Outer boundary nodes.
-    outer: Vec<usize>,
+    pub(crate) outer: Vec<usize>,
 }
 
-fn coarse_membrane(
+pub(crate) fn coarse_membrane(
     m: &mut Model,
     pos: &[f64],
     quarter: bool,
@@ -189,7 +189,7 @@ fn hold_outer_edge(m: &mut Model, coarse: &Coarse, quarter: bool, length: f64) {
 }
 
 /// Tie every listed fine node lying on a hole side to the coarse edge it lies on.
-fn tie_to_hole(m: &mut Model, coarse: &Coarse, fine: &[usize]) -> Result<Vec<usize>> {
+pub(crate) fn tie_to_hole(m: &mut Model, coarse: &Coarse, fine: &[usize]) -> Result<Vec<usize>> {
     let mut tied = vec![];
     for &f in fine {
         let x = m.coords[f];

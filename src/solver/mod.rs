@@ -858,6 +858,27 @@ impl Solver {
                 sampler.cur.t = self.state.t;
                 sampler.cur.e = e;
                 last_e = e;
+                // A non-finite energy is a broken run even when the nodes are finite (a
+                // comparison with NaN is false: it would pass the check below).
+                let terms = [
+                    ("kinetic", ke),
+                    ("internal", el_e.internal),
+                    ("damping", el_e.damping),
+                    ("friction", el_e.friction),
+                    ("hourglass", el_e.hourglass),
+                    ("contact (stored and friction work)", contact),
+                    ("external work", w_ext),
+                ];
+                if let Some((name, v)) = terms.iter().find(|(_, v)| !v.is_finite()) {
+                    return Err(WeftError::Numerical {
+                        what: format!("the {name} energy is {v}"),
+                        step: self.state.step,
+                        time: self.state.t,
+                        hint: Some(
+                            "a penalty or element with zero mass or zero length somewhere; the contact report names the definitions (run with the same model and a shorter end time to look at it)".to_string(),
+                        ),
+                    });
+                }
                 if e.balance_error_relative > a.max_energy_error
                     && self.state.step >= ENERGY_CHECK_AFTER
                 {

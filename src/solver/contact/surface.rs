@@ -201,6 +201,14 @@ pub fn pair_force(
     fr: &Friction,
     st: &mut SlaveState,
 ) -> ([f64; 3], f64, f64) {
+    if !(k > 0.0) {
+        // A pair whose nodes all have no mass of their own (tie slaves, whose mass their
+        // masters carry) has no penalty: no force, and nothing stored or dissipated
+        // (friction's μ f_n (|f_t*| − μ f_n)/k would be 0/0).
+        st.ft = [0.0; 3];
+        st.k = 0.0;
+        return ([0.0; 3], 0.0, 0.0);
+    }
     let fnorm = k * g;
     let mut stored = 0.5 * k * g * g;
     let mut diss = 0.0;
@@ -1306,6 +1314,35 @@ mod tests {
             found > points.len(),
             "the test must exercise overlaps: {found}"
         );
+    }
+
+    /// A pair with no penalty (all its nodes massless: tie slaves) gives no force and
+    /// nothing stored or dissipated, instead of friction's 0/0 (which made a patch tied
+    /// into a membrane report NaN contact energy).
+    #[test]
+    fn a_pair_without_penalty_is_inert() {
+        use super::{pair_force, Friction, SlaveState};
+        let fr = Friction {
+            mu_s: 0.2,
+            mu_d: 0.15,
+            decay: 0.0,
+        };
+        let mut st = SlaveState {
+            ft: [0.1, 0.0, 0.0],
+            k: 1.0,
+            g0: 0.0,
+        };
+        let (f, stored, diss) = pair_force(
+            1e-6,
+            &[0.0, 0.0, 1.0],
+            0.0,
+            &[1.0, 0.0, 0.0],
+            1e-8,
+            &fr,
+            &mut st,
+        );
+        assert_eq!((f, stored, diss), ([0.0; 3], 0.0, 0.0));
+        assert_eq!((st.ft, st.k), ([0.0; 3], 0.0));
     }
 
     #[test]
