@@ -51,6 +51,10 @@ struct Cli {
     /// Node set to write to history.parquet (repeatable) [default: all nodes].
     #[arg(long = "history-set")]
     history_sets: Vec<String>,
+    /// Write every node to history.parquet, whatever node sets the model's
+    /// analysis.parquet names (for whole-mesh figures: weft-plot field, weft-vtk).
+    #[arg(long, conflicts_with = "history_sets")]
+    all_nodes: bool,
     /// Stop when the energy balance error exceeds this fraction [model default 0.1].
     #[arg(long)]
     max_energy_error: Option<f64>,
@@ -83,7 +87,12 @@ fn run_cli() -> anyhow::Result<ExitCode> {
         time_step: cli.time_step,
         target_time_step: cli.target_time_step,
         mass_damping: cli.mass_damping,
-        history_sets: (!cli.history_sets.is_empty()).then_some(cli.history_sets.clone()),
+        // An empty list overrides the model's sets: every node.
+        history_sets: if cli.all_nodes {
+            Some(vec![])
+        } else {
+            (!cli.history_sets.is_empty()).then_some(cli.history_sets.clone())
+        },
         max_energy_error: cli.max_energy_error,
         max_steps: Some(cli.max_steps),
         static_solve: cli.static_solve,
