@@ -4,7 +4,7 @@
 //! Layout: [`model`] (the model and its folder of tables), [`solver`] (explicit central
 //! difference, element kernels, output sinks), [`simulate`] (the stage behind
 //! `weft-simulate`), [`generate`] (canonical models behind `weft-weave`), [`plot`]
-//! (the figures behind `weft-plot`), [`table`]
+//! (the figures behind `weft-plot`), [`vtk`] (ParaView time series behind `weft-vtk`), [`table`]
 //! (validated Parquet I/O with provenance), [`error`] (typed errors), [`cli`] (what the
 //! stage binaries share: `main`, error printing, progress).
 
@@ -20,5 +20,6 @@ pub mod plot;
 pub mod simulate;
 pub mod solver;
 pub mod table;
+pub mod vtk;
 
 pub use error::{Result, WeftError};
