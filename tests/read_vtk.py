@@ -98,6 +98,22 @@ for k in sorted({0, len(mesh) // 2, len(mesh) - 1}):
             check(got_nodes == [int(row[n]) for n in cols], f"cell {c} (element {eid[c]}) nodes {got_nodes}")
             check(pid[c] == row["part_id"], f"cell {c} part")
             check(types[c] == VTK_TYPE[kind], f"cell {c} type")
+# Element results: each column of elements.parquet is cell data with the same values.
+if (run / "elements.parquet").exists():
+    er = pd.read_parquet(run / "elements.parquet")
+    quantities = [c for c in er.columns if c not in ("t", "element_id", "part_id", "kind")]
+    k = len(mesh) - 1
+    g = read(out / mesh[k].get("file"))
+    cd = g.GetCellData()
+    eid = vtk_to_numpy(cd.GetArray("element_id"))
+    rows = er[er["t"] == times[k]].set_index("element_id")
+    for c in quantities:
+        a = vtk_to_numpy(cd.GetArray(c))
+        want = rows[c].reindex(eid).to_numpy(dtype=float)  # no row (point mass): NaN
+        same = (a == want) | (np.isnan(a) & np.isnan(want))
+        check(same.all(), f"cell data {c} vs elements.parquet")
+    print(f"element results: {len(quantities)} columns as cell data, equal to elements.parquet at t = {times[k]:g} s "
+          f"({int(rows['axial_force'].notna().sum())} axial forces, {int(rows['stress_11'].notna().sum())} membrane stresses)")
 print(f"cells: {n_cells} with types {expected_types}, connectivity, element and part ids as in the element tables")
 print("max |difference| against history.parquet: " + ", ".join(f"{k} {v:.1e}" for k, v in worst.items()))
 

@@ -6,8 +6,8 @@
 //! `vtkXMLUnstructuredGridReader` in `tests/read_vtk.py`, and compared with the model
 //! and run tables read by pandas: cell counts and VTK types per element kind, each
 //! cell's nodes, the output times, displacements and velocities (exactly: binary
-//! Float64), points = X + u₀ + u, the membranes' nodal thickness, the projectile's tip
-//! and radius. Where Python's `vtk` is missing the test says so and passes, unless
+//! Float64), points = X + u₀ + u, the membranes' nodal thickness, the element results
+//! of `elements.parquet` as cell data, the projectile's tip and radius. Where Python's `vtk` is missing the test says so and passes, unless
 //! `WEFT_REQUIRE_PYTHON=1` (set by `.ci/run`, which installs it).
 //!
 //! Case: the composite model of `tests/common` (every element kind: quads with a row of
@@ -73,7 +73,7 @@ fn vtk_reads_every_element_kind_the_times_and_the_history_values() {
         return;
     }
     let dir = tempfile::tempdir().unwrap();
-    let (model, out) = composite_run(dir.path(), &["--all-nodes"]);
+    let (model, out) = composite_run(dir.path(), &["--all-nodes", "--element-results", "all"]);
     let vtk = dir.path().join("vtk");
     let msg = run_ok(
         env!("CARGO_BIN_EXE_weft-vtk"),

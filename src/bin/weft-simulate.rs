@@ -55,6 +55,12 @@ struct Cli {
     /// analysis.parquet names (for whole-mesh figures: weft-plot field, weft-vtk).
     #[arg(long, conflicts_with = "history_sets")]
     all_nodes: bool,
+    /// Write element results of this part at the output times to elements.parquet
+    /// (repeatable; `all`: every part): axial strain and force (trusses, beams), relative
+    /// displacement and force (links), Green strain and stress (membranes), energy. The
+    /// history must hold the parts' nodes (--all-nodes).
+    #[arg(long = "element-results", value_name = "PART")]
+    element_results: Vec<String>,
     /// Stop when the energy balance error exceeds this fraction [model default 0.1].
     #[arg(long)]
     max_energy_error: Option<f64>,
@@ -96,6 +102,7 @@ fn run_cli() -> anyhow::Result<ExitCode> {
         max_energy_error: cli.max_energy_error,
         max_steps: Some(cli.max_steps),
         static_solve: cli.static_solve,
+        element_results: cli.element_results.clone(),
     };
     let progress = Progress::new(
         cli.quiet,
