@@ -4,7 +4,7 @@
 //! Layout: [`model`] (the model and its folder of tables), [`solver`] (explicit central
 //! difference, element kernels, output sinks), [`simulate`] (the stage behind
 //! `weft-simulate`), [`generate`] (canonical models behind `weft-weave`), [`plot`]
-//! (the figures behind `weft-plot`), [`vtk`] (ParaView time series behind `weft-vtk`), [`table`]
+//! (the figures behind `weft-plot`), [`vtk`] (ParaView time series behind `weft-vtk`), [`export`] (CalculiX and LS-DYNA decks behind `weft-export`), [`table`]
 //! (validated Parquet I/O with provenance), [`error`] (typed errors), [`cli`] (what the
 //! stage binaries share: `main`, error printing, progress).
 
@@ -12,6 +12,7 @@ pub mod analysis;
 pub mod cli;
 pub mod element_results;
 pub mod error;
+pub mod export;
 pub mod fit;
 pub mod form;
 pub mod generate;
