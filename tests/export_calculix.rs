@@ -12,7 +12,7 @@
 //! 1. `weft-weave rod --elements 50` (a steel rod, 100 N sine pulse at x = L, clamped
 //!    at x = 0): trusses → SPRINGA + MASS.
 //! 2. A pretensioned net: 5 × 5 crossings (spacing a = 2 mm) of warp (along x) and weft
-//!    (along y) yarns, trusses with prestrain 10⁻³, the two yarns' nodes coincident at
+//!    (along y, tension-only) yarns, trusses with prestrain 10⁻³, the two yarns' nodes coincident at
 //!    each crossing and joined by a link (k on each axis), yarn ends clamped, a 1 N
 //!    transverse sine pulse on the middle crossing; it moves only through the
 //!    pretension (NONLINEAR SPRINGA with the offset force) and the links (SPRING2):
@@ -203,7 +203,16 @@ fn net(n: usize) -> Model {
         ..Default::default()
     };
     let warp = m.add_part(1, "warp", ElementKind::Truss, yarn.clone());
-    let weft = m.add_part(2, "weft", ElementKind::Truss, yarn);
+    // The weft yarns tension-only (a three-point NONLINEAR spring; they stay taut).
+    let weft = m.add_part(
+        2,
+        "weft",
+        ElementKind::Truss,
+        PartProps {
+            tension_only: Some(true),
+            ..yarn
+        },
+    );
     let link = m.add_part(
         3,
         "crossings",

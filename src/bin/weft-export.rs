@@ -75,6 +75,8 @@ fn run() -> anyhow::Result<ExitCode> {
         r.output_nodes,
         cli.out.display()
     );
-    eprintln!("  compare with weft: weft-simulate --time-step {:e}", r.dt);
+    if cli.format == export::Format::Calculix {
+        eprintln!("  compare with weft: weft-simulate --time-step {:e}", r.dt);
+    }
     Ok(ExitCode::SUCCESS)
 }

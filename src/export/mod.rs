@@ -101,7 +101,9 @@ pub fn time_step(m: &Model, asked: Option<f64>) -> Result<(f64, u64)> {
     };
     let out = m.analysis.output_interval;
     let n = (out / dt * (1.0 - 1e-12)).ceil().max(1.0);
-    Ok((out / n, n as u64))
+    // The step as the deck writes it (14 digits), so that weft can run on the same one.
+    let dt: f64 = num(out / n).parse().expect("a formatted number parses");
+    Ok((dt, n as u64))
 }
 
 /// A number as CalculiX and LS-DYNA read it: at most 20 characters (ccx reads fields of
