@@ -320,11 +320,9 @@ pub fn deck(m: &Model, dt: f64, nsub: u64, provenance: &str) -> Result<(String, 
     let mut bc = String::new();
     let mut nbc = 0;
     for (i, f) in fixed.iter().enumerate() {
-        for d in 0..3 {
-            if f[d] {
-                let _ = writeln!(bc, "{}, {}, {}", m.node_id[i], d + 1, d + 1);
-                nbc += 1;
-            }
+        for (d, _) in f.iter().enumerate().filter(|p| *p.1) {
+            let _ = writeln!(bc, "{}, {}, {}", m.node_id[i], d + 1, d + 1);
+            nbc += 1;
         }
     }
     if nbc > 0 {
@@ -336,10 +334,8 @@ pub fn deck(m: &Model, dt: f64, nsub: u64, provenance: &str) -> Result<(String, 
     if !m.initial_velocities.is_empty() {
         s.push_str("*INITIAL CONDITIONS, TYPE=VELOCITY\n");
         for (i, v) in &m.initial_velocities {
-            for d in 0..3 {
-                if v[d] != 0.0 {
-                    let _ = writeln!(s, "{}, {}, {}", m.node_id[*i], d + 1, num(v[d]));
-                }
+            for (d, vd) in v.iter().enumerate().filter(|p| *p.1 != 0.0) {
+                let _ = writeln!(s, "{}, {}, {}", m.node_id[*i], d + 1, num(*vd));
             }
         }
     }
