@@ -19,7 +19,8 @@ use weft::export;
                   --format calculix: a ccx 2.20 deck for *DYNAMIC, EXPLICIT. Only what CalculiX's explicit \
                   scheme runs faithfully is written: trusses (as SPRINGA springs with lumped MASS elements; \
                   prestrained or tension-only trusses as nonlinear springs), links between nodes (one SPRING2 \
-                  per axis), point masses, fixed translations, symmetry planes, loads, initial velocities. \
+                  per axis), point masses, fixed translations, symmetry planes, loads, initial velocities, \
+                  mass damping. \
                   Beams, membranes, link dashpots, friction sliders, projectiles, contacts, ties and formed \
                   models are refused with the reason (measured: B31 and M3D4 are expanded into C3D8I bricks, \
                   wrong in explicit; DASHPOTA is ignored in explicit). The deck's step is fixed and divides \

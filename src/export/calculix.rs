@@ -14,14 +14,16 @@
 //! - point masses as `MASS` elements;
 //! - fixed translations and symmetry planes as `*BOUNDARY`, loads as `*CLOAD` with a
 //!   tabulated `*AMPLITUDE` (a sine pulse sampled at every step), initial velocities as
-//!   `*INITIAL CONDITIONS, TYPE=VELOCITY`.
+//!   `*INITIAL CONDITIONS, TYPE=VELOCITY`;
+//! - mass-proportional damping α as Rayleigh damping `*DAMPING, ALPHA=α` (applied to the
+//!   whole model).
 //!
 //! Refused, with the reason: beams (`B31` runs in explicit but is expanded into `C3D8I`
 //! bricks, which give wrong answers there), membranes (`M3D4` likewise; `S4R` shells run
 //! correctly in-plane but add a bending stiffness weft's membranes do not have), link
 //! dashpots (`DASHPOTA` is silently ignored in explicit), friction sliders, projectiles,
 //! contacts, ties, formed models (initial displacement with its stresses), mass
-//! damping (not exported yet), mass scaling.
+//! scaling.
 //!
 //! The step: ccx in explicit with `DIRECT` needs the minimum and maximum increment on the
 //! `*DYNAMIC` line (without them its time does not advance: the springs have no wave
@@ -113,13 +115,6 @@ fn check(m: &Model) -> Result<()> {
             FORMAT,
             "a formed model (initial displacements ux0, uy0, uz0)",
             "CalculiX cannot start from displaced positions with the strains of that state",
-        ));
-    }
-    if m.analysis.mass_damping != 0.0 {
-        return Err(refuse(
-            FORMAT,
-            "mass-proportional damping",
-            "not exported yet",
         ));
     }
     if m.analysis.target_time_step.is_some() {
@@ -316,6 +311,15 @@ pub fn deck(m: &Model, dt: f64, nsub: u64, provenance: &str) -> Result<(String, 
                 fixed[i][sp.normal] = true;
             }
         }
+    }
+    // Mass-proportional damping f = −α m v: Rayleigh damping C = αM (ccx applies it to
+    // the whole model; it warns that the material has no elastic constants).
+    if m.analysis.mass_damping != 0.0 {
+        let _ = writeln!(
+            s,
+            "*MATERIAL, NAME=DAMPING\n*DAMPING, ALPHA={}, BETA=0.",
+            num(m.analysis.mass_damping)
+        );
     }
     let mut bc = String::new();
     let mut nbc = 0;
