@@ -19,8 +19,8 @@ use weft::vtk;
                   points at the current positions (--reference-points: the initial ones, for Warp By Vector). \
                   Point data: displacement, velocity, node_id, and the membranes' nodal thickness. Cell data: \
                   element_id, part_id, kind (0 truss, 1 link, 2 point mass, 3 tri, 4 quad, 5 beam) and, when the \
-                  run wrote elements.parquet (weft-simulate --element-results), those results. A projectiles' \
-                  surface goes in weft_projectile_*.vtu (part 1 of the collection) when projectile.parquet is \
+                  run wrote elements.parquet (weft-simulate --element-results), those results. The projectiles' \
+                  surfaces go in weft_projectile_*.vtu (part 1 of the collection) when projectile.parquet is \
                   beside the history.\n\n\
                   The history must hold every node of the mesh: run weft-simulate with --all-nodes.\n\n\
                   Example:\n  weft-simulate --model runs/rod --out runs/rod-out --all-nodes\n  \
