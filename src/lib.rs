@@ -4,13 +4,15 @@
 //! Layout: [`model`] (the model and its folder of tables), [`solver`] (explicit central
 //! difference, element kernels, output sinks), [`simulate`] (the stage behind
 //! `weft-simulate`), [`generate`] (canonical models behind `weft-weave`), [`plot`]
-//! (the figures behind `weft-plot`), [`table`]
+//! (the figures behind `weft-plot`), [`vtk`] (ParaView time series behind `weft-vtk`), [`export`] (CalculiX and LS-DYNA decks behind `weft-export`), [`table`]
 //! (validated Parquet I/O with provenance), [`error`] (typed errors), [`cli`] (what the
 //! stage binaries share: `main`, error printing, progress).
 
 pub mod analysis;
 pub mod cli;
+pub mod element_results;
 pub mod error;
+pub mod export;
 pub mod fit;
 pub mod form;
 pub mod generate;
@@ -20,5 +22,6 @@ pub mod plot;
 pub mod simulate;
 pub mod solver;
 pub mod table;
+pub mod vtk;
 
 pub use error::{Result, WeftError};

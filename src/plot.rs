@@ -1,10 +1,13 @@
 //! The figures behind `weft-plot`: charts built from the tables the stages write
 //! (displacement time laws, wave speeds, per-node errors, a fit's convergence), drawn with
 //! plotters as PNG or SVG (by the output's extension) with a bundled font (DejaVu Sans),
-//! and written atomically (beside the target, then renamed).
+//! and written atomically (beside the target, then renamed); and colour maps of a nodal
+//! quantity over the mesh ([`field`]: the paper's Fig. 4).
 //!
 //! Errors are `anyhow` errors: problems with the input are [`WeftError`]s inside them;
 //! the file system and the drawing backend fail with their own errors under a context.
+
+pub mod field;
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -41,6 +44,9 @@ pub enum Figure {
     /// Section of a woven patch along a line y = y₀: the centre line and envelope of
     /// the yarn along x there, and the sections of the yarns across it.
     Weave(WeaveFigure),
+    /// A colour map of a nodal quantity over the mesh at one time, several models side
+    /// by side on one colour scale (the paper's Fig. 4).
+    Field(field::FieldFigure),
 }
 
 /// Where and how large the figure is drawn.
@@ -124,8 +130,10 @@ pub struct WeaveFigure {
 /// What drawing a figure reports back to the binary.
 #[derive(Debug, Clone)]
 pub struct Report {
-    /// Series drawn (empty ones included).
+    /// Series drawn (empty ones included; a field figure: its panels).
     pub series: usize,
+    /// A field figure's times, missing nodes and colour range.
+    pub field: Option<field::FieldReport>,
 }
 
 /// Build the figure and write it to `output.out`.
@@ -138,12 +146,42 @@ pub fn run(c: &Config) -> anyhow::Result<Report> {
         Figure::Error(a) => error(a)?,
         Figure::Fit(a) => fit(a)?,
         Figure::Weave(a) => weave(a)?,
+        Figure::Field(a) => {
+            let (f, report) = field::build(a)?;
+            let panels = a.model.len();
+            save(&Drawing::Field(f, c.output.title.clone()), &c.output)?;
+            return Ok(Report {
+                series: panels,
+                field: Some(report),
+            });
+        }
     };
     chart.title = c.output.title.clone();
-    save(&chart, &c.output)?;
+    if chart.series.iter().all(|s| s.points.is_empty()) {
+        return Err(WeftError::input("nothing to plot: every series is empty").into());
+    }
+    let series = chart.series.len();
+    save(&Drawing::Chart(chart), &c.output)?;
     Ok(Report {
-        series: chart.series.len(),
+        series,
+        field: None,
     })
+}
+
+/// What `save` draws: a line chart, or a field figure with its title.
+enum Drawing {
+    Chart(Chart),
+    Field(field::Field, Option<String>),
+}
+
+fn draw_any<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, d: &Drawing) -> anyhow::Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    match d {
+        Drawing::Chart(c) => draw(root, c),
+        Drawing::Field(f, title) => field::draw(root, f, title.as_deref()),
+    }
 }
 
 /// How a series is drawn.
@@ -614,7 +652,7 @@ fn fit(a: &FitFigure) -> Result<Chart> {
     })
 }
 
-fn save(chart: &Chart, c: &Output) -> anyhow::Result<()> {
+fn save(chart: &Drawing, c: &Output) -> anyhow::Result<()> {
     let ext = c
         .out
         .extension()
@@ -626,9 +664,6 @@ fn save(chart: &Chart, c: &Output) -> anyhow::Result<()> {
             c.width, c.height
         ))
         .into());
-    }
-    if chart.series.iter().all(|s| s.points.is_empty()) {
-        return Err(WeftError::input("nothing to plot: every series is empty").into());
     }
     if let Some(dir) = c.out.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir)
@@ -646,8 +681,8 @@ fn save(chart: &Chart, c: &Output) -> anyhow::Result<()> {
         .with_file_name(format!(".{name}.tmp-{}.{ext}", std::process::id()));
     let size = (c.width, c.height);
     let r = match ext.as_str() {
-        "png" => draw(BitMapBackend::new(&tmp, size).into_drawing_area(), chart),
-        "svg" => draw(SVGBackend::new(&tmp, size).into_drawing_area(), chart),
+        "png" => draw_any(BitMapBackend::new(&tmp, size).into_drawing_area(), chart),
+        "svg" => draw_any(SVGBackend::new(&tmp, size).into_drawing_area(), chart),
         other => {
             return Err(WeftError::input(format!(
                 "--out `{}`: unknown figure format `{other}` (expected a .png or .svg file name)",

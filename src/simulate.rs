@@ -1,11 +1,13 @@
 //! The `simulate` stage: read a model folder, run the explicit solver, write
-//! `history.parquet`, `energy.parquet` and `summary.parquet` atomically.
+//! `history.parquet`, `energy.parquet` and `summary.parquet` atomically (and, when asked,
+//! `elements.parquet`: [`crate::element_results`]).
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use serde::Serialize;
 
+use crate::element_results::{ElementResults, WithElementResults};
 use crate::error::{Result, WeftError};
 use crate::model::io::read_model;
 use crate::model::Model;
@@ -35,6 +37,10 @@ pub struct Config {
     /// Linear static solve instead of the explicit dynamic run.
     #[serde(rename = "static")]
     pub static_solve: bool,
+    /// Parts whose element results go to `elements.parquet` at the output times (`all`:
+    /// every part); empty: no element results.
+    #[serde(default)]
+    pub element_results: Vec<String>,
 }
 
 /// What a run reports back to the binary.
@@ -129,17 +135,35 @@ pub fn run(c: &Config, progress: &mut (dyn FnMut(f64) + Send)) -> Result<Report>
             )));
         }
     }
+    let mut elements = (!c.element_results.is_empty())
+        .then(|| ElementResults::new(&m, &c.element_results, &solver.output_nodes))
+        .transpose()?;
     std::fs::create_dir_all(&c.out).map_err(|e| WeftError::io(&c.out, e))?;
     if c.static_solve {
-        return run_static(c, &m, &solver, &prov, t_setup);
+        return run_static(c, &m, &solver, &prov, t_setup, elements);
     }
     let setup = t_setup.elapsed();
-    let mut sink = ParquetSink::create(&c.out, solver.node_id.clone(), &prov)?;
-    let mut stats = pool.install(|| solver.run(&mut sink, progress))?;
+    let sink = ParquetSink::create(&c.out, solver.node_id.clone(), &prov)?;
+    let (sink, mut stats) = match elements.as_mut() {
+        Some(results) => {
+            let mut w = WithElementResults {
+                inner: sink,
+                results,
+            };
+            let stats = pool.install(|| solver.run(&mut w, progress))?;
+            (w.inner, stats)
+        }
+        None => {
+            let mut sink = sink;
+            let stats = pool.install(|| solver.run(&mut sink, progress))?;
+            (sink, stats)
+        }
+    };
     stats.threads = pool.current_num_threads();
     stats.times.setup = setup;
     let t_write = Instant::now();
     sink.finish(&c.out, &prov)?;
+    write_element_results(&c.out, elements, &prov)?;
     stats.times.output += t_write.elapsed();
     let sc = solver.scaling.clone().unwrap_or_default();
     let report = Report {
@@ -157,6 +181,21 @@ pub fn run(c: &Config, progress: &mut (dyn FnMut(f64) + Send)) -> Result<Report>
     Ok(report)
 }
 
+/// `elements.parquet` when element results were asked for; otherwise a stale one from
+/// an earlier run into the same folder is removed (weft-vtk would read it).
+fn write_element_results(
+    out: &Path,
+    elements: Option<ElementResults>,
+    prov: &Provenance,
+) -> Result<()> {
+    let path = out.join("elements.parquet");
+    match elements {
+        Some(e) => e.write(&path, prov),
+        None if path.exists() => std::fs::remove_file(&path).map_err(|e| WeftError::io(&path, e)),
+        None => Ok(()),
+    }
+}
+
 /// The static branch: K u = F, one `history` sample at t = 0, a static summary.
 fn run_static(
     c: &Config,
@@ -164,6 +203,7 @@ fn run_static(
     solver: &Solver,
     prov: &Provenance,
     t_setup: Instant,
+    mut elements: Option<ElementResults>,
 ) -> Result<Report> {
     let r = solver.solve_static(m)?;
     let mut sink = ParquetSink::create(&c.out, solver.node_id.clone(), prov)?;
@@ -171,7 +211,11 @@ fn run_static(
     let u: Vec<[f64; 3]> = nodes.iter().map(|&i| r.u[i]).collect();
     let v = vec![[0.0; 3]; nodes.len()];
     crate::solver::Sink::history(&mut sink, 0.0, nodes, &u, &v)?;
+    if let Some(e) = elements.as_mut() {
+        e.sample(0.0, &u, &v);
+    }
     sink.finish_history_only()?;
+    write_element_results(&c.out, elements, prov)?;
     let elements = solver.op.el.len() - solver.op.el.point_mass.id.len();
     write_table(
         &c.out.join("summary.parquet"),

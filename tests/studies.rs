@@ -75,6 +75,7 @@ fn girder_membrane_study_recovers_the_lattice_closed_forms() {
         "wavespeed_tension.png",
         "error.png",
         "fit_convergence.png",
+        "field_shear.png",
     ] {
         let b = std::fs::read(out.join("figures").join(f)).unwrap();
         assert!(
@@ -201,7 +202,7 @@ fn woven_patch_pipeline_forms_and_hits_the_patch() {
     // The bullet has slowed, not stopped or reversed, in 4 µs (it started at 400 m/s).
     let last = *vz.last().unwrap();
     assert!(last < -300.0 && last > -400.0, "vz = {last}");
-    for fig in ["weave.png", "impact.png"] {
+    for fig in ["weave.png", "impact.png", "uz_field.png"] {
         assert!(out.join("figures").join(fig).exists(), "{fig}");
     }
     let again = weft_run(root, "woven_patch.toml");

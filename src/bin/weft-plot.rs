@@ -16,11 +16,14 @@ use weft::plot;
     long_about = "Figures a paper needs, from the tables the stages write: displacement time laws of chosen nodes \
                   for several models side by side (the paper's Figs. 3, 10, 11), wave speeds along a line \
                   (weft-wavespeed), the per-node error along a node set (weft-error) and a fit's convergence \
-                  (weft-fit). The output's extension picks the format: .png (raster, --width × --height pixels) or \
+                  (weft-fit), a woven patch's section, and colour maps of a nodal quantity over the mesh (the paper's \
+                  Fig. 4), several models side by side on one colour scale. The output's extension picks the format: .png (raster, --width × --height pixels) or \
                   .svg. The font is bundled (DejaVu Sans); nothing is needed from the system.\n\nExamples:\n  \
                   weft-plot history --model g --history go/history.parquet --label girder \\\n    \
                   --model m --history mo/history.parquet --label membrane --nodes 121,61 --component ux --out fig3.png\n  \
-                  weft-plot fit --trace runs/fit/fit_trace.parquet --out convergence.svg"
+                  weft-plot fit --trace runs/fit/fit_trace.parquet --out convergence.svg\n  \
+                  weft-plot field --model runs/patch --history runs/impact/history.parquet --component uz \\\n    \
+                  --time 1e-5 --deformed --out uz.png"
 )]
 struct Cli {
     #[command(subcommand)]
@@ -41,6 +44,70 @@ enum Figure {
     /// envelope) and the sections of the yarns across it; reference dashed and formed
     /// solid for a model from weft-form.
     Weave(WeaveArgs),
+    /// Colour map of a nodal quantity (uz, |u|, vx, ...) over the mesh at one output
+    /// time, on the initial or deformed mesh, with a colour bar; several models side by
+    /// side on one colour scale (the paper's Fig. 4).
+    #[command(
+        long_about = "Colour map of a nodal quantity over the mesh at one output time (the paper's Fig. 4: \
+        z-displacement of the whole patch). Membrane faces are filled, trusses, links and beams drawn as \
+        coloured lines, point masses as dots; each face is divided 3 × 3 with the nodal values interpolated. \
+        Seen along the view axis (top view xy by default), the near layer hides the far one. The history must \
+        hold the nodes to colour: a run with --history-set writes only that set (nodes without a value are grey). \
+        Repeat --model/--history for panels side by side: one colour scale and one length scale for all.\n\n\
+        Example (girder and its fitted membrane, shear wave at 0.5 ms):\n  \
+        weft-plot field --model runs/girder --history runs/girder-out/history.parquet --label girder \\\n    \
+        --model runs/membrane --history runs/membrane-out/history.parquet --label membrane \\\n    \
+        --component uy --time 5e-4 --out field.png"
+    )]
+    Field(FieldArgs),
+}
+
+#[derive(Args)]
+struct FieldArgs {
+    /// Model folder (repeat, one per panel).
+    #[arg(long, required = true)]
+    model: Vec<PathBuf>,
+    /// Its history.parquet (repeat, in the same order).
+    #[arg(long, required = true)]
+    history: Vec<PathBuf>,
+    /// Panel title of each model (default: the folder name).
+    #[arg(long)]
+    label: Vec<String>,
+    /// Quantity: ux, uy, uz, vx, vy, vz, or u, v (magnitudes).
+    #[arg(long, default_value = "uz")]
+    component: String,
+    /// Output time [s]; the nearest sample of each history is drawn (its time is in the
+    /// panel title).
+    #[arg(long)]
+    time: f64,
+    /// Draw on the deformed mesh (initial positions + scale × displacement) instead of
+    /// the initial one.
+    #[arg(long)]
+    deformed: bool,
+    /// Displacement magnification on the deformed mesh.
+    #[arg(long, default_value_t = 1.0, requires = "deformed")]
+    scale: f64,
+    /// Projection: xy (seen from +z), xz (seen from -y) or yz (seen from +x).
+    #[arg(long, default_value = "xy")]
+    view: String,
+    /// Colour range MIN:MAX in the quantity's SI unit (default: the values' range over
+    /// all panels).
+    #[arg(long, value_parser = parse_range, allow_hyphen_values = true)]
+    range: Option<(f64, f64)>,
+    #[command(flatten)]
+    common: Common,
+}
+
+fn parse_range(s: &str) -> Result<(f64, f64), String> {
+    let (a, b) = s
+        .split_once(':')
+        .ok_or_else(|| format!("`{s}`: expected MIN:MAX, e.g. -2e-3:0"))?;
+    let num = |x: &str| {
+        x.trim()
+            .parse::<f64>()
+            .map_err(|_| format!("`{x}` in `{s}` is not a number"))
+    };
+    Ok((num(a)?, num(b)?))
 }
 
 #[derive(Args)]
@@ -222,6 +289,20 @@ fn run() -> anyhow::Result<()> {
             }),
             a.common,
         ),
+        Figure::Field(a) => (
+            plot::Figure::Field(plot::field::FieldFigure {
+                model: a.model,
+                history: a.history,
+                label: a.label,
+                component: a.component,
+                time: a.time,
+                deformed: a.deformed,
+                scale: a.scale,
+                view: a.view,
+                range: a.range,
+            }),
+            a.common,
+        ),
         Figure::Fit(a) => (
             plot::Figure::Fit(plot::FitFigure {
                 trace: a.trace,
@@ -236,6 +317,21 @@ fn run() -> anyhow::Result<()> {
         output: output(common),
     };
     let r = plot::run(&c)?;
+    if let Some(f) = &r.field {
+        let times: Vec<String> = f.times.iter().map(|t| format!("{t:e}")).collect();
+        eprintln!(
+            "weft-plot: t = [{}] s, colour range {:e} .. {:e}",
+            times.join(", "),
+            f.range.0,
+            f.range.1
+        );
+        for (k, m) in f.missing_nodes.iter().enumerate().filter(|p| *p.1 > 0) {
+            eprintln!(
+                "weft-plot: panel {}: {m} nodes have no value in the history (grey)",
+                k + 1
+            );
+        }
+    }
     eprintln!(
         "weft-plot: {} series -> {}",
         r.series,

@@ -51,6 +51,16 @@ struct Cli {
     /// Node set to write to history.parquet (repeatable) [default: all nodes].
     #[arg(long = "history-set")]
     history_sets: Vec<String>,
+    /// Write every node to history.parquet, whatever node sets the model's
+    /// analysis.parquet names (for whole-mesh figures: weft-plot field, weft-vtk).
+    #[arg(long, conflicts_with = "history_sets")]
+    all_nodes: bool,
+    /// Write element results of this part at the output times to elements.parquet
+    /// (repeatable; `all`: every part): axial strain and force (trusses, beams), relative
+    /// displacement and force (links), Green strain and stress (membranes), energy. The
+    /// history must hold the parts' nodes (--all-nodes).
+    #[arg(long = "element-results", value_name = "PART")]
+    element_results: Vec<String>,
     /// Stop when the energy balance error exceeds this fraction [model default 0.1].
     #[arg(long)]
     max_energy_error: Option<f64>,
@@ -83,10 +93,16 @@ fn run_cli() -> anyhow::Result<ExitCode> {
         time_step: cli.time_step,
         target_time_step: cli.target_time_step,
         mass_damping: cli.mass_damping,
-        history_sets: (!cli.history_sets.is_empty()).then_some(cli.history_sets.clone()),
+        // An empty list overrides the model's sets: every node.
+        history_sets: if cli.all_nodes {
+            Some(vec![])
+        } else {
+            (!cli.history_sets.is_empty()).then_some(cli.history_sets.clone())
+        },
         max_energy_error: cli.max_energy_error,
         max_steps: Some(cli.max_steps),
         static_solve: cli.static_solve,
+        element_results: cli.element_results.clone(),
     };
     let progress = Progress::new(
         cli.quiet,

@@ -191,6 +191,12 @@ fn kinematics<const N: usize>(x: &[[f64; 3]; N], r: &Reference<N>) -> ([[f64; 3]
     (f, [0.5 * (c11 - 1.0), 0.5 * (c22 - 1.0), c12])
 }
 
+/// Green strain in Voigt form [E₁₁, E₂₂, 2E₁₂] in material axes at current positions
+/// `x` (for output: `weft-simulate --element-results`).
+pub fn green_strain<const N: usize>(x: &[[f64; 3]; N], r: &Reference<N>) -> [f64; 3] {
+    kinematics(x, r).1
+}
+
 /// Second Piola–Kirchhoff stress [S₁₁, S₂₂, S₁₂] from Voigt strain.
 #[inline(always)]
 pub fn stress(m: &Material, e: &[f64; 3]) -> [f64; 3] {

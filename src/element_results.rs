@@ -1,0 +1,368 @@
+//! Element results at the output times (`weft-simulate --element-results PART`):
+//! `elements.parquet`, one row per output time and selected element, computed from the
+//! nodal positions and velocities of the history sample with the solver's own kernels.
+//!
+//! Glossary: X reference (stress-free) positions, u₀ a formed model's initial
+//! displacement, u(t), v(t) the history's displacement and velocity, so the current
+//! position is x = X + u₀ + u. Per element kind:
+//! - truss: L₀ = |X₂ − X₁|/(1 + ε₀) (ε₀ the prestrain), axial strain ε = (L − L₀)/L₀,
+//!   axial force N = E·A·ε (0 in compression when tension-only), energy ½(E·A/L₀)(L − L₀)²
+//!   ([`crate::solver::truss`]);
+//! - beam: the axial part only, L₀ = |X₂ − X₁|, ε and N = E·b·h·ε (bending needs the nodal
+//!   rotations, which the history does not hold);
+//! - link: relative displacement d = (x₂ − x₁) − (X₂ − X₁) and, for a link without a
+//!   friction slider, the force it carries k∘d + c∘ḋ (the force on node 1; node 2 gets
+//!   the opposite) and its spring energy ½ d·k∘d (a slider's slip is solver state the
+//!   history does not hold: null there);
+//! - tri, quad: Green strain [E₁₁, E₂₂, 2E₁₂] in material axes, second Piola–Kirchhoff
+//!   stress S = D E + S₀ (tension field applied), membrane strain energy A₀ s (½E·DE + S₀·E)
+//!   without the hourglass part ([`crate::solver::membrane`]);
+//! - point masses have no row.
+//!
+//! `energy` [J]: the element's stored elastic energy as above (truss, link without a
+//! slider, membranes; null for beams, whose bending energy needs the rotations).
+//!
+//! Between solver steps the history is interpolated linearly; the element quantities
+//! here are those of the interpolated positions (the same at the steps themselves).
+
+use std::path::Path;
+
+use crate::error::{Result, WeftError};
+use crate::model::{ElementKind, Model};
+use crate::solver::membrane::{self, Material, Reference};
+use crate::solver::{truss, Energies, Sink};
+use crate::table::{batch, write_table, Col, Provenance};
+
+/// One selected element with what its quantities need.
+enum Item {
+    Truss {
+        nodes: [usize; 2],
+        k: f64,
+        l0: f64,
+        tension_only: bool,
+    },
+    Beam {
+        nodes: [usize; 2],
+        l0: f64,
+        ea: f64,
+    },
+    Link {
+        nodes: [usize; 2],
+        d0: [f64; 3],
+        k: [f64; 3],
+        c: [f64; 3],
+        slider: bool,
+    },
+    Tri(Box<Membrane<3>>),
+    Quad(Box<Membrane<4>>),
+}
+
+struct Membrane<const N: usize> {
+    nodes: [usize; N],
+    reference: Reference<N>,
+    material: Material,
+    thickness: f64,
+}
+
+/// The element-results calculator: which elements, and the table being collected.
+pub struct ElementResults {
+    id: Vec<i64>,
+    part_id: Vec<i64>,
+    kind: Vec<&'static str>,
+    items: Vec<Item>,
+    /// Initial positions X + u₀.
+    x0: Vec<[f64; 3]>,
+    /// Model node index → position in the history's node list.
+    slot: Vec<usize>,
+    rows: Rows,
+}
+
+#[derive(Default)]
+struct Rows {
+    t: Vec<f64>,
+    id: Vec<i64>,
+    part_id: Vec<i64>,
+    kind: Vec<String>,
+    /// Nullable quantity columns, in [`COLUMNS`] order.
+    q: [Vec<Option<f64>>; 15],
+}
+
+/// The quantity columns of `elements.parquet`, in order.
+pub const COLUMNS: [&str; 15] = [
+    "axial_strain",
+    "axial_force",
+    "relative_displacement_x",
+    "relative_displacement_y",
+    "relative_displacement_z",
+    "force_x",
+    "force_y",
+    "force_z",
+    "strain_11",
+    "strain_22",
+    "strain_12",
+    "stress_11",
+    "stress_22",
+    "stress_12",
+    "energy",
+];
+
+impl ElementResults {
+    /// Select the elements of the named parts (`all`: every part) of a validated model;
+    /// `output_nodes` are the history's nodes, which must hold every node of those
+    /// elements.
+    pub fn new(m: &Model, parts: &[String], output_nodes: &[usize]) -> Result<ElementResults> {
+        let mut chosen = vec![false; m.parts.len()];
+        for name in parts {
+            if name == "all" {
+                chosen.iter_mut().for_each(|c| *c = true);
+                continue;
+            }
+            let i = m.part_index(name).ok_or_else(|| {
+                WeftError::input(format!("--element-results: no part `{name}`")).expected(format!(
+                    "`all` or a part of the model: {}",
+                    m.parts
+                        .iter()
+                        .map(|p| format!("`{}`", p.name))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ))
+            })?;
+            chosen[i] = true;
+        }
+        let mut slot = vec![usize::MAX; m.num_nodes()];
+        for (j, &i) in output_nodes.iter().enumerate() {
+            slot[i] = j;
+        }
+        let x0: Vec<[f64; 3]> = (0..m.num_nodes())
+            .map(|i| {
+                let u0 = m.initial_displacement.get(i).copied().unwrap_or([0.0; 3]);
+                std::array::from_fn(|d| m.coords[i][d] + u0[d])
+            })
+            .collect();
+        let mut r = ElementResults {
+            id: vec![],
+            part_id: vec![],
+            kind: vec![],
+            items: vec![],
+            x0,
+            slot,
+            rows: Rows::default(),
+        };
+        let sub = |a: usize, b: usize| -> [f64; 3] {
+            std::array::from_fn(|d| m.coords[b][d] - m.coords[a][d])
+        };
+        let norm = |v: [f64; 3]| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+        for (&kind, b) in &m.elements {
+            let npe = kind.nodes_per_element();
+            for e in 0..b.len() {
+                let part = &m.parts[b.part[e]];
+                if !chosen[b.part[e]] || kind == ElementKind::PointMass {
+                    continue;
+                }
+                let nodes = &b.nodes[npe * e..npe * (e + 1)];
+                if let Some(&n) = nodes.iter().find(|&&n| r.slot[n] == usize::MAX) {
+                    return Err(WeftError::input(format!(
+                        "element results of part `{}` need the history of its nodes; node `{}` (element `{}`) is not in the history's node sets",
+                        part.name, m.node_id[n], b.id[e]
+                    ))
+                    .hint("write every node: weft-simulate --all-nodes (or add the part's nodes to a --history-set)"));
+                }
+                let p = &part.props;
+                let item = match kind {
+                    ElementKind::Truss => {
+                        let l = norm(sub(nodes[0], nodes[1]));
+                        let l0 = l / (1.0 + p.prestrain.unwrap_or(0.0));
+                        let ea = p.youngs_modulus.unwrap_or(0.0) * p.area.unwrap_or(0.0);
+                        Item::Truss {
+                            nodes: [nodes[0], nodes[1]],
+                            k: ea / l0,
+                            l0,
+                            tension_only: p.tension_only.unwrap_or(false),
+                        }
+                    }
+                    ElementKind::Beam => Item::Beam {
+                        nodes: [nodes[0], nodes[1]],
+                        l0: norm(sub(nodes[0], nodes[1])),
+                        ea: p.youngs_modulus.unwrap_or(0.0)
+                            * p.width.unwrap_or(0.0)
+                            * p.height.unwrap_or(0.0),
+                    },
+                    ElementKind::Link => Item::Link {
+                        nodes: [nodes[0], nodes[1]],
+                        d0: sub(nodes[0], nodes[1]),
+                        k: [p.kx, p.ky, p.kz].map(|v| v.unwrap_or(0.0)),
+                        c: [p.cx, p.cy, p.cz].map(|v| v.unwrap_or(0.0)),
+                        slider: p.slip_force.is_some(),
+                    },
+                    ElementKind::Tri => Item::Tri(Box::new(membrane_item(m, b, e, nodes)?)),
+                    ElementKind::Quad => Item::Quad(Box::new(membrane_item(m, b, e, nodes)?)),
+                    ElementKind::PointMass => unreachable!("skipped above"),
+                };
+                r.id.push(b.id[e]);
+                r.part_id.push(part.id);
+                r.kind.push(kind.name());
+                r.items.push(item);
+            }
+        }
+        Ok(r)
+    }
+
+    /// Number of selected elements.
+    pub fn len(&self) -> usize {
+        self.items.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.items.is_empty()
+    }
+
+    /// Add the rows of output time `t` from the history sample (u, v of the output
+    /// nodes, in the history's order).
+    pub fn sample(&mut self, t: f64, u: &[[f64; 3]], v: &[[f64; 3]]) {
+        let pos = |i: usize| -> [f64; 3] {
+            let j = self.slot[i];
+            std::array::from_fn(|d| self.x0[i][d] + u[j][d])
+        };
+        let vel = |i: usize| v[self.slot[i]];
+        for (e, item) in self.items.iter().enumerate() {
+            let mut q = [None; 15];
+            match item {
+                Item::Truss {
+                    nodes,
+                    k,
+                    l0,
+                    tension_only,
+                } => {
+                    let (x1, x2) = (pos(nodes[0]), pos(nodes[1]));
+                    let l = dist(&x1, &x2);
+                    q[0] = Some((l - l0) / l0);
+                    q[1] = Some(truss::axial_force(&x1, &x2, *k, *l0, *tension_only));
+                    q[14] = Some(truss::energy(&x1, &x2, *k, *l0, *tension_only));
+                }
+                Item::Beam { nodes, l0, ea } => {
+                    let eps = (dist(&pos(nodes[0]), &pos(nodes[1])) - l0) / l0;
+                    q[0] = Some(eps);
+                    q[1] = Some(ea * eps);
+                }
+                Item::Link {
+                    nodes,
+                    d0,
+                    k,
+                    c,
+                    slider,
+                } => {
+                    let (x1, x2) = (pos(nodes[0]), pos(nodes[1]));
+                    let (v1, v2) = (vel(nodes[0]), vel(nodes[1]));
+                    let mut w = 0.0;
+                    for d in 0..3 {
+                        let dd = x2[d] - x1[d] - d0[d];
+                        q[2 + d] = Some(dd);
+                        w += 0.5 * k[d] * dd * dd;
+                        if !slider {
+                            q[5 + d] = Some(k[d] * dd + c[d] * (v2[d] - v1[d]));
+                        }
+                    }
+                    if !slider {
+                        q[14] = Some(w);
+                    }
+                }
+                Item::Tri(mb) => membrane_row(mb, &pos, &mut q),
+                Item::Quad(mb) => membrane_row(mb, &pos, &mut q),
+            }
+            self.rows.t.push(t);
+            self.rows.id.push(self.id[e]);
+            self.rows.part_id.push(self.part_id[e]);
+            self.rows.kind.push(self.kind[e].to_string());
+            for (c, v) in q.into_iter().enumerate() {
+                self.rows.q[c].push(v);
+            }
+        }
+    }
+
+    /// Write `elements.parquet` (atomically).
+    pub fn write(self, path: &Path, prov: &Provenance) -> Result<()> {
+        let r = self.rows;
+        let mut cols = vec![
+            Col::F64("t", r.t),
+            Col::I64("element_id", r.id),
+            Col::I64("part_id", r.part_id),
+            Col::Str("kind", r.kind),
+        ];
+        for (name, v) in COLUMNS.iter().zip(r.q) {
+            cols.push(Col::OptF64(name, v));
+        }
+        write_table(path, &batch(cols), prov)
+    }
+}
+
+fn dist(a: &[f64; 3], b: &[f64; 3]) -> f64 {
+    ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2) + (b[2] - a[2]).powi(2)).sqrt()
+}
+
+fn membrane_item<const N: usize>(
+    m: &Model,
+    b: &crate::model::ElementBlock,
+    e: usize,
+    nodes: &[usize],
+) -> Result<Membrane<N>> {
+    let p = &m.parts[b.part[e]].props;
+    let x: [[f64; 3]; N] = std::array::from_fn(|a| m.coords[nodes[a]]);
+    let reference = Reference::new(&x, p.material_angle.unwrap_or(0.0))
+        .ok_or_else(|| WeftError::input(format!("membrane element `{}` is degenerate", b.id[e])))?;
+    let mut material = Material::orthotropic(
+        p.youngs_modulus_1.unwrap_or(0.0),
+        p.youngs_modulus_2.unwrap_or(0.0),
+        p.poisson_ratio_12.unwrap_or(0.0),
+        p.shear_modulus_12.unwrap_or(0.0),
+        p.no_compression.unwrap_or(false),
+    )?;
+    if !b.stress0.is_empty() {
+        material.s0 = b.stress0[e];
+    }
+    let thickness = if b.thickness.is_empty() {
+        p.thickness.unwrap_or(0.0)
+    } else {
+        b.thickness[N * e..N * (e + 1)].iter().sum::<f64>() / N as f64
+    };
+    Ok(Membrane {
+        nodes: std::array::from_fn(|a| nodes[a]),
+        reference,
+        material,
+        thickness,
+    })
+}
+
+fn membrane_row<const N: usize>(
+    mb: &Membrane<N>,
+    pos: &dyn Fn(usize) -> [f64; 3],
+    q: &mut [Option<f64>; 15],
+) {
+    let x: [[f64; 3]; N] = std::array::from_fn(|a| pos(mb.nodes[a]));
+    let e = membrane::green_strain(&x, &mb.reference);
+    let s = membrane::stress(&mb.material, &e);
+    for k in 0..3 {
+        q[8 + k] = Some(e[k]);
+        q[11 + k] = Some(s[k]);
+    }
+    q[14] = Some(membrane::energy(&x, &mb.reference, &mb.material, mb.thickness, 0.0).0);
+}
+
+/// A sink that passes everything on to `inner` and samples the element results at
+/// every history output.
+pub struct WithElementResults<'a, S: Sink> {
+    pub inner: S,
+    pub results: &'a mut ElementResults,
+}
+
+impl<S: Sink> Sink for WithElementResults<'_, S> {
+    fn history(&mut self, t: f64, nodes: &[usize], u: &[[f64; 3]], v: &[[f64; 3]]) -> Result<()> {
+        self.results.sample(t, u, v);
+        self.inner.history(t, nodes, u, v)
+    }
+    fn energy(&mut self, t: f64, e: &Energies) -> Result<()> {
+        self.inner.energy(t, e)
+    }
+    fn projectile(&mut self, t: f64, id: i64, state: &[f64; 9]) -> Result<()> {
+        self.inner.projectile(t, id, state)
+    }
+}

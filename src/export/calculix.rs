@@ -1,0 +1,405 @@
+//! CalculiX (ccx 2.20) input deck for explicit dynamics (`*DYNAMIC, EXPLICIT`).
+//!
+//! What CalculiX 2.20's explicit scheme runs correctly, measured with the Debian package
+//! `calculix-ccx` (the facts of issue 15, and `tests/export_calculix.rs`):
+//! - a truss as a `SPRINGA` element (an axial spring along the current axis, k = E·A/L₀)
+//!   with the truss's mass lumped on its nodes as `MASS` elements; `T3D2` trusses are
+//!   refused by ccx in explicit ("linear and nonlinear MPC's depend on each other");
+//! - a prestrained or tension-only truss as a `NONLINEAR` `SPRINGA`: force against
+//!   elongation e from the geometric length, F = k(e + L − L₀) (0 below −(L − L₀) when
+//!   tension-only), a straight line through the range −0.9 L … L (ccx holds the force
+//!   constant outside the points given);
+//! - a link between nodes as one `SPRING2` per axis with a spring (the global-axis
+//!   spring of weft's link, exact for coincident nodes);
+//! - point masses as `MASS` elements;
+//! - fixed translations and symmetry planes as `*BOUNDARY`, loads as `*CLOAD` with a
+//!   tabulated `*AMPLITUDE` (a sine pulse sampled at every step), initial velocities as
+//!   `*INITIAL CONDITIONS, TYPE=VELOCITY`;
+//! - mass-proportional damping α as Rayleigh damping `*DAMPING, ALPHA=α` (applied to the
+//!   whole model).
+//!
+//! Refused, with the reason: beams (`B31` runs in explicit but is expanded into `C3D8I`
+//! bricks, which give wrong answers there), membranes (`M3D4` likewise; `S4R` shells run
+//! correctly in-plane but add a bending stiffness weft's membranes do not have), link
+//! dashpots (`DASHPOTA` is silently ignored in explicit), friction sliders, projectiles,
+//! contacts, ties, formed models (initial displacement with its stresses), mass
+//! scaling.
+//!
+//! The step: ccx in explicit with `DIRECT` needs the minimum and maximum increment on the
+//! `*DYNAMIC` line (without them its time does not advance: the springs have no wave
+//! speed, ccx prints "Wave Speed for mat. … −1"); numbers are at most 20 characters
+//! (longer fields are refused by ccx's reader). `*NODE PRINT, FREQUENCY=n` prints every
+//! n-th increment, so the step divides the output interval; `TIME POINTS` collides with
+//! `DIRECT`. CalculiX's explicit scheme is not pure central difference: expect
+//! differences of 10⁻⁴–10⁻³ of max|u| against weft on the same step.
+
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+
+use super::{law_samples, num, refuse, Report};
+use crate::error::Result;
+use crate::model::{ElementKind, Model};
+
+const FORMAT: &str = "CalculiX";
+
+/// Groups elements with equal constants into one ELSET (ccx takes one constant per set).
+#[derive(Default)]
+struct Sets<K: Ord> {
+    sets: BTreeMap<K, Vec<String>>,
+}
+
+impl<K: Ord> Sets<K> {
+    fn add(&mut self, key: K, line: String) {
+        self.sets.entry(key).or_default().push(line);
+    }
+}
+
+/// Bit pattern of a float, for grouping equal values.
+fn bits(x: f64) -> u64 {
+    x.to_bits()
+}
+
+/// What a model holds that this deck cannot reproduce, as an error.
+fn check(m: &Model) -> Result<()> {
+    let kind = |k: ElementKind| m.block(k).is_some();
+    if kind(ElementKind::Beam) {
+        return Err(refuse(FORMAT, "beam elements", "CalculiX's B31 beams run in explicit dynamics but give wrong answers there (they are expanded into C3D8I bricks, which are wrong in explicit); measured with ccx 2.20"));
+    }
+    for k in [ElementKind::Tri, ElementKind::Quad] {
+        if kind(k) {
+            return Err(refuse(FORMAT, &format!("membrane elements ({})", k.name()), "CalculiX's M3D membranes are expanded into C3D8I bricks, wrong in explicit dynamics; S4R shells run correctly in-plane but add a bending stiffness weft's membranes do not have (measured with ccx 2.20)"));
+        }
+    }
+    if let Some(b) = m.block(ElementKind::Link) {
+        for e in 0..b.len() {
+            let part = &m.parts[b.part[e]];
+            let p = &part.props;
+            if [p.cx, p.cy, p.cz]
+                .iter()
+                .any(|c| c.is_some_and(|c| c > 0.0))
+            {
+                return Err(refuse(FORMAT, &format!("the dashpots of link part `{}`", part.name), "CalculiX's DASHPOTA elements are silently ignored in explicit dynamics (measured with ccx 2.20)"));
+            }
+            if p.slip_force.is_some() {
+                return Err(refuse(
+                    FORMAT,
+                    &format!("the friction slider of link part `{}`", part.name),
+                    "CalculiX has no elastic-perfectly-plastic discrete element",
+                ));
+            }
+        }
+    }
+    if !m.projectiles.is_empty() {
+        return Err(refuse(
+            FORMAT,
+            "projectiles",
+            "a rigid projectile in penalty contact has no CalculiX explicit counterpart here",
+        ));
+    }
+    if !m.contacts.is_empty() {
+        return Err(refuse(
+            FORMAT,
+            "contacts between parts",
+            "not exported (CalculiX's contact in explicit dynamics is not checked against weft's)",
+        ));
+    }
+    if !m.ties.is_empty() {
+        return Err(refuse(
+            FORMAT,
+            "tied interfaces",
+            "they would be *EQUATION constraints; not exported",
+        ));
+    }
+    if !m.initial_displacement.is_empty() {
+        return Err(refuse(
+            FORMAT,
+            "a formed model (initial displacements ux0, uy0, uz0)",
+            "CalculiX cannot start from displaced positions with the strains of that state",
+        ));
+    }
+    if m.analysis.target_time_step.is_some() {
+        return Err(refuse(
+            FORMAT,
+            "mass scaling (target_time_step)",
+            "the added masses are weft's; run without mass scaling",
+        ));
+    }
+    Ok(())
+}
+
+/// The deck and what it holds.
+pub fn deck(m: &Model, dt: f64, nsub: u64, provenance: &str) -> Result<(String, Report)> {
+    check(m)?;
+    let mut r = Report {
+        dt,
+        increments_per_output: nsub,
+        end_time: m.analysis.end_time,
+        nodes: m.num_nodes(),
+        ..Default::default()
+    };
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "** CalculiX deck written by weft {} (weft-export --format calculix)",
+        env!("CARGO_PKG_VERSION")
+    );
+    let _ = writeln!(
+        s,
+        "** Units: SI (m, kg, s, N, Pa). Explicit dynamics, fixed step {} s;",
+        num(dt)
+    );
+    let _ = writeln!(
+        s,
+        "** compare with: weft-simulate --time-step {} (same step).",
+        num(dt)
+    );
+    let _ = writeln!(
+        s,
+        "** Trusses are SPRINGA with lumped MASS; links one SPRING2 per axis."
+    );
+    let _ = writeln!(s, "** weft.provenance: {provenance}");
+    let _ = writeln!(s, "*HEADING\nweft model, explicit dynamics");
+    s.push_str("*NODE, NSET=NALL\n");
+    for (i, x) in m.coords.iter().enumerate() {
+        let _ = writeln!(
+            s,
+            "{}, {}, {}, {}",
+            m.node_id[i],
+            num(x[0]),
+            num(x[1]),
+            num(x[2])
+        );
+    }
+    let mut next_id = m
+        .elements
+        .values()
+        .flat_map(|b| b.id.iter().copied())
+        .max()
+        .unwrap_or(0)
+        + 1;
+    let mut mass = vec![0.0; m.num_nodes()];
+    let dist = |a: usize, b: usize| {
+        let (p, q) = (m.coords[a], m.coords[b]);
+        ((q[0] - p[0]).powi(2) + (q[1] - p[1]).powi(2) + (q[2] - p[2]).powi(2)).sqrt()
+    };
+    // Trusses: linear SPRINGA sets by k, nonlinear ones by (k, L, L − L₀, tension-only).
+    let mut linear: Sets<u64> = Sets::default();
+    let mut nonlinear: Sets<(u64, u64, u64, bool)> = Sets::default();
+    let mut consts: BTreeMap<u64, f64> = BTreeMap::new();
+    if let Some(b) = m.block(ElementKind::Truss) {
+        for e in 0..b.len() {
+            let (a, c) = (b.nodes[2 * e], b.nodes[2 * e + 1]);
+            let p = &m.parts[b.part[e]].props;
+            let (ym, area, rho) = (
+                p.youngs_modulus.unwrap_or(0.0),
+                p.area.unwrap_or(0.0),
+                p.density.unwrap_or(0.0),
+            );
+            let l = dist(a, c);
+            let l0 = l / (1.0 + p.prestrain.unwrap_or(0.0));
+            let k = ym * area / l0;
+            mass[a] += 0.5 * rho * area * l;
+            mass[c] += 0.5 * rho * area * l;
+            let line = format!("{}, {}, {}", b.id[e], m.node_id[a], m.node_id[c]);
+            let tension_only = p.tension_only.unwrap_or(false);
+            if l != l0 || tension_only {
+                for v in [k, l, l - l0] {
+                    consts.insert(bits(v), v);
+                }
+                nonlinear.add((bits(k), bits(l), bits(l - l0), tension_only), line);
+            } else {
+                consts.insert(bits(k), k);
+                linear.add(bits(k), line);
+            }
+        }
+        r.written.push(("SPRINGA (trusses)".into(), b.len()));
+    }
+    for (n, (k, lines)) in linear.sets.iter().enumerate() {
+        let _ = writeln!(s, "*ELEMENT, TYPE=SPRINGA, ELSET=TRUSS{}", n + 1);
+        s.push_str(&lines.join("\n"));
+        let _ = writeln!(s, "\n*SPRING, ELSET=TRUSS{}\n\n{}", n + 1, num(consts[k]));
+    }
+    for (n, ((k, l, d, tension_only), lines)) in nonlinear.sets.iter().enumerate() {
+        let (k, l, d) = (consts[k], consts[l], consts[d]);
+        let _ = writeln!(s, "*ELEMENT, TYPE=SPRINGA, ELSET=PRETRUSS{}", n + 1);
+        s.push_str(&lines.join("\n"));
+        let _ = writeln!(s, "\n*SPRING, ELSET=PRETRUSS{}, NONLINEAR\n", n + 1);
+        // (force, elongation) pairs, elongation ascending.
+        let f = |e: f64| {
+            let v = k * (e + d);
+            if *tension_only {
+                v.max(0.0)
+            } else {
+                v
+            }
+        };
+        let mut es = vec![-0.9 * l];
+        if *tension_only && -d > -0.9 * l && -d < l {
+            es.push(-d);
+        }
+        es.push(l);
+        for e in es {
+            let _ = writeln!(s, "{}, {}", num(f(e)), num(e));
+        }
+    }
+    // Links: one SPRING2 per axis with a spring, sets by (axis, k).
+    let mut springs: Sets<(usize, u64)> = Sets::default();
+    if let Some(b) = m.block(ElementKind::Link) {
+        let mut count = 0;
+        for e in 0..b.len() {
+            let (a, c) = (b.nodes[2 * e], b.nodes[2 * e + 1]);
+            let p = &m.parts[b.part[e]].props;
+            for (axis, k) in [p.kx, p.ky, p.kz].into_iter().enumerate() {
+                let k = k.unwrap_or(0.0);
+                if k > 0.0 {
+                    consts.insert(bits(k), k);
+                    springs.add(
+                        (axis, bits(k)),
+                        format!("{next_id}, {}, {}", m.node_id[a], m.node_id[c]),
+                    );
+                    next_id += 1;
+                    count += 1;
+                }
+            }
+        }
+        r.written.push(("SPRING2 (link axes)".into(), count));
+    }
+    for (n, ((axis, k), lines)) in springs.sets.iter().enumerate() {
+        let _ = writeln!(s, "*ELEMENT, TYPE=SPRING2, ELSET=LINK{}", n + 1);
+        s.push_str(&lines.join("\n"));
+        let _ = writeln!(
+            s,
+            "\n*SPRING, ELSET=LINK{}\n{}, {}\n{}",
+            n + 1,
+            axis + 1,
+            axis + 1,
+            num(consts[k])
+        );
+    }
+    // Masses: trusses' lumped halves and point masses, one MASS element per node.
+    if let Some(b) = m.block(ElementKind::PointMass) {
+        for e in 0..b.len() {
+            mass[b.nodes[e]] += m.parts[b.part[e]].props.mass.unwrap_or(0.0);
+        }
+    }
+    let mut masses: Sets<u64> = Sets::default();
+    let mut count = 0;
+    for (i, &mi) in mass.iter().enumerate() {
+        if mi > 0.0 {
+            consts.insert(bits(mi), mi);
+            masses.add(bits(mi), format!("{next_id}, {}", m.node_id[i]));
+            next_id += 1;
+            count += 1;
+        }
+    }
+    r.written.push(("MASS (nodal masses)".into(), count));
+    for (n, (mv, lines)) in masses.sets.iter().enumerate() {
+        let _ = writeln!(s, "*ELEMENT, TYPE=MASS, ELSET=MASS{}", n + 1);
+        s.push_str(&lines.join("\n"));
+        let _ = writeln!(s, "\n*MASS, ELSET=MASS{}\n{}", n + 1, num(consts[mv]));
+    }
+    // Boundary conditions: fixed translations and symmetry planes.
+    let mut fixed = vec![[false; 3]; m.num_nodes()];
+    for (i, f) in &m.constraints {
+        for d in 0..3 {
+            fixed[*i][d] |= f[d];
+        }
+    }
+    for sp in &m.symmetry {
+        for (i, x) in m.coords.iter().enumerate() {
+            if (x[sp.normal] - sp.position).abs() <= sp.tolerance {
+                fixed[i][sp.normal] = true;
+            }
+        }
+    }
+    // Mass-proportional damping f = −α m v: Rayleigh damping C = αM (ccx applies it to
+    // the whole model; it warns that the material has no elastic constants).
+    if m.analysis.mass_damping != 0.0 {
+        let _ = writeln!(
+            s,
+            "*MATERIAL, NAME=DAMPING\n*DAMPING, ALPHA={}, BETA=0.",
+            num(m.analysis.mass_damping)
+        );
+    }
+    let mut bc = String::new();
+    let mut nbc = 0;
+    for (i, f) in fixed.iter().enumerate() {
+        for (d, _) in f.iter().enumerate().filter(|p| *p.1) {
+            let _ = writeln!(bc, "{}, {}, {}", m.node_id[i], d + 1, d + 1);
+            nbc += 1;
+        }
+    }
+    if nbc > 0 {
+        s.push_str("*BOUNDARY\n");
+        s.push_str(&bc);
+    }
+    r.written
+        .push(("*BOUNDARY (fixed translations)".into(), nbc));
+    if !m.initial_velocities.is_empty() {
+        s.push_str("*INITIAL CONDITIONS, TYPE=VELOCITY\n");
+        for (i, v) in &m.initial_velocities {
+            for (d, vd) in v.iter().enumerate().filter(|p| *p.1 != 0.0) {
+                let _ = writeln!(s, "{}, {}, {}", m.node_id[*i], d + 1, num(*vd));
+            }
+        }
+    }
+    r.written
+        .push(("initial velocities".into(), m.initial_velocities.len()));
+    // Load amplitudes, one per load.
+    let end = m.analysis.end_time;
+    for l in &m.loads {
+        let _ = writeln!(s, "*AMPLITUDE, NAME=A{}", l.id);
+        let pts = law_samples(&l.law, end, dt);
+        for chunk in pts.chunks(4) {
+            let row: Vec<String> = chunk
+                .iter()
+                .map(|(t, g)| format!("{}, {}", num(*t), num(*g)))
+                .collect();
+            let _ = writeln!(s, "{}", row.join(", "));
+        }
+    }
+    // Output nodes: the history sets, or every node.
+    let out_nodes: Vec<usize> = if m.analysis.history_sets.is_empty() {
+        (0..m.num_nodes()).collect()
+    } else {
+        let mut v: Vec<usize> = m
+            .analysis
+            .history_sets
+            .iter()
+            .filter_map(|n| m.node_sets.get(n))
+            .flatten()
+            .copied()
+            .collect();
+        v.sort_unstable();
+        v.dedup();
+        v
+    };
+    r.output_nodes = out_nodes.len();
+    s.push_str("*NSET, NSET=NOUT\n");
+    for chunk in out_nodes.chunks(8) {
+        let ids: Vec<String> = chunk.iter().map(|&i| m.node_id[i].to_string()).collect();
+        let _ = writeln!(s, "{}", ids.join(", "));
+    }
+    let steps = (end / dt).round() as u64;
+    let _ = writeln!(s, "*STEP, NLGEOM, INC={}", steps + 10);
+    let _ = writeln!(
+        s,
+        "*DYNAMIC, EXPLICIT, DIRECT\n{}, {}, {}, {}",
+        num(dt),
+        num(end),
+        num(dt),
+        num(dt)
+    );
+    for l in &m.loads {
+        let lines: Vec<String> = (0..3)
+            .filter(|&d| l.force[d] != 0.0)
+            .map(|d| format!("{}, {}, {}", m.node_id[l.node], d + 1, num(l.force[d])))
+            .collect();
+        if !lines.is_empty() {
+            let _ = writeln!(s, "*CLOAD, AMPLITUDE=A{}\n{}", l.id, lines.join("\n"));
+        }
+    }
+    r.written.push(("*CLOAD (loads)".into(), m.loads.len()));
+    let _ = writeln!(s, "*NODE PRINT, NSET=NOUT, FREQUENCY={nsub}\nU\n*END STEP");
+    Ok((s, r))
+}
