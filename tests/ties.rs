@@ -4,7 +4,9 @@
 //! (Graff §8.1 for the plate speed √(E/(ρ(1−ν²)))), and because the slave's mass and force
 //! are distributed to the masters with the same weights that interpolate its motion, the
 //! total momentum Σ m v is conserved exactly (Belytschko, Liu, Moran §10.3, constrained
-//! nodes; Hallquist, LS-DYNA Theory Manual, "Tied interfaces").
+//! nodes; Hallquist, LS-DYNA Theory Manual, "Tied interfaces"); at an impedance step the
+//! transmitted and reflected energies are 4Z₁Z₂/(Z₁ + Z₂)² and ((Z₁ − Z₂)/(Z₁ + Z₂))²
+//! (Graff, *Wave Motion in Elastic Solids*, §1.6).
 //!
 //! ```text
 //!   fine: 300 × 6 quads (h/3)      |  coarse: 100 × 2 quads (h)
@@ -131,8 +133,10 @@ fn a_pulse_keeps_its_speed_across_a_tied_interface_to_a_coarser_mesh() {
         worst < 0.01 * wmax,
         "energy balance error {worst} J against work {wmax} J"
     );
-    // The pulse went through: the coarse side carries most of the energy at the end.
-    assert!(e.kinetic + e.internal > 0.9 * wmax);
+    // Where the energy goes at the interface is measured against the impedances in
+    // `a_tied_impedance_step_reflects_and_transmits_what_the_impedances_say` (the total
+    // asserted here once is conserved whatever the tie does).
+    let _ = e;
 }
 
 #[test]
@@ -186,5 +190,94 @@ fn a_slave_off_its_master_edge_is_refused() {
             && err.contains("ties.parquet")
             && err.contains("row 0"),
         "{err}"
+    );
+}
+
+/// Reflection and transmission at a tied interface between strips of different
+/// impedance: the fine strip (thickness t) is tied to a coarse strip of thickness 2t, the
+/// nodes free in y (the tie interpolates both in-plane components; ν = 0.3 makes the strip
+/// contract across). A bar wave (pulse 20 mm ≫ width 2 mm: Pochhammer dispersion
+/// negligible) meets the impedance step Z₂/Z₁ = 2 (Z = ρcA, same material): the energy
+/// transmitted is 4Z₁Z₂/(Z₁ + Z₂)² = 8/9 and reflected ((Z₁ − Z₂)/(Z₁ + Z₂))² = 1/9 (Graff,
+/// *Wave Motion in Elastic Solids*, §1.6). Measured from the kinetic energy on each side
+/// once the two pulses have separated (a travelling bar wave carries equal kinetic and
+/// strain energy). A tie that dropped its interpolation weights would reflect everything.
+#[test]
+fn a_tied_impedance_step_reflects_and_transmits_what_the_impedances_say() {
+    let (mut m, _, off) = joined();
+    // The coarse strip twice as thick.
+    let thick = m.add_part(
+        2,
+        "thick",
+        ElementKind::Quad,
+        PartProps {
+            youngs_modulus_1: Some(E),
+            youngs_modulus_2: Some(E),
+            poisson_ratio_12: Some(NU),
+            shear_modulus_12: Some(E / (2.0 * (1.0 + NU))),
+            thickness: Some(2e-3),
+            density: Some(RHO),
+            ..Default::default()
+        },
+    );
+    let b = m.elements.get_mut(&ElementKind::Quad).unwrap();
+    for e in 0..b.len() {
+        if b.nodes[4 * e] >= off {
+            b.part[e] = thick;
+        }
+    }
+    // Free in y: only z held.
+    m.constraints.clear();
+    for i in 0..m.num_nodes() {
+        m.constraints.push((i, [false, false, true]));
+    }
+    let c0 = (E / RHO).sqrt();
+    let t_f = 0.02 / c0;
+    for j in 0..=6 {
+        let w = if j == 0 || j == 6 { 0.5 } else { 1.0 };
+        m.loads.push(Load {
+            id: j as i64 + 1,
+            node: j * 301,
+            force: [20.0 * w, 0.0, 0.0],
+            law: TimeLaw::SinePulse {
+                start: 0.0,
+                duration: t_f,
+            },
+        });
+    }
+    // At (0.1 + 0.05)/c₀ + t_f the reflected pulse lies in 0.05–0.07 m and the
+    // transmitted one in 0.13–0.15 m, both clear of the interface and of the ends.
+    m.analysis.end_time = 0.15 / c0 + t_f;
+    m.analysis.output_interval = m.analysis.end_time / 50.0;
+    let (s, out, stats) = run_in_memory(&m).unwrap();
+    let last = out.t.len() - 1;
+    let (mut fine, mut coarse) = (0.0, 0.0);
+    for (j, &i) in out.nodes.iter().enumerate() {
+        let v = out.v[last][j];
+        let ke = 0.5 * s.mass[i] * (v[0] * v[0] + v[1] * v[1]);
+        if i < off {
+            fine += ke;
+        } else {
+            coarse += ke;
+        }
+    }
+    let transmitted = coarse / (fine + coarse);
+    let e = out.energy.last().unwrap();
+    eprintln!(
+        "impedance step 1:2: transmitted {transmitted:.4} of the energy (8/9 = {:.4}), reflected {:.4} (1/9 = {:.4}); kinetic {:.3e} J of {:.3e} J total; balance {:.2e}",
+        8.0 / 9.0,
+        1.0 - transmitted,
+        1.0 / 9.0,
+        fine + coarse,
+        e.kinetic + e.internal,
+        stats.max_balance_error_relative
+    );
+    // The kinetic energy is half of what the pulses carry (equipartition): measured
+    // 0.08 %.
+    assert!(rel(2.0 * (fine + coarse), e.kinetic + e.internal) < 5e-3);
+    // Measured 0.8891 (error 2e-4: mesh dispersion of the pulse).
+    assert!(
+        (transmitted - 8.0 / 9.0).abs() < 2e-3,
+        "transmitted {transmitted}"
     );
 }
