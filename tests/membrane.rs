@@ -222,9 +222,14 @@ fn patch_test_reproduces_a_uniform_strain_exactly() {
             0.5 * (f2[0] * f2[0] + f2[1] * f2[1] - 1.0),
             f1[0] * f2[0] + f1[1] * f2[1],
         ];
-        let mat =
-            weft::solver::membrane::Material::orthotropic(80e9, 20e9, 0.3, 5e9, false).unwrap();
-        let st = weft::solver::membrane::stress(&mat, &e);
+        // The plane-stress reduced stiffness of an orthotropic lamina, written out here
+        // (Jones, *Mechanics of Composite Materials*, §2.6): Q₁₁ = E₁/Δ, Q₂₂ = E₂/Δ,
+        // Q₁₂ = ν₁₂E₂/Δ, Q₆₆ = G₁₂, Δ = 1 − ν₁₂ν₂₁, ν₂₁ = ν₁₂E₂/E₁; e[2] is the
+        // engineering shear strain.
+        let (e1, e2, nu12, g12) = (80e9, 20e9, 0.3, 5e9);
+        let delta = 1.0 - nu12 * nu12 * e2 / e1;
+        let (q11, q22, q12) = (e1 / delta, e2 / delta, nu12 * e2 / delta);
+        let st = [q11 * e[0] + q12 * e[1], q12 * e[0] + q22 * e[1], g12 * e[2]];
         let w = 0.5 * (0.02 * 0.02) * S * (st[0] * e[0] + st[1] * e[1] + st[2] * e[2]);
         let (ie, _, _, hg) = s.internal_energy();
         assert!(rel(ie, w) < 1e-10, "{}: energy {ie} vs {w}", kind.name());
