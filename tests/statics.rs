@@ -83,6 +83,8 @@ fn static_membrane_strip_in_tension() {
     assert_eq!(r.held, (nx) * (ny + 1));
 }
 
+/// A consistency check, not an oracle (the code against itself: two of its solvers must
+/// agree); the closed forms are in the tests above.
 #[test]
 fn static_solution_is_the_steady_state_of_a_damped_dynamic_run() {
     let (nx, ny) = (10, 5);
