@@ -129,9 +129,18 @@ pub fn run(c: &Config, progress: &mut (dyn FnMut(f64) + Send)) -> Result<Report>
                 solver.stable.dt, m.analysis.end_time
             ))
             .hint(format!(
-                "the step is set by {} (stable step {:.3e} s): check its Young's modulus, density and size (or a link's stiffness and masses), or raise --max-steps",
+                "the step is set by {} (stable step {:.3e} s): check its Young's modulus, density and size (or a link's stiffness and masses){}, or raise --max-steps",
                 controlling_name(&solver),
-                solver.stable.dt_stable
+                solver.stable.dt_stable,
+                // Mass damping shortens the step: Δt ≤ (2/ω)(√(1+ξ²) − ξ) ≈ 1/ξω for ξ ≫ 1.
+                if m.analysis.mass_damping * solver.stable.dt_stable > 0.1 {
+                    format!(
+                        ", and the mass damping α = {:e} 1/s (analysis.parquet, column mass_damping), which shortens the step to about 2/α when it is large",
+                        m.analysis.mass_damping
+                    )
+                } else {
+                    String::new()
+                }
             )));
         }
     }

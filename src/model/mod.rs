@@ -859,11 +859,16 @@ fn validate_analysis(a: &Analysis) -> Result<()> {
         );
     }
     if a.end_time / a.output_interval > 1e7 {
-        return err(
-            "output_interval",
+        return Err(WeftError::input(format!(
+            "analysis settings end_time = `{}` s and output_interval = `{}` s give {:.3e} output samples",
+            a.end_time,
             a.output_interval,
-            "at most 10⁷ output samples",
-        );
+            a.end_time / a.output_interval
+        ))
+        .in_file("analysis.parquet")
+        .in_column("output_interval")
+        .expected("at most 10⁷ output samples")
+        .hint("lengthen output_interval, or check end_time"));
     }
     if !(a.dt_safety > 0.0 && a.dt_safety <= 1.0) {
         return err("dt_safety", a.dt_safety, "0 < dt_safety ≤ 1");

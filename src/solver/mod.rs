@@ -549,7 +549,7 @@ impl Solver {
                 .in_file("nodes.parquet")
                 .expected("mass > 0 at every free node that elements or loads act on")
                 .hint(
-                    "links carry no mass: attach a truss or a point_mass to the node, or fix it",
+                    "its elements give it no mass (links only, or trusses of density 0 in parts.parquet, column density): attach a point_mass, give a part a density, or fix the node",
                 ));
             }
         }
@@ -578,7 +578,25 @@ impl Solver {
         for (im, m) in self.inv_m.iter_mut().zip(&self.mass) {
             *im = if *m > 0.0 { 1.0 / m } else { 0.0 };
         }
+        if let Some(i) = self.mass.iter().position(|m| !m.is_finite()) {
+            return Err(WeftError::input(format!(
+                "node `{}` has mass {} kg",
+                self.node_id[i], self.mass[i]
+            ))
+            .in_file("parts.parquet")
+            .expected("finite masses: each element's density × area (or thickness) × size, and point masses, finite")
+            .hint("a density, area, thickness or mass of the node's elements (parts.parquet), or an element's size (node coordinates in nodes.parquet), is far too large"));
+        }
         let (dt_stable, node) = self.stable_step();
+        if dt_stable.is_nan() {
+            return Err(WeftError::input(format!(
+                "the stable step of node `{}` is not a number",
+                self.node_id[node]
+            ))
+            .in_file("parts.parquet")
+            .expected("finite stiffness and mass at every node")
+            .hint("a modulus, area, thickness or stiffness of the node's elements (parts.parquet), or their coordinates (nodes.parquet), far too large"));
+        }
         if !dt_stable.is_finite() && a.time_step.is_none() {
             return Err(WeftError::input(
                 "no element limits the time step (the model has no stiffness)",
@@ -600,7 +618,11 @@ impl Solver {
                     .in_file("analysis.parquet")
                     .in_column("time_step")
                     .expected(format!("a step ≤ {dt_stable:.4e} s"))
-                    .hint("leave time_step empty to use the stable step, or use target_time_step for mass scaling"));
+                    .hint(if a.mass_damping * dt_stable > 0.1 {
+                        format!("the mass damping α = {:e} 1/s (column mass_damping) shortens the stable step to about 2/α: lower it, or leave time_step empty", a.mass_damping)
+                    } else {
+                        "leave time_step empty to use the stable step, or use target_time_step for mass scaling; if the stable step is unexpectedly small, check that element's properties in parts.parquet".to_string()
+                    }));
                 }
                 dt
             }
@@ -700,6 +722,29 @@ impl Solver {
         let fx = self.op.fext[node];
         if culprit.is_empty() && !(fx[0] + fx[1] + fx[2]).is_finite() {
             culprit = "; its external load is not finite".into();
+        }
+        if culprit.is_empty() {
+            // A load on the node (or the largest one in the model) too large for the
+            // model is the next suspect: name it.
+            let big = self
+                .op
+                .loads
+                .loads
+                .iter()
+                .map(|l| (l, l.force.iter().map(|f| f.abs()).fold(0.0, f64::max)))
+                .max_by(|a, b| {
+                    (a.0.node == node, a.1)
+                        .partial_cmp(&(b.0.node == node, b.1))
+                        .unwrap_or(std::cmp::Ordering::Equal)
+                });
+            if let Some((l, f)) = big {
+                culprit = format!(
+                    "; {} load `{}` (loads.parquet, node `{}`) peaks at {f:.3e} N",
+                    if l.node == node { "its" } else { "the largest" },
+                    l.id,
+                    self.node_id[l.node]
+                );
+            }
         }
         WeftError::Numerical {
             what: format!("velocity or position of node `{}` became NaN or infinite{culprit}", self.node_id[node]),
@@ -870,13 +915,30 @@ impl Solver {
                     ("external work", w_ext),
                 ];
                 if let Some((name, v)) = terms.iter().find(|(_, v)| !v.is_finite()) {
+                    let hint = if *name == "external work" {
+                        let big = self.op.loads.loads.iter().max_by(|a, b| {
+                            let m = |l: &crate::model::Load| {
+                                l.force.iter().map(|f| f.abs()).fold(0.0, f64::max)
+                            };
+                            m(a).total_cmp(&m(b))
+                        });
+                        match big {
+                            Some(l) => format!(
+                                "the loads' work overflowed: the largest is load `{}` (loads.parquet, node `{}`, force {:?} N)",
+                                l.id, self.node_id[l.node], l.force
+                            ),
+                            None => "a projectile with prescribed velocity did non-finite work".to_string(),
+                        }
+                    } else if *name == "kinetic" {
+                        "a mass × velocity² overflowed: check the initial velocities, the element and point masses (parts.parquet) and the projectiles' mass and velocity (projectile.parquet)".to_string()
+                    } else {
+                        "a penalty or element with zero mass or zero length somewhere; the contact report names the definitions (run with the same model and a shorter end time to look at it)".to_string()
+                    };
                     return Err(WeftError::Numerical {
                         what: format!("the {name} energy is {v}"),
                         step: self.state.step,
                         time: self.state.t,
-                        hint: Some(
-                            "a penalty or element with zero mass or zero length somewhere; the contact report names the definitions (run with the same model and a shorter end time to look at it)".to_string(),
-                        ),
+                        hint: Some(hint),
                     });
                 }
                 if e.balance_error_relative > a.max_energy_error

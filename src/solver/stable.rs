@@ -54,7 +54,10 @@ pub fn nodal_dt(s: f64, c: f64, m: f64, alpha: f64) -> f64 {
     }
     let w = (s / m).sqrt();
     let xi = damp / (2.0 * w);
-    (2.0 / w) * ((1.0 + xi * xi).sqrt() - xi)
+    // √(1+ξ²) − ξ = 1/(√(1+ξ²) + ξ), without the cancellation at large ξ, and with hypot so
+    // that a huge damping gives a tiny step (which the step budget then refuses, naming
+    // the node) rather than ∞ − ∞.
+    (2.0 / w) / (1.0f64.hypot(xi) + xi)
 }
 
 impl Solver {
