@@ -237,8 +237,10 @@ struct WovenArgs {
     pretension_strain: f64,
     /// How a pretensioned model starts: `balanced` (the membrane around carries the same
     /// tension per width, N = E·A·ε₀/p, as an initial stress N/s: in equilibrium at t = 0
-    /// for straight yarns) or `unbalanced` (only the yarns pre-strained: the membrane is
-    /// pulled in and rings; the behaviour before the fix).
+    /// for straight yarns), `relaxed` (balanced, then the crimped crossings settled by
+    /// dynamic relaxation and written as initial displacements: for --crimp > 0) or
+    /// `unbalanced` (only the yarns pre-strained: the membrane is pulled in and rings;
+    /// the behaviour before the fix).
     #[arg(long, value_enum, default_value_t = PretensionStart::Balanced)]
     pretension_start: PretensionStart,
     /// Crimp: z offset of warp and weft at the crossings, ± [m].

@@ -459,10 +459,30 @@ pub enum PretensionStart {
     /// (a uniformly pre-stressed sheet held at its outer edge), so that the yarn ends
     /// pull on a membrane that pulls back as much. Exact for straight yarns (no crimp).
     Balanced,
+    /// Balanced, then relaxed: the crimped crossings, which a pretension presses against
+    /// their links, settle by dynamic relaxation (local damping, [`Solver::relax`], the
+    /// projectile set aside, the links' sliders held stuck so that the start owes
+    /// nothing to a slip the run would not inherit), and the settled positions become
+    /// the model's initial displacements u₀. For crimped yarns.
+    Relaxed,
     /// The yarns alone pre-strained (the membrane unstressed): an unbalanced start that
     /// pulls the membrane in and rings (the behaviour before the fix, kept to compare).
     Unbalanced,
 }
+
+/// How the relaxed start ([`PretensionStart::Relaxed`]) is stopped. Why these: the
+/// crossings settle in a few hundred steps (their link springs are the model's stiffest
+/// parts, and set the step); the test window of 200 steps and the free rest probe of
+/// 2000 steps (≈ 10 µs at the default model's 5 ns step, long against a crossing's
+/// period ≈ 30 ns) are far longer.
+const RELAX_MAX_STEPS: u64 = 200_000;
+const RELAX_CHECK_EVERY: u64 = 200;
+const RELAX_PROBE_STEPS: u64 = 2000;
+/// Residual force ≤ 10⁻⁶ of the yarn tension E·A·ε₀; kinetic energy ≤ 10⁻⁸ of the work
+/// the relaxation took; left alone at rest, no node moves more than 10⁻³ of the crimp.
+const RELAX_FORCE_TOLERANCE: f64 = 1e-6;
+const RELAX_KINETIC_TOLERANCE: f64 = 1e-8;
+const RELAX_CREEP_TOLERANCE: f64 = 1e-3;
 
 /// `woven-reduced`: the reduced woven model of the paper's §5.
 #[derive(Debug, Clone, Serialize)]
@@ -840,5 +860,54 @@ pub fn woven_reduced(p: &WovenParams) -> Result<Model> {
         ..Default::default()
     };
     m.validate()?;
+    if p.pretension_strain != 0.0 && p.pretension_start == PretensionStart::Relaxed {
+        relax_start(&mut m, p)?;
+    }
     Ok(m)
+}
+
+/// The relaxed start: relax a copy of the model (no projectile, link sliders stuck) and
+/// write its equilibrium as the initial displacements.
+fn relax_start(m: &mut Model, p: &WovenParams) -> Result<()> {
+    let mut r = m.clone();
+    r.projectiles.clear();
+    for part in r.parts.iter_mut().filter(|q| q.kind == ElementKind::Link) {
+        part.props.slip_force = None;
+        part.props.friction = None;
+    }
+    let mut solver = crate::solver::Solver::new(&r)?;
+    let tension = p.yarn_modulus * p.yarn_area * p.pretension_strain.abs();
+    let stats = solver.relax(
+        &crate::solver::relax::RelaxOptions {
+            max_steps: RELAX_MAX_STEPS,
+            min_steps: RELAX_CHECK_EVERY,
+            check_every: RELAX_CHECK_EVERY,
+            alpha: 0.8,
+            kinetic_tolerance: RELAX_KINETIC_TOLERANCE,
+            force_tolerance: RELAX_FORCE_TOLERANCE,
+            force_scale: tension,
+            creep_window: RELAX_PROBE_STEPS,
+            creep_tolerance: RELAX_CREEP_TOLERANCE * p.crimp.abs().max(p.spacing * 1e-3),
+            work_offset: 0.0,
+            contact_damping: 0.0,
+            hold_in_rest_test: vec![],
+        },
+        &mut |_| {},
+    )?;
+    if !stats.converged {
+        return Err(WeftError::input(format!(
+            "the pretensioned model did not settle in {} steps (residual force {:.3e} N of the yarn tension {tension:.3e} N; a free node moved {:.3e} m at rest)",
+            stats.steps, stats.residual, stats.creep
+        ))
+        .expected("an equilibrium of the crimped crossings under the pretension")
+        .hint("check --crimp and --k-z, or start with --pretension-start balanced"));
+    }
+    m.initial_displacement = solver
+        .state
+        .x
+        .iter()
+        .zip(&m.coords)
+        .map(|(x, x0)| [x[0] - x0[0], x[1] - x0[1], x[2] - x0[2]])
+        .collect();
+    m.validate()
 }
