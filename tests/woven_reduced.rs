@@ -767,3 +767,89 @@ fn a_relaxed_crimped_pretensioned_start_stays_still() {
     assert!(relaxed <= 1e-3 * p.crimp, "relaxed drift {relaxed}");
     assert!(balanced > relaxed, "balanced {balanced}, relaxed {relaxed}");
 }
+
+// ---------------------------------------------------------------------------------------
+// The frame nodes on disk, and bad frames.
+
+#[test]
+fn frame_nodes_round_trip_through_the_link_table() {
+    // A model with local Coulomb unilateral links written and read back is the same
+    // model (frame nodes f1…f4 and the new part columns included).
+    use weft::model::io::write_model;
+    use weft::table::Provenance;
+    let mut p = WovenParams::paper();
+    small(&mut p);
+    p.local_frame = true;
+    p.friction = Some(0.1);
+    p.unilateral = true;
+    let m = woven_reduced(&p).unwrap();
+    assert_eq!(
+        m.block(ElementKind::Link).unwrap().frame.len(),
+        m.block(ElementKind::Link).unwrap().len()
+    );
+    let dir = tempfile::tempdir().unwrap();
+    write_model(
+        &m,
+        dir.path(),
+        &Provenance::new("test", serde_json::json!({})),
+    )
+    .unwrap();
+    let back = read_model(dir.path()).unwrap();
+    assert!(back == m, "the model changed on its way through the tables");
+}
+
+#[test]
+fn local_links_without_a_frame_are_refused_with_the_link_named() {
+    // A local-frame part whose links have no frame nodes, and one whose frame nodes are
+    // parallel: errors naming the link, the file and the column, never a panic.
+    let mut m = tilted_link(0.0, true, 1e-6, PartProps::default());
+    m.elements
+        .get_mut(&ElementKind::Link)
+        .unwrap()
+        .frame
+        .clear();
+    let e = Solver::new(&m)
+        .err()
+        .expect("accepted a local link without frame nodes");
+    let msg = e.to_string();
+    eprintln!("{msg}");
+    assert!(
+        msg.contains("link `1`") && msg.contains("f1") && msg.contains("local frame"),
+        "{msg}"
+    );
+    let mut m = tilted_link(0.0, true, 1e-6, PartProps::default());
+    // f3, f4 along x too: the weft direction parallel to the warp.
+    m.coords[4] = [-2e-3, 0.0, 0.0];
+    m.coords[5] = [2e-3, 0.0, 0.0];
+    m.initial_displacement.clear();
+    let msg = Solver::new(&m)
+        .err()
+        .expect("accepted parallel frame directions")
+        .to_string();
+    eprintln!("{msg}");
+    assert!(
+        msg.contains("do not span a plane") && msg.contains("elements_link.parquet"),
+        "{msg}"
+    );
+    // Coulomb friction together with a constant slip force: one slip law only.
+    let m = pressed_link(
+        1e-6,
+        PartProps {
+            kx: Some(K_T),
+            ky: Some(K_T),
+            kz: Some(K_N),
+            friction: Some(0.2),
+            slip_force: Some(1.0),
+            ..Default::default()
+        },
+    );
+    let msg = Solver::new(&m)
+        .err()
+        .expect("accepted two slip laws")
+        .to_string();
+    eprintln!("{msg}");
+    assert!(
+        msg.contains("friction") && msg.contains("slip_force") && msg.contains("hint"),
+        "{msg}"
+    );
+}

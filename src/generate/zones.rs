@@ -460,7 +460,7 @@ pub enum PretensionStart {
     /// pull on a membrane that pulls back as much. Exact for straight yarns (no crimp).
     Balanced,
     /// Balanced, then relaxed: the crimped crossings, which a pretension presses against
-    /// their links, settle by dynamic relaxation (local damping, [`Solver::relax`], the
+    /// their links, settle by dynamic relaxation (local damping, `Solver::relax`, the
     /// projectile set aside, the links' sliders held stuck so that the start owes
     /// nothing to a slip the run would not inherit), and the settled positions become
     /// the model's initial displacements u₀. For crimped yarns.

@@ -16,9 +16,11 @@
 //! A rigid motion of the crossing gives d = 0 and no force, so a tilted fabric slides in
 //! its own plane against k_x, k_y only (in global axes a slide along a tilted yarn has a
 //! z component that k_z locks). The frame nodes take no force: the frame is kinematic
-//! (for coincident link nodes the force pair has no moment; the neglected terms, of order
-//! k d·Ṙ, leave the energy ledger's balance at the rounding level, measured in
-//! `tests/woven_reduced.rs`).
+//! (for coincident link nodes the force pair has no moment). The neglected terms, of
+//! order (K d)·(Ω d) for a frame turning at Ω, are not zero when k_z ≠ k_x: in the
+//! reduced woven model's impact (crimp 50 µm, 10 µs) the energy ledger's error was
+//! 0.028 J of the 160 J impact with local links against 8·10⁻⁴ J with global ones
+//! (measured), far inside the 1 % the runs are held to.
 //!
 //! Force on node 2 (node 1 gets the opposite), in the link's axes:
 //! - normal (z): spring f_n = −k_z d_z; unilateral (`unilateral`): the spring pushes and
