@@ -20,7 +20,7 @@ use nalgebra::DVector;
 use nalgebra_sparse::factorization::CscCholesky;
 use nalgebra_sparse::{CooMatrix, CscMatrix};
 
-use super::{beam, membrane, truss, Solver};
+use super::{beam, link, membrane, truss, Solver};
 use crate::error::{Result, WeftError};
 use crate::model::Model;
 
@@ -163,10 +163,22 @@ impl Solver {
         for e in 0..l.id.len() {
             let [a, b] = l.nodes[e].map(|v| v as usize);
             let ke = fd_stiffness(&[x0[a], x0[b]], 1e-6, |x| {
-                let f2 = l.reference_force(e, &x[0], &x[1]);
+                let f2 = link::elastic_force(
+                    &link::rel_disp(&x[0], &x[1], &l.d0[e]),
+                    &l.props[e],
+                    &[0.0; 2],
+                );
                 [[-f2[0], -f2[1], -f2[2]], f2]
             });
             add_element(&[a, b], &ke);
+        }
+        let l = &self.op.el.framed_link;
+        for e in 0..l.id.len() {
+            let nodes: [usize; 6] = l.nodes[e].map(|v| v as usize);
+            let xe: [[f64; 3]; 6] = std::array::from_fn(|k| x0[nodes[k]]);
+            let h = 1e-6 * l.chords[e][0].min(l.chords[e][1]);
+            let ke = fd_stiffness(&xe, h, |x| l.reference_forces(e, x));
+            add_element(&nodes, &ke);
         }
         fn membranes<const N: usize>(
             grp: &super::membrane::MembraneGroup<N>,
