@@ -478,7 +478,7 @@ pub enum PretensionStart {
 /// parts, and set the step); the test window of 200 steps and the free rest probe of
 /// 2000 steps (≈ 10 µs at the default model's 5 ns step, long against a crossing's
 /// period ≈ 30 ns) are far longer.
-const RELAX_MAX_STEPS: u64 = 200_000;
+const RELAX_MAX_STEPS: u64 = 1_000_000;
 const RELAX_CHECK_EVERY: u64 = 200;
 const RELAX_PROBE_STEPS: u64 = 2000;
 /// Residual force ≤ 10⁻⁴ of the yarn tension E·A·ε₀; kinetic energy ≤ 10⁻⁸ of the work
