@@ -643,6 +643,62 @@ fn coulomb_friction_slips_at_mu_n() {
 }
 
 #[test]
+fn coulomb_friction_in_the_tilted_local_frame_takes_n_from_the_local_normal() {
+    // The same as above on the fabric tilted by θ = 20°, links in the local frame: node
+    // 1 pressed along −n (the tilted normal) by N = 2 N and pulled along the tilted warp
+    // e₁ by a ramp to 2μN. Slip at μN = 0.4 N along e₁ with N the local normal force;
+    // read in global axes the slide has a z part, and a global link's N (its z force)
+    // would differ (cos θ N plus the slide's k_z share).
+    let (mass, n_load, mu) = (1e-6, 2.0, 0.2);
+    let theta = 20f64.to_radians();
+    let (e1, n) = (tilt(theta, [1.0, 0.0, 0.0]), tilt(theta, [0.0, 0.0, 1.0]));
+    let wt = (K_T / mass).sqrt();
+    let t_r = 2000.0 / wt;
+    let mut m = tilted_link(
+        theta,
+        true,
+        mass,
+        PartProps {
+            cz: Some(2.0 * (K_N * mass).sqrt()),
+            friction: Some(mu),
+            ..Default::default()
+        },
+    );
+    m.loads.push(Load {
+        id: 1,
+        node: 1,
+        force: [-n_load * n[0], -n_load * n[1], -n_load * n[2]],
+        law: TimeLaw::Step { start: 0.0 },
+    });
+    let f_max = 2.0 * mu * n_load;
+    m.loads.push(Load {
+        id: 2,
+        node: 1,
+        force: [f_max * e1[0], f_max * e1[1], f_max * e1[2]],
+        law: TimeLaw::Ramp {
+            start: 0.0,
+            duration: t_r,
+        },
+    });
+    m.analysis.end_time = 0.75 * t_r;
+    m.analysis.output_interval = t_r / 100.0;
+    let (s, _out, _) = run_in_memory(&m).unwrap();
+    let f = s.link_forces()[0];
+    let ft = f[0] * e1[0] + f[1] * e1[1] + f[2] * e1[2];
+    let fnorm = f[0] * n[0] + f[1] * n[1] + f[2] * n[2];
+    eprintln!(
+        "local Coulomb: tangential {:.6} N vs μN = {:.6} N (rel {:.1e}); normal {fnorm:.6} N vs N = {n_load} (rel {:.1e})",
+        -ft,
+        mu * n_load,
+        rel(-ft, mu * n_load),
+        rel(fnorm, n_load)
+    );
+    // Measured: both 1.8·10⁻¹⁰ off (the damped normal still settling); the issue asks 1 %.
+    assert!(rel(-ft, mu * n_load) < 0.01, "{f:?}");
+    assert!(rel(fnorm, n_load) < 0.01, "{f:?}");
+}
+
+#[test]
 fn the_unilateral_spring_pushes_and_never_pulls() {
     // Node 1 (m = 10⁻⁶ kg) pulled away from node 0 along +z by F = 1 N (a step).
     // Unilateral: no force resists, the node is a free mass, z = F t²/(2m) (to rounding),
