@@ -323,11 +323,13 @@ fn the_reduced_woven_model() {
     let n = p.yarns / 2;
     assert_eq!(m.block(ElementKind::Link).unwrap().len(), (n + 1) * (n + 1));
     assert_eq!(m.block(ElementKind::Truss).unwrap().len(), 2 * n * (n + 1));
-    // Mass: yarns ρA × length (the yarns on the symmetry planes with half the area) and
-    // the membrane ρ s × its area.
+    // Mass: yarns ρA × length (the yarns on the symmetry planes and on the interface
+    // with half the area: n + 1 lines of length c per family, two of them half) and the
+    // membrane ρ s × its area.
     let c = n as f64 * p.spacing;
-    let yarn = p.yarn_density * p.yarn_area * 2.0 * c * (n as f64 + 0.5);
-    let mem = p.membrane.density * p.membrane.thickness * (0.05f64.powi(2) - c * c);
+    let yarn = p.yarn_density * p.yarn_area * 2.0 * c * n as f64;
+    let mp = p.membrane();
+    let mem = mp.density * mp.thickness * (0.05f64.powi(2) - c * c);
     let s = Solver::new(&m).unwrap();
     assert!(
         rel(s.physical_mass, yarn + mem) < 1e-9,

@@ -8,7 +8,18 @@ use clap::{Parser, Subcommand};
 use weft::generate::rod::RodParams;
 use weft::generate::square::{GirderParams, LoadCase, MembraneParams, Square};
 use weft::generate::weave::{self, Spec};
-use weft::generate::zones::{Centre, CombinedParams, MembraneProps, WovenParams};
+use weft::generate::zones::{
+    Centre, CombinedParams, MembraneProps, PretensionStart, SurroundParams, WovenParams,
+};
+
+/// Axes of the reduced model's links.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum LinkAxes {
+    /// Global x, y, z.
+    Global,
+    /// The crossing's frame: warp direction, weft direction, their normal.
+    Local,
+}
 use weft::model::ProjectileShape;
 
 #[derive(Parser)]
@@ -242,10 +253,18 @@ struct WovenArgs {
     /// Let yarns carry compression too.
     #[arg(long)]
     compressible_yarns: bool,
-    /// Yarn pretension as an initial strain ε₀ (the yarns start with E·A·ε₀; the membrane
-    /// around is not pre-stressed, so relax the model first, e.g. with --mass-damping).
+    /// Yarn pretension as an initial strain ε₀ [–] (the yarns start with the force E·A·ε₀;
+    /// see --pretension-start).
     #[arg(long, default_value_t = 0.0)]
     pretension_strain: f64,
+    /// How a pretensioned model starts: `balanced` (the membrane around carries the same
+    /// tension per width, N = E·A·ε₀/p, as an initial stress N/s: in equilibrium at t = 0
+    /// for straight yarns), `relaxed` (balanced, then the crimped crossings settled by
+    /// dynamic relaxation and written as initial displacements: for --crimp > 0) or
+    /// `unbalanced` (only the yarns pre-strained: the membrane is pulled in and rings;
+    /// the behaviour before the fix).
+    #[arg(long, value_enum, default_value_t = PretensionStart::Balanced)]
+    pretension_start: PretensionStart,
     /// Crimp: z offset of warp and weft at the crossings, ± [m].
     #[arg(long, default_value_t = 0.0)]
     crimp: f64,
@@ -264,6 +283,36 @@ struct WovenArgs {
     /// Link friction slider: tangential slip force [N] [default: none].
     #[arg(long)]
     slip_force: Option<f64>,
+    /// Link Coulomb friction coefficient μ [–]: the tangential springs slip at μ·N, N the
+    /// normal spring's compressive force (not with --slip-force) [default: none].
+    #[arg(long)]
+    link_friction: Option<f64>,
+    /// Unilateral link normal: the normal spring (and dashpot) pushes the yarns apart and
+    /// never pulls them together [default: two-way, as the paper's links].
+    #[arg(long)]
+    unilateral_links: bool,
+    /// Link axes: `global` (x, y, z, as the paper's links) or `local` (the crossing's two
+    /// yarn directions and their normal, following the fabric as it tilts).
+    #[arg(long, value_enum, default_value_t = LinkAxes::Global)]
+    link_axes: LinkAxes,
+    /// Membrane surround: its surface density over the woven patch's 2ρA/p [–] (the
+    /// paper's §3: 0.8).
+    #[arg(long, default_value_t = 0.8)]
+    membrane_density_ratio: f64,
+    /// Membrane surround: its Young's modulus over the yarn's [–] (the paper's §3: 0.3).
+    #[arg(long, default_value_t = 0.3)]
+    membrane_modulus_ratio: f64,
+    /// Membrane surround: its shear modulus over its Young's modulus [–] (the paper's §3:
+    /// 0.0042).
+    #[arg(long, default_value_t = 0.0042)]
+    membrane_shear_ratio: f64,
+    /// Membrane surround: Poisson's ratio ν [–].
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    membrane_poisson: f64,
+    /// Membrane surround: thickness s [m] (its density follows: ratio × 2ρA/p / s)
+    /// [default: 2A/p].
+    #[arg(long)]
+    membrane_thickness: Option<f64>,
     /// Side of the whole model [m].
     #[arg(long, default_value_t = 0.1)]
     length: f64,
@@ -512,7 +561,6 @@ fn run() -> anyhow::Result<ExitCode> {
             );
         }
         Model::WovenReduced(a) => {
-            let d = WovenParams::paper();
             let p = WovenParams {
                 yarns: a.yarns,
                 spacing: a.spacing,
@@ -521,12 +569,23 @@ fn run() -> anyhow::Result<ExitCode> {
                 yarn_area: a.yarn_area,
                 tension_only: !a.compressible_yarns,
                 pretension_strain: a.pretension_strain,
+                pretension_start: a.pretension_start,
                 crimp: a.crimp,
                 k_xy: a.k_xy,
                 k_z: a.k_z,
                 c_xy: a.c_xy,
                 c_z: a.c_z,
                 slip_force: a.slip_force,
+                friction: a.link_friction,
+                unilateral: a.unilateral_links,
+                local_frame: a.link_axes == LinkAxes::Local,
+                surround: SurroundParams {
+                    density_ratio: a.membrane_density_ratio,
+                    modulus_ratio: a.membrane_modulus_ratio,
+                    shear_ratio: a.membrane_shear_ratio,
+                    poisson_ratio: a.membrane_poisson,
+                    thickness: a.membrane_thickness,
+                },
                 length: a.length,
                 growth: a.growth,
                 quarter: !a.full,
@@ -536,14 +595,20 @@ fn run() -> anyhow::Result<ExitCode> {
                 projectile_velocity: a.projectile_velocity,
                 end_time: a.end_time,
                 output_interval: a.output_interval,
-                ..d
             };
             let m = weave::run(&Spec::WovenReduced(p.clone()), &a.out, &mut warn)?;
+            let mp = p.membrane();
             eprintln!(
-                "weft-weave woven-reduced: {} nodes, {} elements, {} ties -> {}",
+                "weft-weave woven-reduced: {} nodes, {} elements, {} ties; membrane surround ρs = {:.4e} kg/m² ({:.3} × the patch's 2ρA/p = {:.4e}), E = {:.3e} Pa, G = {:.3e} Pa, s = {:.3e} m -> {}",
                 m.num_nodes(),
                 m.num_elements(),
                 m.ties.len(),
+                mp.density * mp.thickness,
+                mp.density * mp.thickness / p.patch_surface_density(),
+                p.patch_surface_density(),
+                mp.youngs_modulus,
+                mp.shear_modulus,
+                mp.thickness,
                 a.out.display()
             );
         }

@@ -243,6 +243,24 @@ fn read_model_inner(dir: &Path) -> Result<Model> {
                 .expected("all three or none"));
             }
         }
+        // Frame nodes of links: f1…f4 (all or none; see `ElementBlock::frame`).
+        let mut fcols = Vec::new();
+        if kind == ElementKind::Link {
+            for c in ["f1", "f2", "f3", "f4"] {
+                if t.has(c) {
+                    let ids = t.i64(c, "f1, f2, f3, f4")?;
+                    fcols.push(node_refs(&t, c, &ids, &map)?);
+                }
+            }
+            if !fcols.is_empty() && fcols.len() != 4 {
+                return Err(WeftError::input(format!(
+                    "{} of the frame node columns f1, f2, f3, f4 are present",
+                    fcols.len()
+                ))
+                .in_file(&t.path)
+                .expected("all four or none"));
+            }
+        }
         let mut b = ElementBlock::default();
         for row in 0..eid.len() {
             let part = *part_map.get(&pid[row]).ok_or_else(|| {
@@ -265,6 +283,9 @@ fn read_model_inner(dir: &Path) -> Result<Model> {
             if !s0cols.is_empty() {
                 b.stress0
                     .push(std::array::from_fn(|k| s0cols[k][row].unwrap_or(0.0)));
+            }
+            if !fcols.is_empty() {
+                b.frame.push(std::array::from_fn(|k| fcols[k][row]));
             }
         }
         m.elements.insert(kind, b);
@@ -647,6 +668,12 @@ fn write_tables(m: &Model, dir: &Path, prov: &Provenance) -> Result<()> {
         if !b.stress0.is_empty() {
             for (j, c) in ["s0_11", "s0_22", "s0_12"].into_iter().enumerate() {
                 cols.push(Col::F64(c, b.stress0.iter().map(|s| s[j]).collect()));
+            }
+        }
+        if !b.frame.is_empty() {
+            for (j, c) in ["f1", "f2", "f3", "f4"].into_iter().enumerate() {
+                let v: Vec<usize> = b.frame.iter().map(|f| f[j]).collect();
+                cols.push(Col::I64(c, ids(&v)));
             }
         }
         write_table(

@@ -92,6 +92,11 @@ pub struct ElementBlock {
     /// Membranes: initial stress [S₁₁, S₂₂, S₁₂] [Pa] in material axes, one per element
     /// (a formed, pre-stressed state); empty when every element starts unstressed.
     pub stress0: Vec<[f64; 3]>,
+    /// Links: the frame nodes (f1, f2, f3, f4) of each link, whose local frame has
+    /// e₁ along x_f2 − x_f1 and its normal n along e₁ × (x_f4 − x_f3) (the crossing's two
+    /// yarn directions); empty when no link carries them. Read only by links whose part
+    /// has `local_frame`.
+    pub frame: Vec<[usize; 4]>,
 }
 
 impl ElementBlock {
@@ -375,6 +380,41 @@ impl Model {
         }
         if !b.stress0.is_empty() {
             b.stress0.push([0.0; 3]);
+        }
+        if !b.frame.is_empty() {
+            // A link without frame nodes of its own: the link's nodes twice (a frame
+            // that `validate` refuses if its part asks for a local frame).
+            b.frame.push([nodes[0], nodes[1], nodes[0], nodes[1]]);
+        }
+    }
+
+    /// Add a link with its frame nodes (f1, f2, f3, f4): e₁ along x_f2 − x_f1, the normal
+    /// along e₁ × (x_f4 − x_f3) (see [`ElementBlock::frame`]).
+    pub fn add_link_with_frame(
+        &mut self,
+        id: i64,
+        part: usize,
+        nodes: &[usize],
+        frame: [usize; 4],
+    ) {
+        let b = self.elements.entry(ElementKind::Link).or_default();
+        if b.frame.is_empty() && !b.is_empty() {
+            b.frame = (0..b.len())
+                .map(|e| {
+                    let (a, c) = (b.nodes[2 * e], b.nodes[2 * e + 1]);
+                    [a, c, a, c]
+                })
+                .collect();
+        }
+        self.add_element(id, part, nodes);
+        let b = self
+            .elements
+            .get_mut(&ElementKind::Link)
+            .expect("just added");
+        if b.frame.len() < b.len() {
+            b.frame.push(frame);
+        } else {
+            *b.frame.last_mut().expect("one per link") = frame;
         }
     }
 
@@ -701,6 +741,7 @@ impl Model {
             }
         }
         self.validate_nodal_thickness()?;
+        self.validate_link_frames()?;
         contacts::validate(self)?;
         validate_analysis(&self.analysis)
     }
@@ -779,6 +820,76 @@ impl Model {
     }
 }
 
+impl Model {
+    /// Link frame nodes: on link tables only, one set per link; every link whose part
+    /// asks for `local_frame` has frame nodes that span a plane at the reference
+    /// coordinates (e₁ = x_f2 − x_f1 ≠ 0, not parallel to x_f4 − x_f3).
+    fn validate_link_frames(&self) -> Result<()> {
+        for (kind, b) in &self.elements {
+            let file = format!("elements_{}.parquet", kind.name());
+            if !b.frame.is_empty() && (*kind != ElementKind::Link || b.frame.len() != b.len()) {
+                return Err(WeftError::input(format!(
+                    "{} elements carry {} frame-node sets for {} elements",
+                    kind.name(),
+                    b.frame.len(),
+                    b.len()
+                ))
+                .in_file(file)
+                .expected(
+                    "frame node columns f1, f2, f3, f4 on the link table only, one set per link",
+                ));
+            }
+        }
+        let Some(b) = self.block(ElementKind::Link) else {
+            return Ok(());
+        };
+        let file = "elements_link.parquet";
+        for e in 0..b.len() {
+            let part = &self.parts[b.part[e]];
+            if part.props.local_frame != Some(true) {
+                continue;
+            }
+            let Some(f) = b.frame.get(e) else {
+                return Err(WeftError::input(format!(
+                    "link `{}` of part `{}` asks for a local frame but the link table has no frame nodes",
+                    b.id[e], part.name
+                ))
+                .in_file(file)
+                .in_column("f1")
+                .at_row(e)
+                .expected("columns f1, f2, f3, f4: the nodes whose directions f2 − f1 and f4 − f3 span the crossing's plane")
+                .hint("give the frame nodes, or set `local_frame` of the part to null (global axes)"));
+            };
+            let x = |k: usize| self.coords[f[k]];
+            let sub = |a: [f64; 3], c: [f64; 3]| [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
+            let (u, w) = (sub(x(0), x(1)), sub(x(2), x(3)));
+            let cr = [
+                u[1] * w[2] - u[2] * w[1],
+                u[2] * w[0] - u[0] * w[2],
+                u[0] * w[1] - u[1] * w[0],
+            ];
+            let norm = |v: [f64; 3]| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+            let (nu, nw, nc) = (norm(u), norm(w), norm(cr));
+            if !(nu > 0.0 && nw > 0.0 && nc > 1e-6 * nu * nw) {
+                return Err(WeftError::input(format!(
+                    "link `{}` has frame nodes `{}`, `{}`, `{}`, `{}` whose directions f2 − f1 and f4 − f3 do not span a plane (sine of their angle {:.1e})",
+                    b.id[e],
+                    self.node_id[f[0]],
+                    self.node_id[f[1]],
+                    self.node_id[f[2]],
+                    self.node_id[f[3]],
+                    if nu > 0.0 && nw > 0.0 { nc / (nu * nw) } else { 0.0 }
+                ))
+                .in_file(file)
+                .in_column("f1")
+                .at_row(e)
+                .expected("two non-zero, non-parallel directions (the crossing's warp and weft)"));
+            }
+        }
+        Ok(())
+    }
+}
+
 /// A value > 0 that one property needs because of another (a friction slider's
 /// tangential stiffness).
 fn require_pos(p: &Part, col: &str, v: Option<f64>, unit: &str) -> Result<()> {
@@ -810,14 +921,42 @@ pub fn validate_part(p: &Part) -> Result<()> {
     }
     let q = &p.props;
     match p.kind {
-        ElementKind::Link if q.slip_force.is_some() => {
-            for (c, v) in [("kx", q.kx), ("ky", q.ky)] {
+        ElementKind::Link => {
+            if let (Some(f), Some(mu)) = (q.slip_force, q.friction) {
+                return Err(WeftError::input(format!(
+                    "part `{}` (link) has both slip_force = `{f}` and friction = `{mu}`",
+                    p.name
+                ))
+                .in_column("friction")
+                .expected("one slip law: a constant slip force or Coulomb friction μ")
+                .hint("leave `slip_force` null to slip at μ·N, or `friction` null to slip at a constant force"));
+            }
+            if q.slip_force.is_some() || q.friction.is_some() {
+                for (c, v) in [("kx", q.kx), ("ky", q.ky)] {
+                    require_pos(
+                        p,
+                        c,
+                        v,
+                        "in N/m (a friction slider needs tangential stiffness)",
+                    )?;
+                }
+            }
+            if q.friction.is_some() {
                 require_pos(
                     p,
-                    c,
-                    v,
-                    "in N/m (a friction slider needs tangential stiffness)",
+                    "kz",
+                    q.kz,
+                    "in N/m (Coulomb friction takes its normal force N from the normal spring)",
                 )?;
+            }
+            if q.unilateral == Some(true) && q.kz.is_none() && q.cz.is_none() {
+                return Err(WeftError::input(format!(
+                    "part `{}` (link) is unilateral but has no kz or cz",
+                    p.name
+                ))
+                .in_column("unilateral")
+                .expected("a normal spring `kz` (or dashpot `cz`) for the unilateral law to act on")
+                .hint("give `kz`, or leave `unilateral` null"));
             }
         }
         ElementKind::Tri | ElementKind::Quad => {

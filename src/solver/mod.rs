@@ -56,6 +56,7 @@ pub use ties::tie_weights;
 crate::families! {
     truss: truss::TrussGroup,
     link: link::LinkGroup,
+    framed_link: link::FramedLinkGroup,
     point_mass: point_mass::PointMassGroup,
     tri: membrane::MembraneGroup<3>,
     quad: membrane::MembraneGroup<4>,
@@ -758,17 +759,29 @@ impl Solver {
     }
 
     /// Current force of every link on its node 2 at the current positions: spring and
-    /// slider (the slider return-mapped on a copy of its state), without the dashpot.
+    /// slider (the slider return-mapped on a copy of its state), without the dashpot;
+    /// the links in global axes first, then those in a local frame, each in table order.
     pub fn link_forces(&self) -> Vec<[f64; 3]> {
-        self.op.el.link.elastic_forces(&self.state.x)
+        let mut f = self.op.el.link.elastic_forces(&self.state.x);
+        f.extend(
+            self.op
+                .el
+                .framed_link
+                .elastic_forces(&self.state.x)
+                .iter()
+                .map(|six| six[1]),
+        );
+        f
     }
 
     /// Internal nodal forces at the current positions (the forces the elements exert;
     /// the dashpots see the current half-step velocities and the sliders do not advance).
     pub fn internal_forces(&mut self) -> Vec<[f64; 3]> {
         let saved = self.op.el.link.state.clone();
+        let saved_framed = self.op.el.framed_link.state.clone();
         self.op.element_forces(&self.state);
         self.op.el.link.state = saved;
+        self.op.el.framed_link.state = saved_framed;
         (0..self.x0.len())
             .map(|i| {
                 let mut f = [0.0; 3];

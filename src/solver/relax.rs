@@ -147,6 +147,9 @@ impl Solver {
             self.op
                 .contact_and_ties(&self.state, &self.mass, self.stable.dt);
             let (op, inv_m, fixed, mass) = (&self.op, &self.inv_m, &self.fixed, &self.mass);
+            // A tied slave carries no mass; its force went to its masters (the tie
+            // transfer), so it has no residual of its own: it follows them below.
+            let is_slave = &op.ties.is_slave;
             let fcon = op.has_fcon().then_some(&op.fcon);
             type Chunk<'c> = (
                 usize,
@@ -174,7 +177,11 @@ impl Solver {
                             *fd = 0.0;
                         }
                     }
-                    let r = dot(&f, &f);
+                    let r = if is_slave.get(i).copied().unwrap_or(false) {
+                        0.0
+                    } else {
+                        dot(&f, &f)
+                    };
                     if r > q.res {
                         q.res = r;
                         q.res_node = i;
@@ -241,6 +248,11 @@ impl Solver {
                     res_node = p.res_node;
                 }
                 fc = fc.max(p.fc);
+            }
+            if !self.op.ties.is_empty() {
+                self.op
+                    .ties
+                    .update_slaves(&mut self.state.x, &mut self.state.v, None);
             }
             st.removed += removed;
             ke_window = ke_window.max(ke);

@@ -172,6 +172,14 @@ impl Solver {
             });
             add_element(&[a, b], &ke);
         }
+        let l = &self.op.el.framed_link;
+        for e in 0..l.id.len() {
+            let nodes: [usize; 6] = l.nodes[e].map(|v| v as usize);
+            let xe: [[f64; 3]; 6] = std::array::from_fn(|k| x0[nodes[k]]);
+            let h = 1e-6 * l.chords[e][0].min(l.chords[e][1]);
+            let ke = fd_stiffness(&xe, h, |x| l.reference_forces(e, x));
+            add_element(&nodes, &ke);
+        }
         fn membranes<const N: usize>(
             grp: &super::membrane::MembraneGroup<N>,
             x0: &[[f64; 3]],
