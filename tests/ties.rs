@@ -73,11 +73,9 @@ fn joined() -> (Model, usize, usize) {
     (m, 0, off)
 }
 
-#[test]
-fn a_pulse_keeps_its_speed_across_a_tied_interface_to_a_coarser_mesh() {
-    let (mut m, _, off) = joined();
-    let c = (E / (RHO * (1.0 - NU * NU))).sqrt();
-    let t_f = 0.02 / c;
+/// An axial sine pulse of `duration` on the fine strip's edge x = 0 (20 N in all, the
+/// corner nodes half).
+fn pulse_at_x0(m: &mut Model, duration: f64) {
     for j in 0..=6 {
         let w = if j == 0 || j == 6 { 0.5 } else { 1.0 };
         m.loads.push(Load {
@@ -86,10 +84,18 @@ fn a_pulse_keeps_its_speed_across_a_tied_interface_to_a_coarser_mesh() {
             force: [20.0 * w, 0.0, 0.0],
             law: TimeLaw::SinePulse {
                 start: 0.0,
-                duration: t_f,
+                duration,
             },
         });
     }
+}
+
+#[test]
+fn a_pulse_keeps_its_speed_across_a_tied_interface_to_a_coarser_mesh() {
+    let (mut m, _, off) = joined();
+    let c = (E / (RHO * (1.0 - NU * NU))).sqrt();
+    let t_f = 0.02 / c;
+    pulse_at_x0(&mut m, t_f);
     m.analysis.end_time = 0.19 / c + t_f;
     m.analysis.output_interval = m.analysis.end_time / 3000.0;
     let (_s, out, _) = run_in_memory(&m).unwrap();
@@ -233,18 +239,7 @@ fn a_tied_impedance_step_reflects_and_transmits_what_the_impedances_say() {
     }
     let c0 = (E / RHO).sqrt();
     let t_f = 0.02 / c0;
-    for j in 0..=6 {
-        let w = if j == 0 || j == 6 { 0.5 } else { 1.0 };
-        m.loads.push(Load {
-            id: j as i64 + 1,
-            node: j * 301,
-            force: [20.0 * w, 0.0, 0.0],
-            law: TimeLaw::SinePulse {
-                start: 0.0,
-                duration: t_f,
-            },
-        });
-    }
+    pulse_at_x0(&mut m, t_f);
     // At (0.1 + 0.05)/c₀ + t_f the reflected pulse lies in 0.05–0.07 m and the
     // transmitted one in 0.13–0.15 m, both clear of the interface and of the ends.
     m.analysis.end_time = 0.15 / c0 + t_f;
