@@ -31,6 +31,7 @@
 //! (set by `.ci/run`, which installs `calculix-ccx`). The refusals need no ccx.
 
 mod common;
+use common::run_ok;
 use std::collections::HashMap;
 use std::path::Path;
 use std::process::Command;
@@ -52,16 +53,6 @@ fn ccx_ok() -> bool {
         eprintln!("SKIP: CalculiX (`ccx`) not found (apt-get install calculix-ccx)");
     }
     ok
-}
-
-fn run_ok(exe: &str, args: &[&str]) -> String {
-    let o = Command::new(exe).args(args).output().unwrap();
-    assert!(
-        o.status.success(),
-        "{exe} {args:?}: {}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-    String::from_utf8_lossy(&o.stderr).to_string()
 }
 
 fn s(p: &Path) -> &str {

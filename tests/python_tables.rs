@@ -5,6 +5,7 @@
 //! so and passes, unless `WEFT_REQUIRE_PYTHON=1` (set by `.ci/run`, which installs them).
 
 mod common;
+use common::run_ok;
 use std::process::Command;
 
 /// Whether python3 with pandas, polars and pyarrow is here; required when
@@ -50,15 +51,6 @@ fn read_tables(
 }
 
 /// Runs a weft binary, which must succeed.
-fn run_ok(exe: &str, args: &[&str]) {
-    let o = Command::new(exe).args(args).output().unwrap();
-    assert!(
-        o.status.success(),
-        "{exe} {args:?}: {}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-}
-
 #[test]
 fn tables_open_in_pandas_and_polars() {
     if !python_ok() {

@@ -15,6 +15,7 @@
 //! with slider and dashpots, a round-nosed projectile, contact), 10 µs.
 
 mod common;
+use common::run_ok;
 use std::path::Path;
 use std::process::Command;
 
@@ -31,16 +32,6 @@ fn python_vtk_ok() -> bool {
         eprintln!("SKIP: python3 with vtk and pandas not found (pip install vtk pandas pyarrow)");
     }
     ok
-}
-
-fn run_ok(exe: &str, args: &[&str]) -> String {
-    let o = Command::new(exe).args(args).output().unwrap();
-    assert!(
-        o.status.success(),
-        "{exe} {args:?}: {}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-    String::from_utf8_lossy(&o.stderr).to_string()
 }
 
 fn s(p: &Path) -> &str {

@@ -288,3 +288,15 @@ pub fn composite() -> weft::model::Model {
     m.analysis.output_interval = 1e-6;
     m
 }
+
+/// Runs a binary, asserting success (its stderr in the failure message); returns its
+/// stderr.
+pub fn run_ok(exe: &str, args: &[&str]) -> String {
+    let o = std::process::Command::new(exe).args(args).output().unwrap();
+    assert!(
+        o.status.success(),
+        "{exe} {args:?}: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    String::from_utf8_lossy(&o.stderr).to_string()
+}
