@@ -36,7 +36,8 @@ mod common;
 use std::process::Command;
 
 use common::rel;
-use weft::generate::zones::{woven_reduced, PretensionStart, WovenParams};
+use weft::generate::woven::{woven, Surround, WovenBandParams};
+use weft::generate::zones::{woven_reduced, Interface, PretensionStart, WovenParams};
 use weft::model::io::read_model;
 use weft::model::{ElementKind, Load, Model, PartProps, TimeLaw};
 use weft::solver::{run_in_memory, Solver};
@@ -266,6 +267,81 @@ const K_T: f64 = 3.8661e6; // the paper's fitted k_x = k_y [N/m]
 const K_N: f64 = 5.2448e9; // the paper's fitted k_z [N/m]: 1357 × k_x
 
 /// Rotation by θ about y: the flat fabric tilted into the cone's side.
+#[test]
+fn band_ends_meet_the_membrane_where_the_yarn_level_patch_does() {
+    // `--interface band-ends`: the crossing lines 0 … np are n full yarns and one half
+    // (on the symmetry plane), n + ½ strips of width p, each running to c = (n + ½)p:
+    // yarn mass 2 × ρA/p × c² again (the same lattice bookkeeping as above, with the
+    // interface moved half a spacing out), and 2(n + 1) band ends tied to the membrane.
+    let mut p = WovenParams::paper();
+    p.interface = Interface::BandEnds;
+    p.growth = 1.2;
+    let n = p.yarns / 2;
+    let c = (n as f64 + 0.5) * p.spacing;
+    let m = woven_reduced(&p).unwrap();
+    let expected = 2.0 * p.yarn_density * p.yarn_area / p.spacing * c * c;
+    let got = truss_mass(&m, None);
+    eprintln!("band ends: yarn mass {got:.6e} kg, (2ρA/p) c² {expected:.6e} kg");
+    assert!(rel(got, expected) < 1e-12, "{got} vs {expected}");
+    assert_eq!(m.ties.len(), 2 * (n + 1));
+    for t in &m.ties {
+        let x = m.coords[t.slave];
+        assert!(
+            ((x[0] - c).abs() < 1e-12 || (x[1] - c).abs() < 1e-12) && x[2] == 0.0,
+            "tied node at {x:?}"
+        );
+    }
+    let mp = p.membrane();
+    let mem = mp.density * mp.thickness * (0.25 * p.length * p.length - c * c);
+    let s = Solver::new(&m).unwrap();
+    assert!(rel(s.physical_mass, expected + mem) < 1e-9);
+    // The yarn-level patch of the same crossings (`woven --yarns n + 1 --membrane-length
+    // L/2`): its membrane has the same nodes, and its warp's centre-line crossing nodes on
+    // the diagonal lie where the girder's do when the girder's crimp offset is the
+    // yarn-level crimp amplitude (the positions the §5 study compares by).
+    let (y, info) = woven(&WovenBandParams {
+        yarns: n + 1,
+        surround: Some(Surround::paper(0.5 * p.length)),
+        ..WovenBandParams::default()
+    })
+    .unwrap();
+    let mut q = p.clone();
+    q.crimp = info.crimp_amplitude;
+    let g = woven_reduced(&q).unwrap();
+    let beyond = |m: &Model| {
+        let mut v: Vec<[i64; 2]> = (0..m.num_nodes())
+            .map(|k| m.coords[k])
+            .filter(|x| x[0] > c + 1e-12 || x[1] > c + 1e-12)
+            .map(|x| [(x[0] * 1e9).round() as i64, (x[1] * 1e9).round() as i64])
+            .collect();
+        v.sort();
+        v
+    };
+    let (a, b) = (beyond(&y), beyond(&g));
+    assert!(a.len() > 100, "{} membrane nodes", a.len());
+    assert_eq!(a, b, "the two membranes' nodes differ");
+    let diag = |m: &Model| -> Vec<[f64; 3]> {
+        m.node_sets["diagonal"]
+            .iter()
+            .map(|&k| m.coords[k])
+            .filter(|x| x[0] < c - 1e-12)
+            .collect()
+    };
+    let (dy, dg) = (diag(&y), diag(&g));
+    assert_eq!(dy.len(), n + 1);
+    assert_eq!(dy.len(), dg.len());
+    for (u, v) in dy.iter().zip(&dg) {
+        for k in 0..3 {
+            assert!((u[k] - v[k]).abs() < 1e-15, "{u:?} vs {v:?}");
+        }
+    }
+    // A full model has band ends on both sides: refused, with the option named.
+    let mut f = p.clone();
+    f.quarter = false;
+    let e = woven_reduced(&f).unwrap_err().to_string();
+    assert!(e.contains("--interface band-ends") && e.contains("--full"), "{e}");
+}
+
 fn tilt(theta: f64, v: [f64; 3]) -> [f64; 3] {
     let (s, c) = theta.sin_cos();
     [c * v[0] + s * v[2], v[1], -s * v[0] + c * v[2]]

@@ -9,7 +9,7 @@ use weft::generate::rod::RodParams;
 use weft::generate::square::{GirderParams, LoadCase, MembraneParams, Square};
 use weft::generate::weave::{self, Spec};
 use weft::generate::zones::{
-    Centre, CombinedParams, MembraneProps, PretensionStart, SurroundParams, WovenParams,
+    Centre, CombinedParams, Interface, MembraneProps, PretensionStart, SurroundParams, WovenParams,
 };
 
 /// Axes of the reduced model's links.
@@ -319,6 +319,12 @@ struct WovenArgs {
     /// Growth ratio of the membrane cells away from the patch.
     #[arg(long, default_value_t = 1.25)]
     growth: f64,
+    /// Where the patch meets the membrane: `crossing` (on the last crossing line x = np,
+    /// whose yarns are halved) or `band-ends` (as `woven --membrane-length`: the last
+    /// crossing line a full yarn, the rods running on to the membrane at (n + ½)p; quarter
+    /// only; for comparing with the yarn-level patch).
+    #[arg(long, value_enum, default_value_t = Interface::Crossing)]
+    interface: Interface,
     /// Full model instead of the quarter.
     #[arg(long)]
     full: bool,
@@ -334,6 +340,10 @@ struct WovenArgs {
     /// Impact velocity [m/s].
     #[arg(long, default_value_t = 400.0)]
     projectile_velocity: f64,
+    /// Projectile–yarn Coulomb friction coefficient (the yarn-level `woven` patch's
+    /// default is 0.1).
+    #[arg(long, default_value_t = 0.0)]
+    projectile_friction: f64,
     /// Simulated time [s].
     #[arg(long, default_value_t = 5e-5)]
     end_time: f64,
@@ -589,10 +599,12 @@ fn run() -> anyhow::Result<ExitCode> {
                 length: a.length,
                 growth: a.growth,
                 quarter: !a.full,
+                interface: a.interface,
                 projectile_shape: a.projectile_shape,
                 projectile_radius: a.projectile_radius,
                 projectile_mass: a.projectile_mass,
                 projectile_velocity: a.projectile_velocity,
+                projectile_friction: a.projectile_friction,
                 end_time: a.end_time,
                 output_interval: a.output_interval,
             };

@@ -487,6 +487,20 @@ const RELAX_FORCE_TOLERANCE: f64 = 1e-4;
 const RELAX_KINETIC_TOLERANCE: f64 = 1e-8;
 const RELAX_CREEP_TOLERANCE: f64 = 1e-3;
 
+/// Where the reduced patch meets its membrane surround.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, clap::ValueEnum)]
+#[serde(rename_all = "kebab-case")]
+pub enum Interface {
+    /// On the last crossing line (x = c = np): the yarns along it are halved (the membrane
+    /// carries the other half of their strip) and its crossings lie flat on the membrane.
+    Crossing,
+    /// As the yarn-level patch tied by `woven --membrane-length`: every crossing line
+    /// 0 … np a full yarn (halved only on a symmetry plane), crimped, and the rods run on
+    /// half a spacing past the last crossing to the membrane's edge at c = (n + ½)p, where
+    /// their ends are tied; the membrane's cells there are p/2 wide. Quarter models only.
+    BandEnds,
+}
+
 /// `woven-reduced`: the reduced woven model of the paper's §5.
 #[derive(Debug, Clone, Serialize)]
 pub struct WovenParams {
@@ -523,6 +537,8 @@ pub struct WovenParams {
     pub length: f64,
     pub growth: f64,
     pub quarter: bool,
+    /// Where the patch meets the membrane.
+    pub interface: Interface,
     /// The equivalent membrane around the patch, relative to the yarns.
     pub surround: SurroundParams,
     /// Projectile: flat-nosed by default.
@@ -530,6 +546,8 @@ pub struct WovenParams {
     pub projectile_radius: f64,
     pub projectile_mass: f64,
     pub projectile_velocity: f64,
+    /// Projectile–yarn Coulomb friction μ (0: frictionless, the paper's reduced model).
+    pub projectile_friction: f64,
     pub end_time: f64,
     pub output_interval: f64,
 }
@@ -562,11 +580,13 @@ impl WovenParams {
             length: 0.1,
             growth: 1.25,
             quarter: true,
+            interface: Interface::Crossing,
             surround: SurroundParams::paper(),
             projectile_shape: ProjectileShape::Flat,
             projectile_radius: 4.5e-3,
             projectile_mass: 8e-3,
             projectile_velocity: 400.0,
+            projectile_friction: 0.0,
             end_time: 5e-5,
             output_interval: 1e-6,
         }
@@ -604,6 +624,11 @@ impl WovenParams {
             return Err(WeftError::input(format!("--yarns = `{}`", self.yarns))
                 .expected("an even number ≥ 2 (a crossing at the centre)"));
         }
+        if self.interface == Interface::BandEnds && !self.quarter {
+            return Err(WeftError::input("--interface band-ends with --full".to_string())
+                .expected("a quarter model (the band ends of a full patch lie on both sides)")
+                .hint("leave out --full, or use --interface crossing"));
+        }
         let r = &self.surround;
         let mut positive = vec![
             ("spacing", "m", self.spacing),
@@ -636,6 +661,11 @@ impl WovenParams {
             return Err(WeftError::input(format!("--membrane-poisson = `{nu}`"))
                 .expected("−1 < ν < 1 (an isotropic membrane, ν² < 1)"));
         }
+        let pf = self.projectile_friction;
+        if !(pf >= 0.0 && pf.is_finite()) {
+            return Err(WeftError::input(format!("--projectile-friction = `{pf}`"))
+                .expected("a Coulomb coefficient μ ≥ 0"));
+        }
         if let Some(mu) = self.friction {
             if !(mu >= 0.0 && mu.is_finite()) {
                 return Err(WeftError::input(format!("--link-friction = `{mu}`"))
@@ -656,14 +686,21 @@ impl WovenParams {
 pub fn woven_reduced(p: &WovenParams) -> Result<Model> {
     p.check()?;
     let membrane = p.membrane();
-    let c = 0.5 * p.yarns as f64 * p.spacing;
-    let pos = graded_lines(c, p.spacing, 0.5 * p.length, p.growth)?;
-    let mut m = Model::default();
+    let ends = p.interface == Interface::BandEnds;
     let (n, x0) = if p.quarter {
         (p.yarns / 2, 0.0)
     } else {
-        (p.yarns, -c)
+        (p.yarns, -0.5 * p.yarns as f64 * p.spacing)
     };
+    // The membrane's hole: the last crossing line, or half a spacing past it (band ends,
+    // where the membrane's first cells are p/2 wide, as around the yarn-level patch).
+    let (c, hc) = if ends {
+        ((n as f64 + 0.5) * p.spacing, 0.5 * p.spacing)
+    } else {
+        (0.5 * p.yarns as f64 * p.spacing, p.spacing)
+    };
+    let pos = graded_lines(c, hc, 0.5 * p.length, p.growth)?;
+    let mut m = Model::default();
     let w = n + 1;
     let mut warp = vec![];
     let mut weft = vec![];
@@ -672,7 +709,8 @@ pub fn woven_reduced(p: &WovenParams) -> Result<Model> {
     for j in 0..=n {
         for i in 0..=n {
             let (x, y) = (x0 + i as f64 * p.spacing, x0 + j as f64 * p.spacing);
-            let boundary = (x.abs() - c).abs() < 1e-12 || (y.abs() - c).abs() < 1e-12;
+            let boundary =
+                !ends && ((x.abs() - c).abs() < 1e-12 || (y.abs() - c).abs() < 1e-12);
             // Plain weave: the warp passes over and under alternately; flat on the boundary.
             let z = if boundary {
                 0.0
@@ -685,6 +723,20 @@ pub fn woven_reduced(p: &WovenParams) -> Result<Model> {
             weft.push(m.add_node((2 * (j * w + i) + 2) as i64, [x, y, -z]));
         }
     }
+    // Band ends: the warp on y = jp ends at (c, jp), the weft on x = ip at (ip, c), on the
+    // membrane's plane z = 0 (where the yarn-level bands' crimp cos(πx/p) is zero).
+    let (mut warp_end, mut weft_end) = (vec![], vec![]);
+    if ends {
+        let first = 2 * (w * w) as i64;
+        for k in 0..=n {
+            let t = k as f64 * p.spacing;
+            warp_end.push(m.add_node(first + 1 + k as i64, [c, t, 0.0]));
+            weft_end.push(m.add_node(first + 1 + (w + k) as i64, [t, c, 0.0]));
+        }
+    }
+    // Yarn nodes along the warp j (i = n + 1: its end) and the weft i (j = n + 1).
+    let warp_at = |i: usize, j: usize| if i > n { warp_end[j] } else { warp[j * w + i] };
+    let weft_at = |i: usize, j: usize| if j > n { weft_end[i] } else { weft[j * w + i] };
     let yarn = m.add_part(
         1,
         "yarns",
@@ -758,24 +810,27 @@ pub fn woven_reduced(p: &WovenParams) -> Result<Model> {
     } else {
         (link, link)
     };
-    let on_line = |k: usize| k == 0 || k == n;
+    // Halved: the yarns on a symmetry plane, and (crossing interface) those on the
+    // interface lines; with band ends the last crossing line is a full yarn.
+    let on_line = |k: usize| k == 0 || (k == n && !ends);
+    let last = if ends { n + 1 } else { n };
     let mut eid = 1;
     for j in 0..=n {
         for i in 0..=n {
             let k = j * w + i;
-            if i < n {
+            if i < last {
                 m.add_element(
                     eid,
                     if on_line(j) { half_yarn } else { yarn },
-                    &[warp[k], warp[k + 1]],
+                    &[warp_at(i, j), warp_at(i + 1, j)],
                 );
                 eid += 1;
             }
-            if j < n {
+            if j < last {
                 m.add_element(
                     eid,
                     if on_line(i) { half_yarn } else { yarn },
-                    &[weft[k], weft[k + w]],
+                    &[weft_at(i, j), weft_at(i, j + 1)],
                 );
                 eid += 1;
             }
@@ -799,10 +854,11 @@ pub fn woven_reduced(p: &WovenParams) -> Result<Model> {
                 // height: the mirrored neighbour's chord, level as symmetry asks (a
                 // one-sided chord to k + 1 would tilt the normal by 2a/p and read the
                 // crimp's pressure as a pull there, measured); at k = n the chord to n − 1
-                // (those crossings are tied to the membrane).
+                // (those crossings are tied to the membrane), or with band ends the chord
+                // from n − 1 to the band's end.
                 let chord = |k: usize| match k {
-                    0 => (0, 2.min(n)),
-                    k if k == n => (k - 1, k),
+                    0 => (0, 2.min(last)),
+                    k if k == last => (k - 1, k),
                     k => (k - 1, k + 1),
                 };
                 let ((ia, ib), (ja, jb)) = (chord(i), chord(j));
@@ -810,12 +866,7 @@ pub fn woven_reduced(p: &WovenParams) -> Result<Model> {
                     eid,
                     lk,
                     &pair,
-                    [
-                        warp[j * w + ia],
-                        warp[j * w + ib],
-                        weft[ja * w + i],
-                        weft[jb * w + i],
-                    ],
+                    [warp_at(ia, j), warp_at(ib, j), weft_at(i, ja), weft_at(i, jb)],
                 );
             } else {
                 m.add_element(eid, lk, &pair);
@@ -840,6 +891,8 @@ pub fn woven_reduced(p: &WovenParams) -> Result<Model> {
     let on_boundary: Vec<usize> = warp
         .iter()
         .chain(weft.iter())
+        .chain(warp_end.iter())
+        .chain(weft_end.iter())
         .copied()
         .filter(|&n| {
             let x = m.coords[n];
@@ -860,7 +913,7 @@ pub fn woven_reduced(p: &WovenParams) -> Result<Model> {
         velocity: [0.0, 0.0, -p.projectile_velocity],
         prescribed_velocity: false,
         contact_stiffness: None,
-        friction: 0.0,
+        friction: p.projectile_friction,
         segment_contact: true,
     });
     m.node_sets.insert("reference".into(), warp.clone());
