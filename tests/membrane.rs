@@ -358,3 +358,61 @@ fn membrane_mass_is_density_times_volume() {
         assert!(rel(mass, RHO * S * 0.02 * 0.02) < 1e-12);
     }
 }
+
+/// A band (E₁ = 80 GPa along x, E₂ = 1.6 GPa, G = 0.8 GPa) pre-stretched uniformly along
+/// x and held at both ends, at rest in equilibrium. The stable step is set from the
+/// undeformed band; an St Venant–Kirchhoff band stretched to a Green strain E₁₁ has the
+/// uniaxial tangent modulus dP/dλ = E₁(3λ² − 1)/2 = E₁(1 + 3E₁₁) (P = E₁λ(λ² − 1)/2 the
+/// nominal stress; Bonet & Wood, *Nonlinear Continuum Mechanics for FEA*, §6), so its
+/// stable step shrinks by √(1 + 3E₁₁); the step used leaves the margin
+/// (Δt_stable/Δt)² = 1/dt_safety². The run must stop, naming the element and its strain,
+/// once 1 + 3E₁₁ exceeds that margin, and run below it. Measured: the threshold at
+/// dt_safety 0.9 is E₁₁ = 0.0782; 0.95 of it runs (energy drift 0), 1.05 of it stops at
+/// t = 0. Without the check such a band blows up a few steps later (the yarn-level
+/// impacts at 43–49 µs of 400 m/s variants, README).
+#[test]
+fn a_band_stretched_past_the_steps_margin_stops_with_its_strain_named() {
+    let (nx, ny, lx, ly) = (40, 2, 0.02, 1e-3);
+    let band = |e11: f64, safety: f64| {
+        let (nodes, elems) = rectangle(nx, ny, lx, ly, ElementKind::Quad);
+        let mut m = Model::default();
+        for (i, x) in nodes.iter().enumerate() {
+            m.add_node(i as i64 + 1, *x);
+        }
+        let part = m.add_part(1, "band", ElementKind::Quad, props(80e9, 1.6e9, 0.0, 0.8e9, 0.0));
+        for (e, ns) in elems.iter().enumerate() {
+            m.add_element(e as i64 + 1, part, ns);
+        }
+        // λ from the Green strain E = (λ² − 1)/2; u₀ = (λ − 1) x.
+        let lam = (1.0 + 2.0 * e11).sqrt();
+        m.initial_displacement = nodes.iter().map(|x| [(lam - 1.0) * x[0], 0.0, 0.0]).collect();
+        for (i, x) in nodes.iter().enumerate() {
+            let end = x[0] < 1e-12 || (x[0] - lx).abs() < 1e-12;
+            m.constraints.push((i, [end, true, true]));
+        }
+        m.analysis.dt_safety = safety;
+        m.analysis.end_time = 2e-6;
+        m.analysis.output_interval = 1e-7;
+        m
+    };
+    let safety = 0.9;
+    let s = Solver::new(&band(0.0, safety)).unwrap();
+    let margin = (s.stable.dt_stable / s.stable.dt).powi(2);
+    let threshold = (margin - 1.0) / 3.0;
+    eprintln!("margin {margin:.5} (1/dt_safety² = {:.5}), threshold E11 = {threshold:.4}", 1.0 / (safety * safety));
+    assert!((margin - 1.0 / (safety * safety)).abs() < 1e-9 * margin);
+    let (_s, out, _) = run_in_memory(&band(0.95 * threshold, safety)).unwrap();
+    let e = out.energy.last().unwrap();
+    assert!(e.balance_error.abs() <= 1e-9 * e.internal, "{e:?}");
+    let err = match run_in_memory(&band(1.05 * threshold, safety)) {
+        Ok(_) => panic!("a band stretched past the margin ran"),
+        Err(e) => e.to_string(),
+    };
+    eprintln!("{err}");
+    assert!(
+        err.contains("quad `") && err.contains("Green strain") && err.contains("t = 0"),
+        "{err}"
+    );
+    // With a shorter step the same band runs.
+    run_in_memory(&band(1.05 * threshold, 0.8)).unwrap();
+}

@@ -197,6 +197,24 @@ pub fn green_strain<const N: usize>(x: &[[f64; 3]; N], r: &Reference<N>) -> [f64
     kinematics(x, r).1
 }
 
+/// How far the element has stiffened since the reference configuration, the stable
+/// step's basis: an estimate of λ_max(K_t)/λ_max(K₀) for the total-Lagrangian membrane.
+/// Its material part is E₁(f₁·δf₁)² + E₂(f₂·δf₂)² + G(f₁·δf₂ + f₂·δf₁)² with f_i = F e_i,
+/// |f_i|² = C_ii: the fibre terms grow as C₁₁ and C₂₂, the shear term at most as 2 max C_ii
+/// (D's diagonal E₁, E₂, G; ν's coupling left out); the geometric part adds the largest
+/// principal stress over the stiffest modulus. Uniaxial St Venant–Kirchhoff: 1 + 3E₁₁,
+/// the tangent modulus (3λ² − 1)/2 over E. A band sheared in its plane (G ≪ E₁) stiffens
+/// little: its fibre terms do not see the shear. Returns it with the Green strain.
+pub fn stiffening<const N: usize>(x: &[[f64; 3]; N], r: &Reference<N>, m: &Material) -> (f64, [f64; 3]) {
+    let (_, e) = kinematics(x, r);
+    let (c11, c22) = (1.0 + 2.0 * e[0], 1.0 + 2.0 * e[1]);
+    let (e1, e2, g) = (m.d[0][0], m.d[1][1], m.d[2][2]);
+    let material = ((e1 * c11).max(e2 * c22) + 2.0 * g * c11.max(c22)) / (e1.max(e2) + 2.0 * g);
+    let sv = stress(m, &e);
+    let s_max = (0.5 * (sv[0] + sv[1])).abs() + (0.25 * (sv[0] - sv[1]).powi(2) + sv[2] * sv[2]).sqrt();
+    (material + s_max / m.e_max(), e)
+}
+
 /// Second Piola–Kirchhoff stress [S₁₁, S₂₂, S₁₂] from Voigt strain.
 #[inline(always)]
 pub fn stress(m: &Material, e: &[f64; 3]) -> [f64; 3] {
@@ -430,6 +448,34 @@ pub struct MembraneGroup<const N: usize> {
     /// Element mass ρ s A₀ [kg].
     pub mass: Vec<f64>,
     partials: Vec<EnergyPartial>,
+}
+
+impl<const N: usize> MembraneGroup<N> {
+    /// Adds each element's stiffening (see [`stiffening`]) to its nodes' stiffness rows
+    /// of the stable step, (ratio − 1) × its largest eigenvalue k_max, and keeps, per
+    /// node, the element that adds most: `(added, element index, Green strain)`.
+    pub fn add_stiffening(
+        &self,
+        x: &[[f64; 3]],
+        extra: &mut [f64],
+        most: &mut [Option<(f64, usize, [f64; 3])>],
+    ) {
+        for (e, ns) in self.nodes.iter().enumerate() {
+            let xe: [[f64; 3]; N] = std::array::from_fn(|a| x[ns[a] as usize]);
+            let (r, strain) = stiffening(&xe, &self.reference[e], &self.material[e]);
+            if r <= 1.0 {
+                continue;
+            }
+            let add = (r - 1.0) * self.k_max[e];
+            for &n in ns {
+                let n = n as usize;
+                extra[n] += add;
+                if most[n].is_none_or(|m| add > m.0) {
+                    most[n] = Some((add, e, strain));
+                }
+            }
+        }
+    }
 }
 
 impl<const N: usize> Family for MembraneGroup<N> {

@@ -101,6 +101,87 @@ impl Solver {
         best
     }
 
+    /// The nodal stiffness and damping sums of the stable step, kept for
+    /// [`Solver::check_stiffening`].
+    pub(super) fn step_rows(&self) -> (Vec<f64>, Vec<f64>) {
+        self.nodal_sums()
+    }
+
+    /// Stops a run whose membranes have stretched so far that the fixed step no longer
+    /// suits them. The stable step is set once, from the undeformed model, and an St
+    /// Venant–Kirchhoff membrane stiffens as it stretches (uniaxially by 1 + 3E₁₁): each
+    /// element's stiffening, (ratio − 1) k_max, is added to its nodes' rows of the same
+    /// Gershgorin bound (through ties to their masters, as the bound does), and a node
+    /// whose step with those rows falls below the step in use stops the run, naming the
+    /// element that stiffened it most: a clear message instead of the blow-up a few
+    /// steps later.
+    pub(super) fn check_stiffening(&self, rows: &(Vec<f64>, Vec<f64>), dt: f64) -> crate::error::Result<()> {
+        let x = &self.state.x;
+        let nn = x.len();
+        let mut extra = vec![0.0; nn];
+        let (mut mq, mut mt) = (vec![None; nn], vec![None; nn]);
+        self.op.el.quad.add_stiffening(x, &mut extra, &mut mq);
+        self.op.el.tri.add_stiffening(x, &mut extra, &mut mt);
+        for t in &self.op.ties.ties {
+            for (a, &mn) in t.masters.iter().enumerate() {
+                extra[mn] += t.w[a] * extra[t.slave];
+            }
+        }
+        let (s, c) = rows;
+        for i in 0..nn {
+            if extra[i] <= 0.0 || self.fixed[i] == 0b111 || self.mass[i] <= 0.0 {
+                continue;
+            }
+            let dt_i = nodal_dt(s[i] + extra[i], c[i], self.mass[i], self.alpha);
+            if dt_i >= dt {
+                continue;
+            }
+            // The element that stiffened this node most (a master's may sit on its slave).
+            let pick = |i: usize| -> Option<(ElementKind, i64, [f64; 3], f64)> {
+                let q = mq[i].map(|(a, e, st): (f64, usize, [f64; 3])| (a, ElementKind::Quad, self.op.el.quad.id[e], st));
+                let t = mt[i].map(|(a, e, st): (f64, usize, [f64; 3])| (a, ElementKind::Tri, self.op.el.tri.id[e], st));
+                match (q, t) {
+                    (Some(q), Some(t)) => Some(if q.0 >= t.0 { (q.1, q.2, q.3, q.0) } else { (t.1, t.2, t.3, t.0) }),
+                    (Some(q), None) => Some((q.1, q.2, q.3, q.0)),
+                    (None, Some(t)) => Some((t.1, t.2, t.3, t.0)),
+                    (None, None) => None,
+                }
+            };
+            let who = pick(i).or_else(|| {
+                self.op
+                    .ties
+                    .ties
+                    .iter()
+                    .filter(|t| t.masters.contains(&i))
+                    .filter_map(|t| pick(t.slave))
+                    .max_by(|a, b| a.3.total_cmp(&b.3))
+            });
+            let what = match who {
+                Some((kind, id, e, _)) => format!(
+                    "{} `{id}` has stretched to a Green strain of [{:.3}, {:.3}, {:.3}] (E₁₁, E₂₂, 2E₁₂)",
+                    kind.name(),
+                    e[0],
+                    e[1],
+                    e[2]
+                ),
+                None => "its membranes have stretched".to_string(),
+            };
+            return Err(crate::error::WeftError::Numerical {
+                what: format!(
+                    "{what}, which stiffens node `{}` so far that its stable step {dt_i:.4e} s is now below the step {dt:.4e} s in use",
+                    self.node_id[i]
+                ),
+                step: self.state.step,
+                time: self.state.t,
+                hint: Some(format!(
+                    "the stable step is set once, from the undeformed model; strains this large are beyond what most materials bear (aramid yarns break near 3.6 %) and weft models no failure: shorten end_time, lower the load or the impact velocity, or lower dt_safety (now {}) to run on",
+                    self.analysis.dt_safety
+                )),
+            });
+        }
+        Ok(())
+    }
+
     /// The stiffest element attached to a node.
     pub fn controlling_element(&self, node: usize) -> Option<(ElementKind, i64)> {
         let mut best: Option<(f64, ElementKind, i64)> = None;
