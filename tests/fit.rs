@@ -105,6 +105,7 @@ fn fit_recovers_a_models_own_parameters() {
         cases,
         components: vec![0, 1],
         tolerance: 1e-9,
+        matching: weft::analysis::Matching::Position,
         static_mode: false,
         objective: Objective::Displacement,
     };
@@ -178,6 +179,7 @@ fn section4_errors(cells: usize, static_mode: bool) -> (Vec<f64>, f64, usize) {
         cases,
         components: vec![0, 1],
         tolerance: 1e-9,
+        matching: weft::analysis::Matching::Position,
         static_mode,
         objective: Objective::Displacement,
     };
@@ -264,6 +266,7 @@ fn multistart_is_reproducible_across_thread_counts() {
         )],
         components: vec![0, 1],
         tolerance: 1e-9,
+        matching: weft::analysis::Matching::Position,
         static_mode: false,
         objective: Objective::Displacement,
     };
@@ -447,6 +450,7 @@ fn arrival_time_objective_recovers_the_wave_speed() {
         cases: vec![case("tension", r.clone(), cand.clone())],
         components: vec![0],
         tolerance: 1e-9,
+        matching: weft::analysis::Matching::Position,
         static_mode: false,
         objective: Objective::Arrival {
             component: 3,
