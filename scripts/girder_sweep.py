@@ -18,14 +18,19 @@ PERIODS = {"tension": T, "shear": 40 * T}
 
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("--cells", default="6,8,10", help="N_g of the same-mesh sweep")
-    ap.add_argument("--ratios", type=int, default=4,
+    ap.add_argument("--cells", default="5,6,7,8,9,10", help="N_g of the same-mesh sweep")
+    ap.add_argument("--ratios", type=int, default=5,
                     help="b/a values, log-spaced over the paper's 1/20..1/8 (eq. 3)")
     ap.add_argument("--combined-cells", default="12", help="N_g of the combined sweep")
     ap.add_argument("--membrane-cells", default="4,6", help="N_m of the combined sweep")
     ap.add_argument("--starts", type=int, default=4, help="dynamic multistart starts")
     ap.add_argument("--evaluations", type=int, default=400, help="dynamic evaluations per start")
+    ap.add_argument("--heldout", default="7,0.085",
+                    help="the held-out x: N_g,b/a (not in the training grid)")
+    ap.add_argument("--restarts", type=int, default=5, help="network initialisations per (n1, activation)")
     a = ap.parse_args()
+    hn, hr = a.heldout.split(",")
+    hn, hr = int(hn), float(hr)
     cells = [int(c) for c in a.cells.split(",")]
     ccells = [int(c) for c in a.combined_cells.split(",") if c]
     mcells = [int(c) for c in a.membrane_cells.split(",") if c]
@@ -33,7 +38,9 @@ def main():
     ratios = [(1 / 20) * (2.5 ** (k / (n_r - 1))) if n_r > 1 else 0.1 for k in range(n_r)]
 
     girders = sorted(set((n, k) for n in cells + ccells for k in range(n_r)))
-    membranes = sorted(set(cells + mcells))
+    ratios.append(hr)          # index n_r: the held-out ratio
+    girders.append((hn, n_r))
+    membranes = sorted(set(cells + mcells + [hn]))
     # One fit instance per (x, mode): same-mesh (N_m = N_g, matched by position, all
     # nodes) and combined (N_m < N_g, interpolated, the central zone).
     fits = []
@@ -46,7 +53,7 @@ def main():
                 fits.append((n, k, m, "interpolate", "centre"))
 
     def g(n, k):
-        return f"g{n}-r{k}"
+        return f"g{n}-r{k}" if k < n_r else f"heldout-g{n}"
 
     out = []
     w = out.append
@@ -115,33 +122,36 @@ params = "--param membrane.G12:1e7:1e11:log --param membrane.s:1e-6:1e-2:log"
     w('inputs = { model = "${out}/girder/${name}/${case}" }')
     w('outputs = { run = "${out}/runs/${name}/${mode}-${case}" }\n')
 
-    for mode in ["static", "dynamic"]:
-        w(f"[stages.fit_{mode}]")
-        if mode == "static":
-            w('desc = "the membrane\'s {G, s} fitted to each girder x statically (ρ does not enter a static solve)"')
-            extra = "--static"
-        else:
-            w('desc = "the membrane\'s {G, s, ρ} fitted to each girder x dynamically (multistart)"')
-            extra = f"--param membrane.rho:1e3:1e5:log --expected membrane.rho=${{rho_cf}} --starts {a.starts} --max-evaluations {a.evaluations}"
-        w(f'''cmd = """weft-fit --quiet --threads 1 --components ux,uy --set ${{set}} --match ${{match}} ${{params}} {extra} \\
+    def fit_stages(prefix, fits, where):
+        for mode in ["static", "dynamic"]:
+            w(f"[stages.{prefix}_{mode}]")
+            if mode == "static":
+                w(f'desc = "{where}: the membrane\'s {{G, s}} fitted statically (ρ does not enter a static solve)"')
+                extra = "--static"
+            else:
+                w(f'desc = "{where}: the membrane\'s {{G, s, ρ}} fitted dynamically from the static fit (multistart)"')
+                extra = (f"--param membrane.rho:1e3:1e5:log --expected membrane.rho=${{rho_cf}} "
+                         f"--starts {a.starts} --max-evaluations {a.evaluations}")
+            w(f'''cmd = """weft-fit --quiet --threads 1 --components ux,uy --set ${{set}} --match ${{match}} ${{params}} {extra} \\
   --expected membrane.G12=${{G_cf}} --expected membrane.s=${{s_cf}} \\
   --reference-model ${{inputs.gt}} --reference-history ${{inputs.rt}}/history.parquet --model ${{inputs.mt}} \\
   --reference-model ${{inputs.gs}} --reference-history ${{inputs.rs}}/history.parquet --model ${{inputs.ms}} \\
   --out ${{outputs.fit}}"""''')
-        w("foreach = [")
-        for n, k, m, match, st in fits:
-            r = ratios[k]
-            b = r * L / n
-            w(f'  {{ name = "{g(n, k)}", N_g = {n}, b_g = {b:.10e}, ratio = {r:.10e}, N_m = {m}, '
-              f'match = "{match}", set = "{st}", '
-              f'G_cf = {E * r * r / 2:.10e}, s_cf = {r * r * L / n:.10e}, rho_cf = {RHO_G * (2 - r):.10e} }},')
-        w("]")
-        w(f'inputs = {{ gt = "${{out}}/girder/${{name}}/tension", gs = "${{out}}/girder/${{name}}/shear", '
-          f'rt = "${{out}}/runs/${{name}}/{mode}-tension", rs = "${{out}}/runs/${{name}}/{mode}-shear", '
-          + ('mt = "${out}/membrane/${N_m}/tension", ms = "${out}/membrane/${N_m}/shear" }' if mode == "static" else
-             'mt = "${out}/fit/static/${name}-m${N_m}/models/tension", ms = "${out}/fit/static/${name}-m${N_m}/models/shear" }'))
-        w(f'outputs = {{ fit = "${{out}}/fit/{mode}/${{name}}-m${{N_m}}" }}\n')
+            w("foreach = [")
+            for n, k, m, match, st in fits:
+                r = ratios[k]
+                b = r * L / n
+                w(f'  {{ name = "{g(n, k)}", N_g = {n}, b_g = {b:.10e}, ratio = {r:.10e}, N_m = {m}, '
+                  f'match = "{match}", set = "{st}", '
+                  f'G_cf = {E * r * r / 2:.10e}, s_cf = {r * r * L / n:.10e}, rho_cf = {RHO_G * (2 - r):.10e} }},')
+            w("]")
+            w(f'inputs = {{ gt = "${{out}}/girder/${{name}}/tension", gs = "${{out}}/girder/${{name}}/shear", '
+              f'rt = "${{out}}/runs/${{name}}/{mode}-tension", rs = "${{out}}/runs/${{name}}/{mode}-shear", '
+              + ('mt = "${out}/membrane/${N_m}/tension", ms = "${out}/membrane/${N_m}/shear" }' if mode == "static" else
+                 f'mt = "${{out}}/{prefix}/static/${{name}}-m${{N_m}}/models/tension", ms = "${{out}}/{prefix}/static/${{name}}-m${{N_m}}/models/shear" }}'))
+            w(f'outputs = {{ fit = "${{out}}/{prefix}/{mode}/${{name}}-m${{N_m}}" }}\n')
 
+    fit_stages("fit", fits, "each girder x")
     for mode in ["static", "dynamic"]:
         w(f"""[stages.gather_{mode}]
 desc = "one table x → y, T ({mode} fits, both approaches), the closed forms beside: one row per fit"
@@ -149,6 +159,52 @@ cmd = "weft gather pipelines/girder_sweep.toml --stage fit_{mode} --table fit_ro
 inputs = {{ fits = "${{out}}/fit/{mode}" }}
 outputs = {{ table = "${{out}}/sweep_{mode}.parquet" }}
 """)
+    hb = hr * L / hn
+    xs = f"b_g={hb:.10e},N_g={hn}"
+    w(f"""[stages.surrogate]
+desc = "regression and the paper's network search (n1 = 3..17 × tanh, logistic × {a.restarts} restarts) on the same-mesh dynamic fits: x = {{b_g, N_g}} → y = {{G, s, ρ}}"
+cmd = "weft-surrogate train --table ${{inputs.table}} --filter match=position --inputs b_g,N_g --outputs membrane.G12,membrane.s,membrane.rho --restarts {a.restarts} --out ${{outputs.dir}}"
+inputs = {{ table = "${{out}}/sweep_dynamic.parquet" }}
+outputs = {{ dir = "${{out}}/surrogate" }}
+
+[stages.surrogate_figure]
+desc = "test MSE against n1 per activation, the regression's and the paper's (its Fig. 6b)"
+cmd = "mkdir -p ${{outputs.figs}} && weft-plot surrogate --search ${{inputs.dir}}/search.parquet --surrogate ${{inputs.dir}}/surrogate.json --mark 'paper: 11 tansig, 0.0333=11:0.0333' --title 'Network search: test MSE (normalised outputs)' --out ${{outputs.figs}}/surrogate_search.png"
+inputs = {{ dir = "${{out}}/surrogate" }}
+outputs = {{ figs = "${{out}}/figures" }}
+
+# The held-out x = (N_g = {hn}, b/a = {hr}; b_g = {hb:.6e} m), not in the training grid: the
+# surrogates' prediction, the membrane the network predicts (built with the one-liner
+# weft-weave membrane $$(weft-surrogate predict ... --print-flags network ...)) run against
+# the girder, and a direct fit at that x (static, then dynamic) to compare with.
+[stages.heldout_prediction]
+desc = "both surrogates' y at the held-out x"
+cmd = "weft-surrogate predict --surrogate ${{inputs.dir}}/surrogate.json --x {xs} --out ${{outputs.table}}"
+inputs = {{ dir = "${{out}}/surrogate" }}
+outputs = {{ table = "${{out}}/heldout/prediction.parquet" }}
+
+[stages.heldout_membrane]
+desc = "the membrane the network predicts at the held-out x"
+cmd = "weft-weave membrane --cells {hn} --load-case ${{case}} --period ${{period}} $$(weft-surrogate predict --surrogate ${{inputs.dir}}/surrogate.json --x {xs} --print-flags network --flag membrane.G12=--shear-modulus --flag membrane.s=--thickness --flag membrane.rho=--density) --out ${{outputs.model}}"
+foreach = [{{ case = "tension", period = {PERIODS['tension']:.15e} }}, {{ case = "shear", period = {PERIODS['shear']:.15e} }}]
+inputs = {{ dir = "${{out}}/surrogate" }}
+outputs = {{ model = "${{out}}/heldout/predicted/${{case}}" }}
+
+[stages.heldout_run]
+desc = "explicit run of the predicted membrane"
+cmd = "weft-simulate --quiet --threads 1 --model ${{inputs.model}} --out ${{outputs.run}}"
+matrix = {{ case = ["tension", "shear"] }}
+inputs = {{ model = "${{out}}/heldout/predicted/${{case}}" }}
+outputs = {{ run = "${{out}}/heldout/runs/${{case}}" }}
+
+[stages.heldout_error]
+desc = "T of the predicted membrane against the girder at the held-out x"
+cmd = "weft-error --components ux,uy --set reference --reference-model ${{inputs.g}} --reference-history ${{inputs.gr}}/history.parquet --model ${{inputs.m}} --history ${{inputs.mr}}/history.parquet --out-dir ${{outputs.dir}}"
+matrix = {{ case = ["tension", "shear"] }}
+inputs = {{ g = "${{out}}/girder/{g(hn, n_r)}/${{case}}", gr = "${{out}}/runs/{g(hn, n_r)}/dynamic-${{case}}", m = "${{out}}/heldout/predicted/${{case}}", mr = "${{out}}/heldout/runs/${{case}}" }}
+outputs = {{ dir = "${{out}}/heldout/error/${{case}}" }}
+""")
+    fit_stages("heldout_fit", [(hn, n_r, hn, "position", "reference")], "the held-out x, fitted directly")
     out_txt = "\n".join(out)
     print(out_txt)
 

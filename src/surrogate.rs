@@ -577,6 +577,8 @@ pub struct Experiment {
 #[derive(Debug, Clone, Serialize)]
 pub struct TrainConfig {
     pub table: PathBuf,
+    /// `COLUMN=VALUE`: train on the rows where the column (string or number) equals it.
+    pub filter: Vec<String>,
     pub inputs: Vec<String>,
     pub outputs: Vec<String>,
     pub input_scale: Scale,
@@ -610,6 +612,43 @@ fn column_list(c: &[String]) -> String {
         .map(|s| format!("`{s}`"))
         .collect::<Vec<_>>()
         .join(", ")
+}
+
+/// The rows every `COLUMN=VALUE` filter keeps (a string column compared as text, a
+/// numeric one as a number).
+fn filter_rows(t: &Table, filters: &[String]) -> Result<Vec<bool>> {
+    let mut keep = vec![true; t.num_rows()];
+    for f in filters {
+        let (col, val) = f.split_once('=').ok_or_else(|| {
+            WeftError::input(format!("--filter `{f}`"))
+                .expected("COLUMN=VALUE, e.g. match=position")
+        })?;
+        let (col, val) = (col.trim(), val.trim());
+        let hits: Vec<bool> = match t.str(col, col) {
+            Ok(v) => v.iter().map(|s| s == val).collect(),
+            Err(_) => {
+                let num: f64 = val.parse().map_err(|_| {
+                    WeftError::input(format!("--filter `{f}`: `{val}` is not a number"))
+                        .in_file(&t.path)
+                        .in_column(col.to_string())
+                        .expected("a number for a numeric column")
+                })?;
+                t.f64(col, col)?.iter().map(|&v| v == num).collect()
+            }
+        };
+        for (k, h) in keep.iter_mut().zip(hits) {
+            *k &= h;
+        }
+    }
+    if !keep.iter().any(|&k| k) {
+        return Err(WeftError::input(format!(
+            "no row of the table passes --filter {}",
+            filters.join(" --filter ")
+        ))
+        .in_file(&t.path)
+        .expected("a filter some rows match"));
+    }
+    Ok(keep)
 }
 
 /// Read columns `names` of a table as rows; log-scaled columns must be positive.
@@ -680,8 +719,16 @@ pub fn train(c: &TrainConfig) -> Result<TrainReport> {
     }
     let t = Table::read(&c.table)?;
     let all = column_list(&[c.inputs.clone(), c.outputs.clone()].concat());
-    let x = read_rows(&t, &c.inputs, &all, c.input_scale, "input")?;
-    let y = read_rows(&t, &c.outputs, &all, c.output_scale, "output")?;
+    let keep = filter_rows(&t, &c.filter)?;
+    let pick = |v: Vec<Vec<f64>>| -> Vec<Vec<f64>> {
+        v.into_iter()
+            .zip(&keep)
+            .filter(|p| *p.1)
+            .map(|p| p.0)
+            .collect()
+    };
+    let x = pick(read_rows(&t, &c.inputs, &all, c.input_scale, "input")?);
+    let y = pick(read_rows(&t, &c.outputs, &all, c.output_scale, "output")?);
     let n = x.len();
     let n_test = (c.test * n as f64).round() as usize;
     let n_val = (c.validation * n as f64).round() as usize;
@@ -989,9 +1036,12 @@ impl Surrogate {
 #[derive(Debug, Clone, Serialize)]
 pub struct PredictConfig {
     pub surrogate: PathBuf,
-    /// A table with the surrogate's input columns.
-    pub table: PathBuf,
-    pub out: PathBuf,
+    /// A table with the surrogate's input columns; or
+    pub table: Option<PathBuf>,
+    /// one x given as `NAME=VALUE` per input.
+    pub x: Vec<String>,
+    /// Predictions table (none: not written).
+    pub out: Option<PathBuf>,
 }
 
 /// What prediction reports back: per row outside the training range, a warning.
@@ -999,20 +1049,64 @@ pub struct PredictConfig {
 pub struct PredictReport {
     pub rows: usize,
     pub warnings: Vec<String>,
+    /// Per row, per output: the predictions (raw units).
+    pub regression: Vec<Vec<f64>>,
+    pub network: Vec<Vec<f64>>,
+    pub outputs: Vec<String>,
+}
+
+/// One x from `NAME=VALUE` entries, one per input.
+fn inline_x(s: &Surrogate, entries: &[String]) -> Result<Vec<f64>> {
+    let mut x = vec![None; s.inputs.len()];
+    for e in entries {
+        let (k, v) = e.split_once('=').ok_or_else(|| {
+            WeftError::input(format!("--x `{e}`")).expected("NAME=VALUE, NAME an input")
+        })?;
+        let i = s.inputs.iter().position(|n| n == k.trim()).ok_or_else(|| {
+            WeftError::input(format!("--x `{e}`: `{k}` is not an input of the surrogate"))
+                .expected(format!("one of {}", column_list(&s.inputs)))
+        })?;
+        let v: f64 = v
+            .trim()
+            .parse()
+            .ok()
+            .filter(|v: &f64| v.is_finite())
+            .ok_or_else(|| WeftError::input(format!("--x `{e}`: `{v}` is not a finite number")))?;
+        x[i] = Some(v);
+    }
+    x.iter()
+        .enumerate()
+        .map(|(i, v)| {
+            v.ok_or_else(|| {
+                WeftError::input(format!("--x gives no value for input `{}`", s.inputs[i]))
+                    .expected(format!("a value for each of {}", column_list(&s.inputs)))
+            })
+        })
+        .collect()
 }
 
 /// Predict y for every row of a table of x; write `out` (the inputs, then per output
 /// `NAME_regression` and `NAME_network`, and `in_range`).
 pub fn predict(c: &PredictConfig) -> Result<PredictReport> {
     let s = Surrogate::read(&c.surrogate)?;
-    let t = Table::read(&c.table)?;
-    let x = read_rows(
-        &t,
-        &s.inputs,
-        &column_list(&s.inputs),
-        s.input_maps[0].scale,
-        "input",
-    )?;
+    let x = match (&c.table, c.x.is_empty()) {
+        (Some(table), true) => {
+            let t = Table::read(table)?;
+            read_rows(
+                &t,
+                &s.inputs,
+                &column_list(&s.inputs),
+                s.input_maps[0].scale,
+                "input",
+            )?
+        }
+        (None, false) => vec![inline_x(&s, &c.x)?],
+        _ => {
+            return Err(WeftError::input("give either --table or --x")
+                .expected("a table of inputs, or one x as NAME=VALUE,...")
+                .hint(format!("the inputs are {}", column_list(&s.inputs))))
+        }
+    };
     let mut warnings = vec![];
     let mut in_range = vec![];
     for (r, row) in x.iter().enumerate() {
@@ -1050,15 +1144,22 @@ pub fn predict(c: &PredictConfig) -> Result<PredictReport> {
         ));
     }
     cols.push(Col::Bool("in_range", in_range));
-    let prov = Provenance::new(
-        "surrogate",
-        serde_json::to_value(c).expect("config serialises"),
-    )
-    .with_input(&c.surrogate)?
-    .with_input(&c.table)?;
-    write_table(&c.out, &batch(cols), &prov)?;
+    if let Some(out) = &c.out {
+        let mut prov = Provenance::new(
+            "surrogate",
+            serde_json::to_value(c).expect("config serialises"),
+        )
+        .with_input(&c.surrogate)?;
+        if let Some(t) = &c.table {
+            prov = prov.with_input(t)?;
+        }
+        write_table(out, &batch(cols), &prov)?;
+    }
     Ok(PredictReport {
         rows: x.len(),
         warnings,
+        regression: reg,
+        network: net,
+        outputs: s.outputs.clone(),
     })
 }

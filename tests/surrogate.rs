@@ -59,6 +59,7 @@ fn closed_form_table(path: &Path) {
 fn config(table: &Path, out: &Path) -> TrainConfig {
     TrainConfig {
         table: table.to_path_buf(),
+        filter: vec![],
         inputs: vec!["b_g".into(), "N_g".into()],
         outputs: vec!["G_m".into(), "s_m".into(), "rho_m".into()],
         input_scale: Scale::Log,
@@ -302,4 +303,42 @@ fn bad_training_and_prediction_input_is_explained() {
     assert!(p.has("G_m_network") && p.has("rho_m_regression"));
     let sur = Surrogate::read(&dir.path().join("sur/surrogate.json")).unwrap();
     assert_eq!(sur.inputs, vec!["b_g", "N_g"]);
+    // One x inline, printed as a generator's flags (the held-out check's one-liner).
+    let o = Command::new(exe)
+        .args([
+            "predict",
+            "--surrogate",
+            &d("sur/surrogate.json"),
+            "--x",
+            "b_g=1e-3,N_g=10",
+            "--print-flags",
+            "network",
+            "--flag",
+            "G_m=--shear-modulus",
+            "--flag",
+            "s_m=--thickness",
+        ])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let flags = String::from_utf8_lossy(&o.stdout).to_string();
+    let y = sur.predict_network(&[1e-3, 10.0]);
+    assert_eq!(
+        flags.trim(),
+        format!(
+            "--shear-modulus {:e} --thickness {:e} --rho_m {:e}",
+            y[0], y[1], y[2]
+        )
+    );
+    // An inline x missing an input is refused, naming it.
+    let m = fails(&[
+        "predict",
+        "--surrogate",
+        &d("sur/surrogate.json"),
+        "--x",
+        "b_g=1e-3",
+        "--out",
+        &d("q.parquet"),
+    ]);
+    assert!(m.contains("no value for input `N_g`"), "{m}");
 }

@@ -43,6 +43,9 @@ struct TrainArgs {
     /// Training table (Parquet) with the input and output columns.
     #[arg(long)]
     table: PathBuf,
+    /// Train on the rows where COLUMN equals VALUE (repeat), e.g. `match=position`.
+    #[arg(long, value_name = "COLUMN=VALUE")]
+    filter: Vec<String>,
     /// Input columns x, comma-separated.
     #[arg(long, value_delimiter = ',', required = true)]
     inputs: Vec<String>,
@@ -103,11 +106,23 @@ struct PredictArgs {
     #[arg(long)]
     surrogate: PathBuf,
     /// Table (Parquet) with the surrogate's input columns.
-    #[arg(long)]
-    table: PathBuf,
+    #[arg(long, conflicts_with = "x", required_unless_present = "x")]
+    table: Option<PathBuf>,
+    /// One x instead of a table: NAME=VALUE per input, comma-separated.
+    #[arg(long, value_delimiter = ',')]
+    x: Vec<String>,
     /// Predictions table (Parquet).
-    #[arg(long)]
-    out: PathBuf,
+    #[arg(long, required_unless_present = "print_flags")]
+    out: Option<PathBuf>,
+    /// Print the prediction for the one x on stdout as command-line flags, from this
+    /// surrogate (network or regression), renamed by --flag: for a generator, e.g.
+    /// `weft-weave membrane $(weft-surrogate predict ... --print-flags network
+    /// --flag G_m=--shear-modulus --flag s_m=--thickness --flag rho_m=--density)`.
+    #[arg(long, value_parser = ["network", "regression"])]
+    print_flags: Option<String>,
+    /// OUTPUT=--FLAG: the flag an output is printed as (repeat; default `--OUTPUT`).
+    #[arg(long = "flag", value_name = "OUTPUT=--FLAG")]
+    flags: Vec<String>,
 }
 
 fn parse_range(s: &str) -> Result<(usize, usize), String> {
@@ -129,6 +144,7 @@ fn run() -> anyhow::Result<ExitCode> {
             let a = *a;
             let r = surrogate::train(&surrogate::TrainConfig {
                 table: a.table,
+                filter: a.filter,
                 inputs: a.inputs,
                 outputs: a.outputs,
                 input_scale: a.input_scale,
@@ -175,12 +191,42 @@ fn run() -> anyhow::Result<ExitCode> {
             let r = surrogate::predict(&surrogate::PredictConfig {
                 surrogate: a.surrogate,
                 table: a.table,
+                x: a.x,
                 out: a.out.clone(),
             })?;
             for w in &r.warnings {
                 eprintln!("weft-surrogate: warning: {w}");
             }
-            eprintln!("weft-surrogate: {} rows -> {}", r.rows, a.out.display());
+            if let Some(which) = &a.print_flags {
+                if r.rows != 1 {
+                    anyhow::bail!(
+                        "--print-flags prints one prediction; the table has {} rows (expected one x: use --x)",
+                        r.rows
+                    );
+                }
+                let y = if which == "network" {
+                    &r.network[0]
+                } else {
+                    &r.regression[0]
+                };
+                let mut parts = vec![];
+                for (k, name) in r.outputs.iter().enumerate() {
+                    let flag = a
+                        .flags
+                        .iter()
+                        .find_map(|f| {
+                            f.split_once('=')
+                                .filter(|p| p.0 == name)
+                                .map(|p| p.1.to_string())
+                        })
+                        .unwrap_or_else(|| format!("--{name}"));
+                    parts.push(format!("{flag} {:e}", y[k]));
+                }
+                println!("{}", parts.join(" "));
+            }
+            if let Some(out) = &a.out {
+                eprintln!("weft-surrogate: {} rows -> {}", r.rows, out.display());
+            }
         }
     }
     Ok(ExitCode::SUCCESS)
