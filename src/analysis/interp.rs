@@ -87,9 +87,9 @@ pub fn interpolation(
             }
             let mut bb = [[f64::INFINITY; 3], [f64::NEG_INFINITY; 3]];
             for &i in nodes {
-                for c in 0..3 {
-                    bb[0][c] = bb[0][c].min(m.coords[i][c] - tol);
-                    bb[1][c] = bb[1][c].max(m.coords[i][c] + tol);
+                for (c, &x) in m.coords[i].iter().enumerate() {
+                    bb[0][c] = bb[0][c].min(x - tol);
+                    bb[1][c] = bb[1][c].max(x + tol);
                 }
             }
             elems.push((kind, nodes.to_vec(), bb));
