@@ -2,7 +2,10 @@
 //! (the paper's §3) and the displacement mismatch T between two models (its eq. 2).
 
 pub mod error;
+pub mod interp;
 pub mod wavespeed;
+
+pub use interp::{interpolation, match_ids, Matching, Pairing};
 
 use std::collections::HashMap;
 use std::path::Path;
@@ -40,6 +43,12 @@ pub fn components(list: &str) -> Result<Vec<usize>> {
 
 /// Read the nodes of `set` (in set order) from a model folder and its history table.
 pub fn read_series(model: &Path, history: &Path, set: &str) -> Result<Series> {
+    read_series_of(model, history, set, &[0, 1, 2, 3, 4, 5])
+}
+
+/// [`read_series`] needing only components `needed` (0..6 = ux … vz): a history without
+/// the others (a displacement-only table) reads with them NaN.
+pub fn read_series_of(model: &Path, history: &Path, set: &str, needed: &[usize]) -> Result<Series> {
     let m = read_model(model)?;
     let nodes = m.node_sets.get(set).ok_or_else(|| {
         WeftError::input(format!(
@@ -55,7 +64,7 @@ pub fn read_series(model: &Path, history: &Path, set: &str) -> Result<Series> {
                 .join(", ")
         ))
     })?;
-    read_nodes(&m, history, nodes, &format!("of set `{set}`"))
+    read_nodes_of(&m, history, nodes, &format!("of set `{set}`"), needed)
 }
 
 /// Read the history of model nodes `nodes` (indices, in that order) from a history
@@ -66,13 +75,38 @@ pub fn read_nodes(
     nodes: &[usize],
     what: &str,
 ) -> Result<Series> {
+    read_nodes_of(m, history, nodes, what, &[0, 1, 2, 3, 4, 5])
+}
+
+/// [`read_nodes`] needing only components `needed`; absent others read NaN.
+pub fn read_nodes_of(
+    m: &crate::model::Model,
+    history: &Path,
+    nodes: &[usize],
+    what: &str,
+    needed: &[usize],
+) -> Result<Series> {
     let h = Table::read(history)?;
-    const COLS: &str = "t, node_id, ux, uy, uz, vx, vy, vz";
-    let t = h.f64("t", COLS)?;
-    let ids = h.i64("node_id", COLS)?;
+    let cols_text = format!(
+        "t, node_id, {}",
+        needed
+            .iter()
+            .map(|&c| COMPONENTS[c])
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
+    let t = h.f64("t", &cols_text)?;
+    let ids = h.i64("node_id", &cols_text)?;
     let cols: Vec<Vec<f64>> = COMPONENTS
         .iter()
-        .map(|c| h.f64(c, COLS))
+        .enumerate()
+        .map(|(k, c)| {
+            if needed.contains(&k) || h.has(c) {
+                h.f64(c, &cols_text)
+            } else {
+                Ok(vec![f64::NAN; t.len()])
+            }
+        })
         .collect::<Result<_>>()?;
     let want: HashMap<i64, usize> = nodes
         .iter()
@@ -264,41 +298,94 @@ pub struct Mismatch {
 }
 
 /// For each reference node, the candidate node nearest to it (within `tol` metres).
+///
+/// Two candidate nodes within `tol` of a reference node (coincident nodes, as the warp
+/// and weft nodes of a crossing) are a tie that position cannot break: an error, never a
+/// silent pick of one of them.
 pub fn match_nodes(reference: &Series, candidate: &Series, tol: f64) -> Result<Vec<usize>> {
     let mut used = HashMap::new();
     let mut out = Vec::with_capacity(reference.node_id.len());
+    const HOW: &str =
+        "compare node sets that hold one node per position (--set, --candidate-set), \
+                       or match by node id (--match id) when both models number the nodes alike";
     for (j, x) in reference.x0.iter().enumerate() {
-        let (k, d) = candidate
+        let d = |y: &[f64; 3]| {
+            ((x[0] - y[0]).powi(2) + (x[1] - y[1]).powi(2) + (x[2] - y[2]).powi(2)).sqrt()
+        };
+        let (k, dk) = candidate
             .x0
             .iter()
             .enumerate()
-            .map(|(k, y)| {
-                (
-                    k,
-                    ((x[0] - y[0]).powi(2) + (x[1] - y[1]).powi(2) + (x[2] - y[2]).powi(2)).sqrt(),
-                )
-            })
+            .map(|(k, y)| (k, d(y)))
             .min_by(|a, b| a.1.total_cmp(&b.1))
             .ok_or_else(|| WeftError::input("the candidate node set is empty"))?;
-        if d > tol {
+        if dk > tol {
             return Err(WeftError::input(format!(
-                "reference node `{}` at {:?} has no candidate node within {tol:e} m (nearest: `{}` at {d:.3e} m)",
+                "reference node `{}` at {:?} has no candidate node within {tol:e} m (nearest: `{}` at {dk:.3e} m)",
                 reference.node_id[j], x, candidate.node_id[k]
             ))
             .expected("a candidate node at every reference position")
-            .hint("compare node sets on the same positions, or raise --tolerance"));
+            .hint("compare node sets on the same positions, raise --tolerance, or interpolate in the candidate's elements (--match interpolate) when the meshes differ"));
+        }
+        let near: Vec<(usize, f64)> = candidate
+            .x0
+            .iter()
+            .enumerate()
+            .map(|(k, y)| (k, d(y)))
+            .filter(|&(_, e)| e <= tol)
+            .collect();
+        if near.len() > 1 {
+            return Err(WeftError::input(format!(
+                "reference node `{}` at {:?} is tied between {} candidate nodes within {tol:e} m: {}",
+                reference.node_id[j],
+                x,
+                near.len(),
+                near.iter()
+                    .map(|&(k, e)| format!("`{}` at {e:.3e} m", candidate.node_id[k]))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ))
+            .expected("one candidate node per reference position (coincident nodes, as at a yarn crossing, cannot be told apart by position)")
+            .hint(HOW));
         }
         if let Some(prev) = used.insert(k, j) {
             return Err(WeftError::input(format!(
-                "reference nodes `{}` and `{}` both match candidate node `{}`",
-                reference.node_id[prev], reference.node_id[j], candidate.node_id[k]
+                "reference nodes `{}` and `{}` both match candidate node `{}` (at {:.3e} m and {dk:.3e} m)",
+                reference.node_id[prev],
+                reference.node_id[j],
+                candidate.node_id[k],
+                dist3(&reference.x0[prev], &candidate.x0[k]),
             ))
             .expected("one candidate node per reference node")
-            .hint("lower --tolerance"));
+            .hint(if dk < tol * 0.5 && dist3(&reference.x0[prev], &candidate.x0[k]) < tol * 0.5 {
+                HOW.to_string()
+            } else {
+                format!("lower --tolerance, or {HOW}")
+            }));
         }
         out.push(k);
     }
     Ok(out)
+}
+
+fn dist3(a: &[f64; 3], b: &[f64; 3]) -> f64 {
+    ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
+}
+
+/// Pair reference nodes with candidate series entries by position or by id (see
+/// [`Matching`]); interpolation needs the candidate's elements: [`interpolation`].
+pub fn pair(reference: &Series, candidate: &Series, tol: f64, how: Matching) -> Result<Pairing> {
+    let k = match how {
+        Matching::Position => match_nodes(reference, candidate, tol)?,
+        Matching::Id => match_ids(reference, candidate)?,
+        Matching::Interpolate => {
+            return Err(
+                WeftError::input("interpolation needs the candidate model's elements")
+                    .expected("analysis::interpolation to pair the nodes"),
+            )
+        }
+    };
+    Ok(k.into_iter().map(|k| vec![(k, 1.0)]).collect())
 }
 
 /// Linear interpolation of the candidate's samples onto times `t`.
@@ -334,7 +421,19 @@ pub fn mismatch(
     tol: f64,
     static_mode: bool,
 ) -> Result<Mismatch> {
-    let pairs = match_nodes(reference, candidate, tol)?;
+    let pairs = pair(reference, candidate, tol, Matching::Position)?;
+    mismatch_paired(reference, candidate, &pairs, comps, static_mode)
+}
+
+/// T between a candidate and a reference whose nodes are paired by `pairs` (a
+/// reference node's candidate value is the weighted sum of the candidate entries).
+pub fn mismatch_paired(
+    reference: &Series,
+    candidate: &Series,
+    pairs: &Pairing,
+    comps: &[usize],
+    static_mode: bool,
+) -> Result<Mismatch> {
     let (t, q_all): (Vec<f64>, Vec<Vec<[f64; 6]>>) = if static_mode {
         (
             vec![*reference.t.last().expect("samples")],
@@ -354,10 +453,11 @@ pub fn mismatch(
     let mut peak_d = vec![0.0f64; n];
     let mut peak_q = vec![0.0f64; n];
     for k in 0..t.len() {
-        for (j, &c) in pairs.iter().enumerate() {
+        for (j, w) in pairs.iter().enumerate() {
             let (mut d2, mut p2, mut q2) = (0.0, 0.0, 0.0);
             for &comp in comps {
-                let (p, q) = (p_all[k][c][comp], q_all[k][j][comp]);
+                let p: f64 = w.iter().map(|&(c, wt)| wt * p_all[k][c][comp]).sum();
+                let q = q_all[k][j][comp];
                 d2 += (p - q) * (p - q);
                 p2 += p * p;
                 q2 += q * q;
@@ -388,7 +488,17 @@ pub fn mismatch(
         .map(|j| {
             (
                 reference.node_id[j],
-                candidate.node_id[pairs[j]],
+                // The entry of largest weight (the node itself unless interpolated).
+                candidate.node_id[pairs[j]
+                    .iter()
+                    .fold((0usize, f64::NEG_INFINITY), |b, &(c, w)| {
+                        if w > b.1 {
+                            (c, w)
+                        } else {
+                            b
+                        }
+                    })
+                    .0],
                 if peak_q[j] > 0.0 {
                     peak_d[j] / peak_q[j]
                 } else {

@@ -29,7 +29,7 @@ use std::time::Instant;
 use rayon::prelude::*;
 use serde::Serialize;
 
-use crate::analysis::{mismatch, Series};
+use crate::analysis::{interpolation, mismatch_paired, pair, Matching, Pairing, Series};
 use crate::error::{Result, WeftError};
 use crate::model::{props, Model, PartProps};
 use crate::solver::output::MemorySink;
@@ -246,6 +246,9 @@ pub struct Problem {
     pub components: Vec<usize>,
     /// Node matching tolerance [m].
     pub tolerance: f64,
+    /// How reference nodes find their candidate values: by position, by id, or
+    /// interpolated in the candidate's elements (meshes that differ).
+    pub matching: Matching,
     /// Linear static solves, comparing final displacements.
     pub static_mode: bool,
     /// What is compared: displacement histories (T), or wave arrival times.
@@ -278,6 +281,17 @@ pub fn arrival_mismatch(
     tol: f64,
 ) -> Result<f64> {
     let pairs = crate::analysis::match_nodes(reference, candidate, tol)?;
+    arrival_mismatch_paired(reference, candidate, &pairs, component, level)
+}
+
+/// [`arrival_mismatch`] with reference node j paired to candidate entry `pairs[j]`.
+pub fn arrival_mismatch_paired(
+    reference: &Series,
+    candidate: &Series,
+    pairs: &[usize],
+    component: usize,
+    level: crate::analysis::Level,
+) -> Result<f64> {
     let wr = crate::analysis::wave_speeds(reference, component, level);
     let wc = crate::analysis::wave_speeds(candidate, component, level);
     let end = *candidate.t.last().expect("samples");
@@ -329,13 +343,24 @@ impl Problem {
                         .join(", ")
                 ))
             })?;
+            if self.matching == Matching::Interpolate {
+                interpolation(
+                    &c.model,
+                    None,
+                    &c.reference.x0,
+                    &c.reference.node_id,
+                    self.tolerance,
+                )
+                .map_err(|e| prefix(e, &c.name))?;
+                continue;
+            }
             let cand = Series {
                 t: vec![0.0],
                 node_id: set.iter().map(|&i| c.model.node_id[i]).collect(),
                 x0: set.iter().map(|&i| c.model.coords[i]).collect(),
                 values: vec![vec![[0.0; 6]; set.len()]],
             };
-            crate::analysis::match_nodes(&c.reference, &cand, self.tolerance)
+            pair(&c.reference, &cand, self.tolerance, self.matching)
                 .map_err(|e| prefix(e, &c.name))?;
         }
         Ok(())
@@ -348,18 +373,39 @@ impl Problem {
         m
     }
 
+    /// The candidate's response at `m` over the nodes the comparison needs, and the
+    /// pairing of the reference's nodes onto it (interpolation searches all of the
+    /// candidate's membrane, truss and beam elements).
+    fn candidate_response(&self, c: &Case, m: &Model) -> Result<(Series, Pairing)> {
+        if self.matching == Matching::Interpolate {
+            let (nodes, pairs) = interpolation(
+                m,
+                None,
+                &c.reference.x0,
+                &c.reference.node_id,
+                self.tolerance,
+            )?;
+            return Ok((respond_nodes(m, &nodes, self.static_mode)?, pairs));
+        }
+        let cand = respond(m, &c.set, self.static_mode)?;
+        let pairs = pair(&c.reference, &cand, self.tolerance, self.matching)?;
+        Ok((cand, pairs))
+    }
+
     /// T of one case at `x` (physical values).
     pub fn case_t(&self, k: usize, x: &[f64]) -> Result<f64> {
         let c = &self.cases[k];
-        let cand = respond(&self.model_at(k, x), &c.set, self.static_mode)?;
+        let (cand, pairs) = self.candidate_response(c, &self.model_at(k, x))?;
         if let Objective::Arrival { component, level } = self.objective {
-            return arrival_mismatch(&c.reference, &cand, component, level, self.tolerance);
+            let aligned = aligned(&cand, &pairs, &c.reference);
+            let identity: Vec<usize> = (0..pairs.len()).collect();
+            return arrival_mismatch_paired(&c.reference, &aligned, &identity, component, level);
         }
-        Ok(mismatch(
+        Ok(mismatch_paired(
             &c.reference,
             &cand,
+            &pairs,
             &self.components,
-            self.tolerance,
             self.static_mode,
         )?
         .t_value)
@@ -385,10 +431,43 @@ impl Problem {
     }
 }
 
+/// The candidate's values paired onto the reference's nodes: one entry per reference
+/// node (at its position), the weighted sums of `pairs`.
+pub fn aligned(candidate: &Series, pairs: &Pairing, reference: &Series) -> Series {
+    Series {
+        t: candidate.t.clone(),
+        node_id: pairs
+            .iter()
+            .map(|w| {
+                candidate.node_id[w
+                    .iter()
+                    .fold((0usize, f64::NEG_INFINITY), |b, &(c, x)| {
+                        if x > b.1 {
+                            (c, x)
+                        } else {
+                            b
+                        }
+                    })
+                    .0]
+            })
+            .collect(),
+        x0: reference.x0.clone(),
+        values: candidate
+            .values
+            .iter()
+            .map(|v| {
+                pairs
+                    .iter()
+                    .map(|w| std::array::from_fn(|q| w.iter().map(|&(c, x)| x * v[c][q]).sum()))
+                    .collect()
+            })
+            .collect(),
+    }
+}
+
 /// Solve a model in-process (explicit, or the linear static solve) and return the
 /// response of node set `set` as a [`Series`] (one sample at t = 0 when static).
 pub fn respond(m: &Model, set: &str, static_mode: bool) -> Result<Series> {
-    let mut m = m.clone();
     let nodes = m
         .node_sets
         .get(set)
@@ -399,6 +478,15 @@ pub fn respond(m: &Model, set: &str, static_mode: bool) -> Result<Series> {
             ))
         })?
         .clone();
+    respond_nodes(m, &nodes, static_mode)
+}
+
+/// [`respond`] over model nodes `nodes` (indices, in that order).
+pub fn respond_nodes(m: &Model, nodes: &[usize], static_mode: bool) -> Result<Series> {
+    const SET: &str = "__weft_compared";
+    let mut m = m.clone();
+    m.node_sets.insert(SET.to_string(), nodes.to_vec());
+    let set = SET;
     m.analysis.history_sets = vec![set.to_string()];
     let solver = match Solver::new(&m) {
         // A fixed step chosen for the generator's parameters may exceed the stable step of

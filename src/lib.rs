@@ -4,7 +4,7 @@
 //! Layout: [`model`] (the model and its folder of tables), [`solver`] (explicit central
 //! difference, element kernels, output sinks), [`simulate`] (the stage behind
 //! `weft-simulate`), [`generate`] (canonical models behind `weft-weave`), [`plot`]
-//! (the figures behind `weft-plot`), [`vtk`] (ParaView time series behind `weft-vtk`), [`export`] (CalculiX and LS-DYNA decks behind `weft-export`), [`table`]
+//! (the figures behind `weft-plot`), [`vtk`] (ParaView time series behind `weft-vtk`), [`export`] (CalculiX and LS-DYNA decks behind `weft-export`), [`surrogate`] (regression and network surrogates behind `weft-surrogate`), [`table`]
 //! (validated Parquet I/O with provenance), [`error`] (typed errors), [`cli`] (what the
 //! stage binaries share: `main`, error printing, progress).
 
@@ -21,6 +21,7 @@ pub mod pipeline;
 pub mod plot;
 pub mod simulate;
 pub mod solver;
+pub mod surrogate;
 pub mod table;
 pub mod vtk;
 

@@ -47,6 +47,20 @@ pub enum Figure {
     /// A colour map of a nodal quantity over the mesh at one time, several models side
     /// by side on one colour scale (the paper's Fig. 4).
     Field(field::FieldFigure),
+    /// Test MSE of a network search against the hidden neurons n₁, per activation
+    /// (search.parquet; the paper's Fig. 6b).
+    Surrogate(SurrogateFigure),
+}
+
+/// A network search (weft-surrogate's search.parquet): every experiment's test MSE as a
+/// point, the best restart per n₁ as a line, per activation.
+#[derive(Debug, Clone)]
+pub struct SurrogateFigure {
+    pub search: PathBuf,
+    /// Reference points to mark, `(label, n₁, MSE)` (the paper's 0.0333 at 11 tansig).
+    pub mark: Vec<(String, f64, f64)>,
+    /// The regression's test MSE, drawn as a dashed line (from surrogate.json).
+    pub regression: Option<f64>,
 }
 
 /// Where and how large the figure is drawn.
@@ -145,6 +159,7 @@ pub fn run(c: &Config) -> anyhow::Result<Report> {
         Figure::Wavespeed(a) => wavespeed(a)?,
         Figure::Error(a) => error(a)?,
         Figure::Fit(a) => fit(a)?,
+        Figure::Surrogate(a) => surrogate(a)?,
         Figure::Weave(a) => weave(a)?,
         Figure::Field(a) => {
             let (f, report) = field::build(a)?;
@@ -647,6 +662,73 @@ fn fit(a: &FitFigure) -> Result<Chart> {
         title: None,
         x_label: "evaluations".into(),
         y_label: "T".into(),
+        log_y: true,
+        series,
+    })
+}
+
+fn surrogate(a: &SurrogateFigure) -> Result<Chart> {
+    let t = Table::read(&a.search)?;
+    const COLS: &str = "hidden, activation, test_mse";
+    let h = t.i64("hidden", COLS)?;
+    let act = t.str("activation", COLS)?;
+    let mse = t.f64_opt("test_mse")?.ok_or_else(|| {
+        WeftError::input("missing column `test_mse`")
+            .in_file(&a.search)
+            .expected(format!("columns {COLS} (weft-surrogate's search.parquet)"))
+    })?;
+    let mut names: Vec<String> = act.clone();
+    names.dedup();
+    names.sort();
+    names.dedup();
+    let (x_lo, x_hi) = (
+        h.iter().copied().min().unwrap_or(0) as f64,
+        h.iter().copied().max().unwrap_or(1) as f64,
+    );
+    let mut series = vec![];
+    for (k, name) in names.iter().enumerate() {
+        let pts: Vec<(f64, f64)> = (0..h.len())
+            .filter(|&r| &act[r] == name)
+            .filter_map(|r| mse[r].filter(|v| *v > 0.0).map(|v| (h[r] as f64, v)))
+            .collect();
+        let mut best: std::collections::BTreeMap<i64, f64> = Default::default();
+        for &(x, y) in &pts {
+            let e = best.entry(x as i64).or_insert(f64::INFINITY);
+            *e = e.min(y);
+        }
+        series.push(Series {
+            label: format!("{name}: each restart"),
+            points: pts,
+            style: Style::Points,
+            color: k,
+        });
+        series.push(Series {
+            label: format!("{name}: best restart"),
+            points: best.into_iter().map(|(x, y)| (x as f64, y)).collect(),
+            style: Style::Line,
+            color: k,
+        });
+    }
+    if let Some(r) = a.regression.filter(|v| *v > 0.0) {
+        series.push(Series {
+            label: format!("regression ({r:.3e})"),
+            points: vec![(x_lo, r), (x_hi, r)],
+            style: Style::Dashed,
+            color: names.len() + 1,
+        });
+    }
+    for (k, (l, x, y)) in a.mark.iter().enumerate() {
+        series.push(Series {
+            label: l.clone(),
+            points: vec![(*x, *y)],
+            style: Style::Points,
+            color: names.len() + 2 + k,
+        });
+    }
+    Ok(Chart {
+        title: None,
+        x_label: "hidden neurons n₁".into(),
+        y_label: "test MSE (normalised outputs)".into(),
         log_y: true,
         series,
     })

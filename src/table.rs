@@ -90,6 +90,8 @@ pub enum Col {
     OptStr(&'static str, Vec<Option<String>>),
     /// A float column whose name is only known at run time (a fitted parameter's).
     F64Named(String, Vec<f64>),
+    /// A nullable float column named at run time.
+    OptF64Named(String, Vec<Option<f64>>),
 }
 
 impl Col {
@@ -125,6 +127,10 @@ impl Col {
             ),
             Col::F64Named(n, v) => (
                 Field::new(n, DataType::Float64, false),
+                Arc::new(Float64Array::from(v)),
+            ),
+            Col::OptF64Named(n, v) => (
+                Field::new(n, DataType::Float64, true),
                 Arc::new(Float64Array::from(v)),
             ),
         }

@@ -382,3 +382,296 @@ fn error_stage_compares_a_girder_with_its_closed_form_membrane() {
     // spread over the panel gives T ≈ δ²/2 ≈ 1.8e-3.
     assert!(t[1].0 > 1e-3 && t[1].0 < 4e-3, "shear T {}", t[1].0);
 }
+
+// ---- Comparing models whose meshes differ (issue 14, item 1) ----
+
+use weft::analysis::{interpolation, mismatch_paired, pair, Matching};
+use weft::model::{ElementKind, Model, PartProps};
+
+/// A linear field u(x) = A x + c (each of the six components its own row).
+fn linear(x: &[f64; 3]) -> [f64; 6] {
+    const A: [[f64; 3]; 6] = [
+        [1.3, -0.7, 0.2],
+        [0.4, 2.1, -1.1],
+        [-0.9, 0.3, 0.8],
+        [0.5, 0.5, -0.5],
+        [2.0, -1.0, 0.1],
+        [-0.3, 0.9, 1.7],
+    ];
+    const C: [f64; 6] = [0.01, -0.02, 0.03, 0.0, 0.1, -0.1];
+    std::array::from_fn(|k| C[k] + (0..3).map(|j| A[k][j] * x[j]).sum::<f64>())
+}
+
+/// One element of each kind, apart, in 3-D and distorted: a triangle, a non-parallelogram
+/// quad in a tilted plane, a truss and a beam along slanted axes.
+fn one_of_each() -> (Model, Vec<(ElementKind, Vec<usize>)>) {
+    let mut m = Model::default();
+    let mut els = vec![];
+    let mut id = 0i64;
+    let mut add = |m: &mut Model, kind: ElementKind, xs: &[[f64; 3]]| {
+        let part = m.add_part(
+            m.parts.len() as i64 + 1,
+            kind.name(),
+            kind,
+            PartProps::default(),
+        );
+        let nodes: Vec<usize> = xs
+            .iter()
+            .map(|x| {
+                id += 1;
+                m.add_node(100 + id, *x)
+            })
+            .collect();
+        m.add_element(id, part, &nodes);
+        els.push((kind, nodes));
+    };
+    add(
+        &mut m,
+        ElementKind::Tri,
+        &[[0.0, 0.0, 0.0], [0.03, 0.005, 0.002], [0.01, 0.025, -0.004]],
+    );
+    // A quad with no parallel sides, its plane tilted about x (z = 0.3 y).
+    let q = |x: f64, y: f64| [x, y, 0.3 * y];
+    add(
+        &mut m,
+        ElementKind::Quad,
+        &[q(0.1, 0.0), q(0.14, 0.01), q(0.135, 0.05), q(0.095, 0.035)],
+    );
+    add(
+        &mut m,
+        ElementKind::Truss,
+        &[[0.2, 0.0, 0.0], [0.23, 0.02, 0.01]],
+    );
+    add(
+        &mut m,
+        ElementKind::Beam,
+        &[[0.3, 0.0, 0.0], [0.31, -0.02, 0.03]],
+    );
+    (m, els)
+}
+
+#[test]
+fn interpolation_reproduces_a_linear_field_exactly_on_every_element_kind() {
+    // Linear shape functions (triangle, truss and beam axis) and the isoparametric
+    // bilinear quad reproduce any linear field exactly (Zienkiewicz & Taylor, The Finite
+    // Element Method vol. 1, §9.5, completeness of isoparametric elements): the
+    // interpolated value at any interior point equals the field there, to rounding.
+    let (m, els) = one_of_each();
+    let mut points = vec![];
+    let mut kinds = vec![];
+    for (kind, nodes) in &els {
+        let x: Vec<[f64; 3]> = nodes.iter().map(|&i| m.coords[i]).collect();
+        let locals: Vec<Vec<f64>> = match kind {
+            ElementKind::Tri => vec![
+                vec![0.2, 0.3, 0.5],
+                vec![0.6, 0.1, 0.3],
+                vec![1.0, 0.0, 0.0],
+            ],
+            ElementKind::Quad => {
+                let n = |xi: f64, eta: f64| {
+                    vec![
+                        0.25 * (1.0 - xi) * (1.0 - eta),
+                        0.25 * (1.0 + xi) * (1.0 - eta),
+                        0.25 * (1.0 + xi) * (1.0 + eta),
+                        0.25 * (1.0 - xi) * (1.0 + eta),
+                    ]
+                };
+                vec![n(0.3, -0.6), n(-0.8, 0.7), n(0.0, 1.0)]
+            }
+            _ => vec![vec![0.75, 0.25], vec![0.1, 0.9]],
+        };
+        for w in locals {
+            points.push(std::array::from_fn::<f64, 3, _>(|c| {
+                w.iter().zip(&x).map(|(w, x)| w * x[c]).sum()
+            }));
+            kinds.push(*kind);
+        }
+    }
+    let ids: Vec<i64> = (0..points.len() as i64).collect();
+    let (nodes, pairs) = interpolation(&m, None, &points, &ids, 1e-9).unwrap();
+    let mut worst = 0.0f64;
+    for (j, p) in points.iter().enumerate() {
+        let exact = linear(p);
+        for k in 0..6 {
+            let v: f64 = pairs[j]
+                .iter()
+                .map(|&(c, w)| w * linear(&m.coords[nodes[c]])[k])
+                .sum();
+            let e = (v - exact[k]).abs();
+            worst = worst.max(e);
+            assert!(
+                e < 5e-16,
+                "{:?} point {j} component {k}: {v} vs {}",
+                kinds[j],
+                exact[k]
+            );
+        }
+    }
+    // Measured: 1.1e-16 (|u| ~ 0.1).
+    eprintln!("linear field: worst interpolation error {worst:.1e}");
+    // Through T: a reference carrying the field at the points, a candidate carrying it at
+    // the element nodes only, give T = 0 to rounding.
+    let q = Series {
+        t: vec![0.0, 1.0],
+        node_id: ids.clone(),
+        x0: points.clone(),
+        values: vec![points.iter().map(linear).collect(); 2],
+    };
+    let p = Series {
+        t: vec![0.0, 1.0],
+        node_id: nodes.iter().map(|&i| m.node_id[i]).collect(),
+        x0: nodes.iter().map(|&i| m.coords[i]).collect(),
+        values: vec![nodes.iter().map(|&i| linear(&m.coords[i])).collect(); 2],
+    };
+    let r = mismatch_paired(&q, &p, &pairs, &[0, 1, 2, 3, 4, 5], false).unwrap();
+    assert!(r.t_value < 1e-28, "T {}", r.t_value);
+    // A point off every element (5 µm out of the quad's plane) is refused, naming it.
+    let off = [[0.12, 0.02, 0.3 * 0.02 + 5e-6]];
+    let err = interpolation(&m, None, &off, &[7], 1e-9)
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(
+        err.contains("reference node `7`") && err.contains("no candidate element"),
+        "{err}"
+    );
+}
+
+#[test]
+fn coincident_nodes_are_a_tie_that_position_matching_refuses() {
+    // A yarn crossing: warp node 10 and weft node 11 at the same point, moving
+    // differently. Position cannot tell them apart: the match must be refused with a way
+    // out, and matching by id must pair them right (T = 0 exactly).
+    let at = |ids: &[i64], vals: &[f64]| Series {
+        t: vec![0.0, 1.0],
+        node_id: ids.to_vec(),
+        x0: vec![[0.001, 0.002, 0.0]; ids.len()],
+        values: vec![
+            vec![[0.0; 6]; ids.len()],
+            vals.iter().map(|&v| [v, 0.0, 0.0, 0.0, 0.0, 0.0]).collect(),
+        ],
+    };
+    let q = at(&[10, 11], &[1.0, 2.0]);
+    let p = at(&[11, 10], &[2.0, 1.0]);
+    let err = match_nodes(&q, &p, 1e-9).err().unwrap().to_string();
+    assert!(
+        err.contains("reference node `10`")
+            && err.contains("tied between 2 candidate nodes")
+            && err.contains("--match id")
+            && err.contains("--candidate-set")
+            && !err.contains("lower --tolerance"),
+        "{err}"
+    );
+    let pairs = pair(&q, &p, 1e-9, Matching::Id).unwrap();
+    assert_eq!(pairs, vec![vec![(1, 1.0)], vec![(0, 1.0)]]);
+    assert_eq!(
+        mismatch_paired(&q, &p, &pairs, &[0], false)
+            .unwrap()
+            .t_value,
+        0.0
+    );
+    // A missing id is an error naming the node.
+    let r = at(&[10, 12], &[1.0, 2.0]);
+    let err = pair(&r, &p, 1e-9, Matching::Id).err().unwrap().to_string();
+    assert!(
+        err.contains("reference node `12`") && err.contains("hint:"),
+        "{err}"
+    );
+}
+
+#[test]
+fn error_stage_interpolates_a_coarser_membrane_and_needs_no_velocities() {
+    // Static tension of the equivalent membrane (ν = 0), clamped (translations) at x = 0,
+    // the edge x = L loaded uniformly: u_x = F x/(E s L), u_y = 0, a linear field that
+    // bilinear quads of any size reproduce. So a 4 × 4 membrane interpolated at the nodes
+    // of a 10 × 10 one (none coincide inside) gives T = 0 to the static solver's tolerance,
+    // where position matching finds no partner. The candidate's history is rewritten
+    // without its velocity columns: a displacement comparison must not need them.
+    let dir = tempfile::tempdir().unwrap();
+    let d = |s: &str| dir.path().join(s).display().to_string();
+    let (weave, sim, err) = (
+        env!("CARGO_BIN_EXE_weft-weave"),
+        env!("CARGO_BIN_EXE_weft-simulate"),
+        env!("CARGO_BIN_EXE_weft-error"),
+    );
+    for (name, n) in [("fine", "10"), ("coarse", "4")] {
+        // The same material in both (the defaults follow the cell size: s = a/100).
+        run_ok(
+            weave,
+            &[
+                "membrane",
+                "--cells",
+                n,
+                "--load-case",
+                "tension",
+                "--thickness",
+                "1e-4",
+                "--out",
+                &d(name),
+            ],
+        );
+        run_ok(
+            sim,
+            &[
+                "--model",
+                &d(name),
+                "--static",
+                "-q",
+                "--out",
+                &d(&format!("{name}-out")),
+            ],
+        );
+    }
+    let h = weft::table::Table::read(&dir.path().join("coarse-out/history.parquet")).unwrap();
+    use weft::table::Col;
+    weft::table::write_table(
+        &dir.path().join("coarse-out/disp.parquet"),
+        &weft::table::batch(vec![
+            Col::F64("t", h.f64("t", "").unwrap()),
+            Col::I64("node_id", h.i64("node_id", "").unwrap()),
+            Col::F64("ux", h.f64("ux", "").unwrap()),
+            Col::F64("uy", h.f64("uy", "").unwrap()),
+            Col::F64("uz", h.f64("uz", "").unwrap()),
+        ]),
+        &weft::table::Provenance::new("test", serde_json::json!({})),
+    )
+    .unwrap();
+    let args = |how: &str, out: &str| -> Vec<String> {
+        [
+            "--reference-model",
+            &d("fine"),
+            "--reference-history",
+            &d("fine-out/history.parquet"),
+            "--model",
+            &d("coarse"),
+            "--history",
+            &d("coarse-out/disp.parquet"),
+            "--components",
+            "ux,uy",
+            "--static",
+            "--match",
+            how,
+            "--out-dir",
+            &d(out),
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .collect()
+    };
+    let a = args("interpolate", "e");
+    run_ok(err, &a.iter().map(|s| s.as_str()).collect::<Vec<_>>());
+    let s = weft::table::Table::read(&dir.path().join("e/error_summary.parquet")).unwrap();
+    let t = s.f64("T", "").unwrap()[0];
+    assert_eq!(s.i64("nodes", "").unwrap()[0], 121);
+    // Measured: T = 2.5e-19, the static solves' residual (~1e-10 relative); the nearest
+    // coarse node instead of the interpolation would leave T ~ 1e-2.
+    eprintln!("coarse membrane interpolated at the fine one's nodes: T = {t:.2e}");
+    assert!(t < 1e-18, "T {t}");
+    let a = args("position", "e2");
+    let o = Command::new(err).args(&a).output().unwrap();
+    let msg = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success() && msg.contains("--match interpolate"),
+        "{msg}"
+    );
+}

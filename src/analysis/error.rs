@@ -6,8 +6,12 @@ use std::path::PathBuf;
 
 use serde::Serialize;
 
-use super::{components, mismatch, read_series, Mismatch, Series};
+use super::{
+    components, interpolation, mismatch_paired, pair, read_nodes_of, read_series_of, Matching,
+    Mismatch, Series,
+};
 use crate::error::Result;
+use crate::model::io::read_model;
 use crate::table::{batch, write_table, Col, Provenance};
 
 /// Settings of one comparison, as `weft-error`'s flags give them (and as its tables'
@@ -27,6 +31,8 @@ pub struct Config {
     pub components: String,
     /// Matching tolerance on node positions [m].
     pub tolerance: f64,
+    /// How reference nodes find their candidate values (position, id, interpolate).
+    pub matching: Matching,
     /// Compare the last samples only (static solutions).
     pub static_mode: bool,
     /// Output folder for error.parquet and error_summary.parquet.
@@ -44,15 +50,10 @@ pub struct Report {
 /// Run the stage.
 pub fn run(c: &Config) -> Result<Report> {
     let comps = components(&c.components)?;
-    let q = read_series(&c.reference_model, &c.reference_history, &c.set)
+    let q = read_series_of(&c.reference_model, &c.reference_history, &c.set, &comps)
         .map_err(|e| e.context("reference"))?;
-    let p = read_series(
-        &c.model,
-        &c.history,
-        c.candidate_set.as_deref().unwrap_or(&c.set),
-    )
-    .map_err(|e| e.context("candidate"))?;
-    let r = mismatch(&q, &p, &comps, c.tolerance, c.static_mode)?;
+    let (p, pairs) = candidate(c, &q, &comps).map_err(|e| e.context("candidate"))?;
+    let r = mismatch_paired(&q, &p, &pairs, &comps, c.static_mode)?;
     let prov = Provenance::new("error", serde_json::to_value(c).expect("config serialises"))
         .with_input(&c.reference_history)?
         .with_input(&c.history)?;
@@ -93,4 +94,39 @@ pub fn run(c: &Config) -> Result<Report> {
         mismatch: r,
         reference: q,
     })
+}
+
+/// The candidate's history over the nodes the comparison needs, and the pairing of the
+/// reference's nodes onto it.
+fn candidate(c: &Config, q: &Series, comps: &[usize]) -> Result<(Series, super::Pairing)> {
+    if c.matching != Matching::Interpolate {
+        let p = read_series_of(
+            &c.model,
+            &c.history,
+            c.candidate_set.as_deref().unwrap_or(&c.set),
+            comps,
+        )?;
+        let pairs = pair(q, &p, c.tolerance, c.matching)?;
+        return Ok((p, pairs));
+    }
+    let m = read_model(&c.model)?;
+    let restrict = match &c.candidate_set {
+        Some(s) => Some(m.node_sets.get(s).cloned().ok_or_else(|| {
+            crate::error::WeftError::input(format!(
+                "model `{}` has no node set `{s}`",
+                c.model.display()
+            ))
+            .expected("the --candidate-set whose elements to interpolate in")
+        })?),
+        None => None,
+    };
+    let (nodes, pairs) = interpolation(&m, restrict.as_deref(), &q.x0, &q.node_id, c.tolerance)?;
+    let p = read_nodes_of(
+        &m,
+        &c.history,
+        &nodes,
+        "of an element containing a reference node",
+        comps,
+    )?;
+    Ok((p, pairs))
 }

@@ -15,7 +15,10 @@ use weft::analysis::error;
                   model) and q the reference, for the chosen components; trapezoidal in time on the reference's grid \
                   (the candidate is resampled linearly). 0 is a perfect match, 1 uncorrelated, 2 opposite. --static \
                   compares the last samples without the integral. Nodes are matched by position (nearest within \
-                  --tolerance); an unmatched node is an error. Writes error.parquet (per node: the peak relative \
+                  --tolerance; an unmatched node, or two candidate nodes within the tolerance, is an error), by id \
+                  (--match id), or the candidate is interpolated at each reference node's position with the shape \
+                  functions of the candidate element containing it (--match interpolate: meshes that differ). Only \
+                  the compared components need be in the histories. Writes error.parquet (per node: the peak relative \
                   error peak‖p − q‖/peak‖q‖) and error_summary.parquet (T, the maximum node error).\n\nExample:\n  \
                   weft-error --reference-model g --reference-history go/history.parquet --model m --history mo/history.parquet \
                   --set reference --components ux,uy --out-dir runs/err"
@@ -42,6 +45,11 @@ struct Cli {
     /// Matching tolerance on node positions [m].
     #[arg(long, default_value_t = 1e-9)]
     tolerance: f64,
+    /// How reference nodes find their candidate values: position (the node there), id
+    /// (the node of the same id), interpolate (the candidate's shape functions at the
+    /// reference position; meshes that differ).
+    #[arg(long = "match", value_enum, default_value = "position")]
+    matching: weft::analysis::Matching,
     /// Compare the last samples only (static solutions).
     #[arg(long = "static")]
     static_mode: bool,
@@ -65,6 +73,7 @@ fn run() -> anyhow::Result<ExitCode> {
         candidate_set: cli.candidate_set,
         components: cli.components,
         tolerance: cli.tolerance,
+        matching: cli.matching,
         static_mode: cli.static_mode,
         out_dir: cli.out_dir,
     })?;

@@ -67,6 +67,12 @@ struct Cli {
     /// Node matching tolerance [m].
     #[arg(long, default_value_t = 1e-9)]
     tolerance: f64,
+    /// How reference nodes find their candidate values: position (the node there), id
+    /// (the node of the same id), interpolate (the candidate's shape functions at the
+    /// reference position, in any of its membrane, truss or beam elements; meshes that
+    /// differ, as the combined model of the paper's Fig. 5b).
+    #[arg(long = "match", value_enum, default_value = "position")]
+    matching: weft::analysis::Matching,
     /// What is matched: `displacement` (the paper's T over --components) or `arrival` (the
     /// arrival times of a wave along the ordered --set, hence its speed: the first time
     /// --arrival-component reaches --relative-level of each node's peak).
@@ -129,6 +135,7 @@ fn run() -> anyhow::Result<ExitCode> {
         candidate_set: cli.candidate_set,
         components: cli.components,
         tolerance: cli.tolerance,
+        matching: cli.matching,
         objective: cli.objective,
         arrival_component: cli.arrival_component,
         relative_level: cli.relative_level,

@@ -40,6 +40,9 @@ enum Figure {
     Error(ErrorArgs),
     /// Best T against evaluations (fit_trace.parquet), one series per trace.
     Fit(FitArgs),
+    /// Test MSE of a network search against the hidden neurons, per activation
+    /// (weft-surrogate's search.parquet; the paper's Fig. 6b).
+    Surrogate(SurrogateArgs),
     /// Section of a woven patch along y = y₀: the yarn along x (centre line and ± t/2
     /// envelope) and the sections of the yarns across it; reference dashed and formed
     /// solid for a model from weft-form.
@@ -234,6 +237,35 @@ struct FitArgs {
     common: Common,
 }
 
+#[derive(Args)]
+struct SurrogateArgs {
+    /// search.parquet from weft-surrogate train.
+    #[arg(long)]
+    search: PathBuf,
+    /// Its surrogate.json: draws the regression's test MSE as a dashed line.
+    #[arg(long)]
+    surrogate: Option<PathBuf>,
+    /// A point to mark, `LABEL=N1:MSE` (repeat), e.g. `--mark 'paper, 11 tansig=11:0.0333'`.
+    #[arg(long, value_parser = parse_mark)]
+    mark: Vec<(String, f64, f64)>,
+    #[command(flatten)]
+    common: Common,
+}
+
+fn parse_mark(s: &str) -> Result<(String, f64, f64), String> {
+    let bad = || format!("`{s}`: expected LABEL=N1:MSE, e.g. 'paper=11:0.0333'");
+    let (l, v) = s.rsplit_once('=').ok_or_else(bad)?;
+    let (a, b) = v.split_once(':').ok_or_else(bad)?;
+    let (a, b): (f64, f64) = (
+        a.trim().parse().map_err(|_| bad())?,
+        b.trim().parse().map_err(|_| bad())?,
+    );
+    if !(a.is_finite() && b.is_finite() && b > 0.0) {
+        return Err(bad());
+    }
+    Ok((l.trim().to_string(), a, b))
+}
+
 fn main() -> ExitCode {
     weft::cli::main(|| run().map(|()| ExitCode::SUCCESS))
 }
@@ -300,6 +332,17 @@ fn run() -> anyhow::Result<()> {
                 scale: a.scale,
                 view: a.view,
                 range: a.range,
+            }),
+            a.common,
+        ),
+        Figure::Surrogate(a) => (
+            plot::Figure::Surrogate(plot::SurrogateFigure {
+                search: a.search,
+                mark: a.mark,
+                regression: match &a.surrogate {
+                    Some(p) => Some(weft::surrogate::Surrogate::read(p)?.regression_test_mse),
+                    None => None,
+                },
             }),
             a.common,
         ),

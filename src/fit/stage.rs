@@ -8,7 +8,7 @@ use arrow_array::RecordBatch;
 use serde::Serialize;
 
 use super::{fit, parse_param, Case, Evaluation, FitResult, Method, Objective, Options, Problem};
-use crate::analysis::{components, read_series, Level};
+use crate::analysis::{components, read_series_of, Level};
 use crate::error::{Result, WeftError};
 use crate::model::io::{read_model, write_model};
 use crate::table::{batch, write_table, Col, Provenance};
@@ -40,6 +40,8 @@ pub struct Config {
     pub candidate_set: Option<String>,
     pub components: String,
     pub tolerance: f64,
+    /// How reference nodes find their candidate values (position, id, interpolate).
+    pub matching: crate::analysis::Matching,
     pub objective: ObjectiveKind,
     pub arrival_component: String,
     pub relative_level: f64,
@@ -146,8 +148,17 @@ pub fn run(c: &Config, on_eval: &(dyn Fn(&Evaluation) + Sync)) -> Result<Report>
     let mut cases = vec![];
     let mut prov_inputs: Vec<PathBuf> = vec![];
     for k in 0..n {
-        let reference = read_series(&c.reference_model[k], &c.reference_history[k], &c.set)
-            .map_err(|e| e.context(format!("reference of case {}", k + 1)))?;
+        let mut needed = comps.clone();
+        if let Objective::Arrival { component, .. } = objective {
+            needed.push(component);
+        }
+        let reference = read_series_of(
+            &c.reference_model[k],
+            &c.reference_history[k],
+            &c.set,
+            &needed,
+        )
+        .map_err(|e| e.context(format!("reference of case {}", k + 1)))?;
         let model = read_model(&c.model[k])
             .map_err(|e| e.context(format!("candidate model of case {}", k + 1)))?;
         prov_inputs.push(c.reference_history[k].clone());
@@ -207,6 +218,7 @@ pub fn run(c: &Config, on_eval: &(dyn Fn(&Evaluation) + Sync)) -> Result<Report>
         params,
         components: comps,
         tolerance: c.tolerance,
+        matching: c.matching,
         static_mode: c.static_mode,
         objective,
     };
@@ -249,6 +261,11 @@ pub fn run(c: &Config, on_eval: &(dyn Fn(&Evaluation) + Sync)) -> Result<Report>
     write_table(
         &c.out.join("fit_result.parquet"),
         &result_table(&report, c),
+        &prov,
+    )?;
+    write_table(
+        &c.out.join("fit_row.parquet"),
+        &row_table(&report, c),
         &prov,
     )?;
     for (k, case) in report.problem.cases.iter().enumerate() {
@@ -372,6 +389,31 @@ pub fn result_table(r: &Report, c: &Config) -> RecordBatch {
         Col::Bool("static", vec![c.static_mode; np]),
         Col::F64("wall_seconds", rep(r.wall_seconds)),
     ])
+}
+
+/// `fit_row.parquet`: the result as one row, for sweeps (`weft gather` joins one row
+/// per instance into a table x → y): per parameter a column named as the parameter (its
+/// fitted value) and `NAME_expected` (the --expected value, null when none), then `T`,
+/// `T_initial`, `evaluations`, `static`.
+pub fn row_table(r: &Report, c: &Config) -> RecordBatch {
+    let mut cols = vec![];
+    for (i, p) in r.problem.params.iter().enumerate() {
+        cols.push(Col::F64Named(p.name.clone(), vec![r.result.x[i]]));
+    }
+    for (i, p) in r.problem.params.iter().enumerate() {
+        cols.push(Col::OptF64Named(
+            format!("{}_expected", p.name),
+            vec![r.expected[i]],
+        ));
+    }
+    cols.push(Col::F64("T", vec![r.result.t]));
+    cols.push(Col::F64("T_initial", vec![r.result.t_initial]));
+    cols.push(Col::I64(
+        "evaluations",
+        vec![r.result.evaluations.len() as i64],
+    ));
+    cols.push(Col::Bool("static", vec![c.static_mode]));
+    batch(cols)
 }
 
 /// The model's tables, sorted: the inputs the provenance records.

@@ -9,7 +9,9 @@
 //! sample share it); a static solve uses the amplitude F.
 //!
 //! Node sets: `reference` (every node), `axis_x` (y = 0, ordered by x), `diagonal`
-//! (x = y, ordered by x), `loaded_edge` (x = L, ordered by y).
+//! (x = y, ordered by x), `loaded_edge` (x = L, ordered by y), `centre` (the nodes of
+//! the central L/2 × L/2 zone, |x − L/2| ≤ L/4 and |y − L/2| ≤ L/4: the reference nodes
+//! of the paper's combined model, Fig. 5b; N ≥ 2).
 
 use serde::Serialize;
 
@@ -136,6 +138,16 @@ fn frame(m: &mut Model, sq: &Square, e: f64, rho: f64, rotations: bool) -> Resul
         .insert("diagonal".into(), (0..=n).map(|i| id(i, i)).collect());
     m.node_sets
         .insert("loaded_edge".into(), (0..=n).map(|j| id(n, j)).collect());
+    // Index test with integers: 4i ∈ [N, 3N] ⇔ |x − L/2| ≤ L/4 exactly. (N = 1 has no
+    // node there, and no `centre` set.)
+    let centre: Vec<usize> = (0..=n)
+        .flat_map(|j| (0..=n).map(move |i| (i, j)))
+        .filter(|&(i, j)| (n..=3 * n).contains(&(4 * i)) && (n..=3 * n).contains(&(4 * j)))
+        .map(|(i, j)| id(i, j))
+        .collect();
+    if !centre.is_empty() {
+        m.node_sets.insert("centre".into(), centre);
+    }
     let end = sq.end_time.unwrap_or(t);
     m.analysis = Analysis {
         end_time: end,
