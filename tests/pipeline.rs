@@ -635,3 +635,44 @@ fn the_slurm_executor_without_slurm_says_what_is_missing() {
         "{err}"
     );
 }
+
+#[test]
+fn a_slurm_dry_run_puts_many_instances_after_one_task_in_one_array() {
+    // Three instances after each task of a two-task array: one `afterok:A_t` array per
+    // task (2 submissions) rather than three `aftercorr` arrays.
+    let p = Project::new(
+        r#"
+[stages.gen]
+cmd = "echo ${n} > ${outputs.o}"
+matrix = { n = [1, 2] }
+outputs = { o = "out/gen/${n}.txt" }
+
+[stages.use]
+cmd = "cat ${inputs.i} > ${outputs.o} && echo ${k} >> ${outputs.o}"
+matrix = { n = [1, 2], k = [1, 2, 3] }
+inputs = { i = "out/gen/${n}.txt" }
+outputs = { o = "out/use/${n}-${k}.txt" }
+"#,
+    );
+    let o = p.weft(&[
+        "run",
+        "pipelines/p.toml",
+        "--executor",
+        "slurm",
+        "--dry-run",
+    ]);
+    let out = String::from_utf8_lossy(&o.stdout).to_string();
+    let uses: Vec<&str> = out
+        .lines()
+        .filter(|l| l.contains("--job-name=weft:p:use "))
+        .collect();
+    assert_eq!(uses.len(), 2, "{out}");
+    assert!(
+        uses[0].contains("--array=0-2") && uses[0].contains("\"--dependency=afterok:${J1}_0\""),
+        "{out}"
+    );
+    assert!(
+        uses[1].contains("--array=0-2") && uses[1].contains("\"--dependency=afterok:${J1}_1\""),
+        "{out}"
+    );
+}

@@ -417,3 +417,43 @@ fn ctrl_c_cancels_the_jobs_of_the_run() {
     }
     assert!(!dir.path().join("out/x.txt").exists());
 }
+
+#[test]
+fn an_upstream_rerun_with_the_same_bytes_leaves_its_dependant_fresh_inside_its_job() {
+    let _g = SLURM.lock().unwrap_or_else(|e| e.into_inner());
+    if !slurm_ok() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::create_dir_all(dir.path().join("pipelines")).unwrap();
+    std::fs::write(
+        dir.path().join("pipelines/u.toml"),
+        "[stages.a]\ncmd = \"echo same > ${outputs.o}\"\noutputs = { o = \"out/a.txt\" }\n\
+         [stages.b]\ncmd = \"cp ${inputs.i} ${outputs.o}\"\ninputs = { i = \"out/a.txt\" }\noutputs = { o = \"out/b.txt\" }\n\
+         [executor]\npoll_seconds = 0.2\n",
+    )
+    .unwrap();
+    let run = |extra: &[&str]| {
+        let mut a = vec!["run", "pipelines/u.toml", "--executor", "slurm"];
+        a.extend_from_slice(extra);
+        let o = weft(dir.path(), &a);
+        let err = text(&o.stderr);
+        assert!(o.status.success(), "{err}");
+        err
+    };
+    assert_eq!(done(&run(&[])), ["a", "b"]);
+    let b_record = std::fs::read_to_string(dir.path().join(".weft/records/u/b.json")).unwrap();
+    // `b` waits in Slurm on the forced `a`, then finds its input unchanged: as the local
+    // executor, it does not run.
+    let err = run(&["--force", "a"]);
+    assert_eq!(queued(&err).len(), 2, "{err}");
+    assert_eq!(done(&err), ["a"], "{err}");
+    assert!(
+        err.contains("fresh b (its upstream reproduced the same inputs)"),
+        "{err}"
+    );
+    assert_eq!(
+        std::fs::read_to_string(dir.path().join(".weft/records/u/b.json")).unwrap(),
+        b_record
+    );
+}

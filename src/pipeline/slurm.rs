@@ -716,36 +716,43 @@ impl Executor for SlurmExecutor {
                 .iter()
                 .filter(|(l, _)| p.instances[l.idx].stage == stage)
                 .collect();
-            // Aligned: each instance waits on exactly one task of one array. Task t of a
-            // new array with `aftercorr` waits on task t of that array; instances waiting
-            // on the same task go to further arrays.
-            let mut aligned: BTreeMap<String, Vec<BTreeMap<usize, &Launch>>> = BTreeMap::new();
+            // Aligned: each instance waits on exactly one task of one array A. Either
+            // `aftercorr:A` arrays, task t of which waits on task t of A (one array per
+            // instance waiting on the same task: `simulate@e,s` for both s after
+            // `weave@e`), or one `afterok:A_t` array per task of A (many instances after
+            // one task); whichever makes fewer submissions.
+            let mut aligned: BTreeMap<String, BTreeMap<usize, Vec<&Launch>>> = BTreeMap::new();
             let mut grouped: BTreeMap<Vec<String>, Vec<&Launch>> = BTreeMap::new();
             for (l, h) in mine {
                 match (h.as_slice(), h.first().and_then(|j| split_task(j))) {
-                    ([_], Some((a, t))) => {
-                        let arrays = aligned.entry(a.to_string()).or_default();
-                        match arrays.iter_mut().find(|m| !m.contains_key(&t)) {
-                            Some(m) => {
-                                m.insert(t, *l);
-                            }
-                            None => arrays.push(BTreeMap::from([(t, *l)])),
-                        }
-                    }
+                    ([_], Some((a, t))) => aligned
+                        .entry(a.to_string())
+                        .or_default()
+                        .entry(t)
+                        .or_default()
+                        .push(*l),
                     _ => grouped.entry(h.clone()).or_default().push(*l),
                 }
             }
-            for (a, arrays) in aligned {
-                for m in arrays {
-                    if m.len() == 1 {
-                        let (t, l) = m.into_iter().next().expect("one");
-                        self.submit(
-                            p,
-                            stage,
-                            vec![(None, l)],
-                            Some(format!("afterok:{a}_{t}")),
-                            say,
-                        )?;
+            for (a, by_task) in aligned {
+                let rounds = by_task.values().map(Vec::len).max().unwrap_or(0);
+                if rounds > by_task.len() {
+                    for (t, ls) in by_task {
+                        grouped
+                            .entry(vec![format!("{a}_{t}")])
+                            .or_default()
+                            .extend(ls);
+                    }
+                    continue;
+                }
+                for r in 0..rounds {
+                    let m: Vec<(usize, &Launch)> = by_task
+                        .iter()
+                        .filter_map(|(&t, ls)| ls.get(r).map(|l| (t, *l)))
+                        .collect();
+                    if let [(t, l)] = m.as_slice() {
+                        let dep = format!("afterok:{a}_{t}");
+                        self.submit(p, stage, vec![(None, *l)], Some(dep), say)?;
                     } else {
                         let tasks = m.into_iter().map(|(t, l)| (Some(t), l)).collect();
                         self.submit(p, stage, tasks, Some(format!("aftercorr:{a}")), say)?;
