@@ -457,3 +457,55 @@ fn an_upstream_rerun_with_the_same_bytes_leaves_its_dependant_fresh_inside_its_j
         b_record
     );
 }
+
+#[test]
+fn jobs_a_dying_controller_submitted_but_did_not_note_are_cancelled_by_the_next_run() {
+    let _g = SLURM.lock().unwrap_or_else(|e| e.into_inner());
+    if !slurm_ok() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::create_dir_all(dir.path().join("pipelines")).unwrap();
+    let file = dir.path().join("pipelines/o.toml");
+    std::fs::write(
+        &file,
+        "[stages.a]\ncmd = \"echo a > ${outputs.o}\"\noutputs = { o = \"out/a.txt\" }\n\
+         [executor]\npoll_seconds = 0.2\n",
+    )
+    .unwrap();
+    // A job of this pipeline file (by its comment) that no job file notes: as if the
+    // controller died between sbatch and writing `.weft/jobs/o/a.job`.
+    let tag = weft::pipeline::slurm::project_tag(&file);
+    let o = Command::new("sbatch")
+        .args([
+            "--parsable",
+            &format!("--comment={tag}"),
+            "--output=/dev/null",
+            "--wrap=sleep 60",
+        ])
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let orphan = text(&o.stdout).trim().to_string();
+    let o = weft(
+        dir.path(),
+        &["run", "pipelines/o.toml", "--executor", "slurm"],
+    );
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let q = Command::new("squeue")
+        .args([
+            "--noheader",
+            "--states=all",
+            "--format=%T",
+            "--jobs",
+            &orphan,
+        ])
+        .output()
+        .unwrap();
+    let state = text(&q.stdout);
+    assert!(
+        state.contains("CANCELLED") || state.contains("COMPLETING"),
+        "orphan {orphan}: {state}"
+    );
+}

@@ -404,6 +404,12 @@ pub fn run(
         ExecutorKind::Slurm => {
             let mut ex = SlurmExecutor::new(p, false)?;
             let adopted = ex.adopt(p, selected, force, &plan)?;
+            if ex.cancelled_at_start > 0 && !o.quiet {
+                eprintln!(
+                    "cancel {} Slurm jobs of an earlier `weft run` (their work changed, they were forced, something they need is stale again, or the run died before noting them)",
+                    ex.cancelled_at_start
+                );
+            }
             let r = schedule(p, ws, selected, force, &plan, o, &mut ex, adopted);
             if r.is_err() {
                 ex.cancel_all();

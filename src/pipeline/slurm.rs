@@ -305,6 +305,8 @@ pub struct SlurmExecutor {
     squeue_failures: u32,
     /// `--comment` of this pipeline file's jobs.
     tag: String,
+    /// Live jobs of an earlier run that [`SlurmExecutor::adopt`] cancelled.
+    pub cancelled_at_start: usize,
 }
 
 fn abs(p: &Path) -> PathBuf {
@@ -340,6 +342,7 @@ impl SlurmExecutor {
             manifests: vec![],
             squeue_failures: 0,
             tag: project_tag(&p.file),
+            cancelled_at_start: 0,
         })
     }
 
@@ -408,6 +411,7 @@ impl SlurmExecutor {
         if !cancel.is_empty() {
             scancel(&cancel, None)?;
         }
+        self.cancelled_at_start = cancel.len();
         Ok(adopted)
     }
 
