@@ -509,3 +509,49 @@ fn jobs_a_dying_controller_submitted_but_did_not_note_are_cancelled_by_the_next_
         "orphan {orphan}: {state}"
     );
 }
+
+#[test]
+fn a_job_held_back_for_a_reason_that_does_not_pass_is_reported_while_waiting() {
+    let _g = SLURM.lock().unwrap_or_else(|e| e.into_inner());
+    if !slurm_ok() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::create_dir_all(dir.path().join("pipelines")).unwrap();
+    // `--hold` keeps the job pending (JobHeldUser) until released.
+    std::fs::write(
+        dir.path().join("pipelines/h.toml"),
+        "[stages.a]\ncmd = \"echo a > ${outputs.o}\"\noutputs = { o = \"out/a.txt\" }\n\
+         [executor]\npoll_seconds = 0.2\nsbatch_args = [\"--hold\"]\n",
+    )
+    .unwrap();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_weft"))
+        .args(["run", "pipelines/h.toml", "--executor", "slurm"])
+        .current_dir(dir.path())
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    use std::io::BufRead;
+    let mut lines = std::io::BufReader::new(child.stderr.take().unwrap()).lines();
+    let mut seen = vec![];
+    let job = loop {
+        let l = lines
+            .next()
+            .expect("weft ended before reporting the held job")
+            .unwrap();
+        seen.push(l.clone());
+        if let Some(rest) = l.strip_prefix("wait  a: Slurm job ") {
+            assert!(rest.contains("JobHeldUser"), "{l}");
+            break rest.split(' ').next().unwrap().to_string();
+        }
+    };
+    let o = Command::new("scontrol")
+        .args(["release", &job])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let rest: Vec<String> = lines.map(|l| l.unwrap()).collect();
+    assert!(child.wait().unwrap().success(), "{seen:?} {rest:?}");
+    assert!(rest.iter().any(|l| l.starts_with("done  a")), "{rest:?}");
+}

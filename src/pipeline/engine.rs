@@ -576,6 +576,7 @@ fn schedule(
                     bar.enable_steady_tick(std::time::Duration::from_millis(200));
                     bars.insert(i, bar);
                 }
+                Event::Note(s) => say(s),
                 Event::Progress(i, f) => {
                     if let Some(b) = bars.get(&i) {
                         b.set_position((f.clamp(0.0, 1.0) * 1000.0) as u64);

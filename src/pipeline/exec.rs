@@ -122,6 +122,7 @@ pub fn log_paths(ws: &Workspace, inst: &Instance) -> (PathBuf, String) {
 }
 
 /// One attempt of an instance, ready to run.
+#[derive(Debug, Clone)]
 pub struct Attempt {
     pub name: String,
     /// The command with the temporary output paths.
@@ -415,6 +416,9 @@ pub enum Event {
     Started(usize),
     Progress(usize, f64),
     Done(usize, Finish),
+    /// Something the user should know while waiting (a job held back for a reason that
+    /// will not pass by itself).
+    Note(String),
 }
 
 /// Launching, polling and cancelling stage instances. Scheduling (what is stale, what is
@@ -490,14 +494,7 @@ impl Executor for LocalExecutor {
             let inst = &p.instances[l.idx];
             let a = prepare(p, ws, inst, &tag)?;
             say(format!("run   {} ({})", inst.name, l.reason));
-            let job = Attempt {
-                name: a.name.clone(),
-                command: a.command.clone(),
-                pairs: vec![],
-                log: a.log.clone(),
-                log_rel: a.log_rel.clone(),
-                tag: a.tag.clone(),
-            };
+            let job = a.clone();
             self.attempts.insert(l.idx, a);
             self.queued.push_back(Event::Started(l.idx));
             let (tx, root, path_env, idx) = (

@@ -307,6 +307,8 @@ pub struct SlurmExecutor {
     tag: String,
     /// Live jobs of an earlier run that [`SlurmExecutor::adopt`] cancelled.
     pub cancelled_at_start: usize,
+    /// Pending reasons already reported (job and reason).
+    noted: HashSet<String>,
 }
 
 fn abs(p: &Path) -> PathBuf {
@@ -343,6 +345,7 @@ impl SlurmExecutor {
             squeue_failures: 0,
             tag: project_tag(&p.file),
             cancelled_at_start: 0,
+            noted: HashSet::new(),
         })
     }
 
@@ -815,6 +818,23 @@ impl Executor for SlurmExecutor {
                     .map(|j| (j.state.clone(), j.reason.clone()))
                     .unwrap_or_else(|| ("UNKNOWN".into(), String::new()));
                 if state == "PENDING" {
+                    // Reasons that pass by themselves are not worth a line.
+                    let waits = matches!(
+                        reason.as_str(),
+                        "" | "None"
+                            | "Priority"
+                            | "Resources"
+                            | "Dependency"
+                            | "DependencyNeverSatisfied"
+                            | "BeginTime"
+                            | "JobArrayTaskLimit"
+                    );
+                    if !waits && self.noted.insert(format!("{}\0{reason}", t.job)) {
+                        events.push(Event::Note(format!(
+                            "wait  {name}: Slurm job {} is pending ({reason}); `scontrol show job {}` says more, Ctrl-C cancels the run",
+                            t.job, t.job
+                        )));
+                    }
                     continue;
                 }
                 if let Some(r) = read_json::<JobResult>(&self.files.result(name)) {
