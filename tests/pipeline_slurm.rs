@@ -23,16 +23,20 @@ use std::time::{Duration, Instant};
 static SLURM: Mutex<()> = Mutex::new(());
 
 fn slurm_ok() -> bool {
-    let ok = Command::new("sinfo")
-        .args(["--noheader", "--format=%t"])
-        .output()
-        .map(|o| {
-            o.status.success()
-                && String::from_utf8_lossy(&o.stdout).lines().any(|l| {
-                    l.starts_with("idle") || l.starts_with("mix") || l.starts_with("alloc")
-                })
-        })
-        .unwrap_or(false);
+    // Asked once: a configured but stopped Slurm takes `sinfo` ~10 s to give up.
+    static UP: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
+    let ok = *UP.get_or_init(|| {
+        Command::new("sinfo")
+            .args(["--noheader", "--format=%t"])
+            .output()
+            .map(|o| {
+                o.status.success()
+                    && String::from_utf8_lossy(&o.stdout).lines().any(|l| {
+                        l.starts_with("idle") || l.starts_with("mix") || l.starts_with("alloc")
+                    })
+            })
+            .unwrap_or(false)
+    });
     if !ok {
         assert!(
             std::env::var("WEFT_REQUIRE_SLURM").as_deref() != Ok("1"),
