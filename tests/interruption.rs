@@ -5,11 +5,11 @@
 //! nothing half-written looks fresh): the final outputs are identical, value by value, to
 //! those of an uninterrupted run, the timing columns aside.
 
-use std::path::{Path, PathBuf};
+mod common;
+use common::same_outputs;
+use std::path::Path;
 use std::process::Command;
 use std::time::{Duration, Instant};
-
-use weft::table::Table;
 
 /// SplitMix64: a fixed-seed generator, so that the kill points are the same every run.
 fn uniform(state: &mut u64) -> f64 {
@@ -70,59 +70,6 @@ fn kill_after(root: &Path, after: Duration) -> bool {
     child.kill().ok();
     child.wait().unwrap();
     running
-}
-
-fn tables(root: &Path) -> Vec<PathBuf> {
-    fn walk(d: &Path, out: &mut Vec<PathBuf>) {
-        for e in std::fs::read_dir(d).unwrap() {
-            let p = e.unwrap().path();
-            if p.is_dir() {
-                walk(&p, out);
-            } else {
-                out.push(p);
-            }
-        }
-    }
-    let mut v = vec![];
-    walk(&root.join("runs"), &mut v);
-    v.iter_mut()
-        .for_each(|p| *p = p.strip_prefix(root).unwrap().to_path_buf());
-    v.sort();
-    v
-}
-
-/// Timing columns: wall times and the throughput derived from them.
-fn timing(column: &str) -> bool {
-    column.starts_with("wall_time") || column == "element_updates_per_second"
-}
-
-fn same_outputs(a: &Path, b: &Path) -> Result<usize, String> {
-    let (ta, tb) = (tables(a), tables(b));
-    if ta != tb {
-        return Err(format!("different files:\n{ta:?}\n{tb:?}"));
-    }
-    for rel in &ta {
-        if rel.extension().is_some_and(|e| e == "parquet") {
-            let (x, y) = (
-                Table::read(&a.join(rel)).unwrap(),
-                Table::read(&b.join(rel)).unwrap(),
-            );
-            let (sx, sy) = (x.batch.schema(), y.batch.schema());
-            let names: Vec<&String> = sx.fields().iter().map(|f| f.name()).collect();
-            let names_y: Vec<&String> = sy.fields().iter().map(|f| f.name()).collect();
-            if names != names_y || x.num_rows() != y.num_rows() {
-                return Err(format!("{}: columns or rows differ", rel.display()));
-            }
-            for n in names.iter().filter(|n| !timing(n)) {
-                if x.batch.column_by_name(n) != y.batch.column_by_name(n) {
-                    return Err(format!("{}: column `{n}` differs", rel.display()));
-                }
-            }
-        } else if std::fs::read(a.join(rel)).unwrap() != std::fs::read(b.join(rel)).unwrap() {
-            return Err(format!("{} differs", rel.display()));
-        }
-    }
-    Ok(ta.len())
 }
 
 #[test]

@@ -531,3 +531,148 @@ fn every_malformed_pipeline_file_gives_a_clear_error() {
         );
     }
 }
+
+#[test]
+fn a_slurm_dry_run_prints_the_sbatch_commands_with_the_executor_resources() {
+    // Needs no Slurm: a dry run submits nothing (tests/pipeline_slurm.rs runs a real one).
+    let p = Project::new(
+        r#"
+[stages.gen]
+cmd = "echo ${n} > ${outputs.o}"
+matrix = { n = [1, 2, 3] }
+outputs = { o = "out/gen/${n}.txt" }
+
+[stages.use]
+cmd = "cat ${inputs.i} > ${outputs.o}"
+matrix = { n = [1, 2, 3] }
+inputs = { i = "out/gen/${n}.txt" }
+outputs = { o = "out/use/${n}.txt" }
+
+[stages.all]
+cmd = "cat ${inputs.u}/* > ${outputs.o}"
+inputs = { u = "out/use" }
+outputs = { o = "out/all.txt" }
+
+[executor]
+partition = "short"
+account = "proj42"
+time = "00:10:00"
+memory = "1G"
+sbatch_args = ["--qos=low"]
+
+[executor.stages.use]
+time = "02:00:00"
+cpus = 4
+sbatch_args = ["--constraint=fast"]
+"#,
+    );
+    let o = p.weft(&[
+        "run",
+        "pipelines/p.toml",
+        "--executor",
+        "slurm",
+        "--dry-run",
+    ]);
+    let out = String::from_utf8_lossy(&o.stdout).to_string();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let line = |stage: &str| -> String {
+        out.lines()
+            .find(|l| l.contains(&format!("--job-name=weft:p:{stage} ")))
+            .unwrap_or_else(|| panic!("no sbatch line for `{stage}`:\n{out}"))
+            .to_string()
+    };
+    let (gen, use_, all) = (line("gen"), line("use"), line("all"));
+    assert!(gen.starts_with("J1=$(sbatch --parsable "), "{gen}");
+    for l in [&gen, &use_, &all] {
+        assert!(
+            l.contains("--kill-on-invalid-dep=yes")
+                && l.contains("--partition=short")
+                && l.contains("--account=proj42")
+                && l.contains("--mem=1G")
+                && l.contains("--qos=low"),
+            "{l}"
+        );
+    }
+    assert!(
+        gen.contains("--array=0-2") && gen.contains("--time=00:10:00"),
+        "{gen}"
+    );
+    assert!(!gen.contains("--dependency"), "{gen}");
+    // Task t of `use` needs task t of `gen`: one array with aftercorr; the stage's
+    // overrides replace time and cpus, and add to sbatch_args.
+    assert!(
+        use_.contains("--array=0-2")
+            && use_.contains("\"--dependency=aftercorr:${J1}\"")
+            && use_.contains("--time=02:00:00")
+            && use_.contains("--cpus-per-task=4")
+            && use_.contains("--constraint=fast"),
+        "{use_}"
+    );
+    // `all` needs every task of `use`: the whole array.
+    assert!(
+        all.contains("\"--dependency=afterok:${J2}\"") && !all.contains("--array"),
+        "{all}"
+    );
+    assert!(out.contains("#   task 1: use@n=2"), "{out}");
+    // Nothing was written or submitted.
+    assert!(!p.root().join("out").exists() && !p.root().join(".weft/jobs").exists());
+}
+
+#[test]
+fn the_slurm_executor_without_slurm_says_what_is_missing() {
+    let p =
+        Project::new("[stages.a]\ncmd = \"echo > ${outputs.o}\"\noutputs = { o = \"out/a\" }\n");
+    let o = Command::new(env!("CARGO_BIN_EXE_weft"))
+        .args(["run", "pipelines/p.toml", "--executor", "slurm"])
+        .current_dir(p.root())
+        .env("PATH", p.root().join("no-such-dir"))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("needs the Slurm client commands") && err.contains("hint:"),
+        "{err}"
+    );
+}
+
+#[test]
+fn a_slurm_dry_run_puts_many_instances_after_one_task_in_one_array() {
+    // Three instances after each task of a two-task array: one `afterok:A_t` array per
+    // task (2 submissions) rather than three `aftercorr` arrays.
+    let p = Project::new(
+        r#"
+[stages.gen]
+cmd = "echo ${n} > ${outputs.o}"
+matrix = { n = [1, 2] }
+outputs = { o = "out/gen/${n}.txt" }
+
+[stages.use]
+cmd = "cat ${inputs.i} > ${outputs.o} && echo ${k} >> ${outputs.o}"
+matrix = { n = [1, 2], k = [1, 2, 3] }
+inputs = { i = "out/gen/${n}.txt" }
+outputs = { o = "out/use/${n}-${k}.txt" }
+"#,
+    );
+    let o = p.weft(&[
+        "run",
+        "pipelines/p.toml",
+        "--executor",
+        "slurm",
+        "--dry-run",
+    ]);
+    let out = String::from_utf8_lossy(&o.stdout).to_string();
+    let uses: Vec<&str> = out
+        .lines()
+        .filter(|l| l.contains("--job-name=weft:p:use "))
+        .collect();
+    assert_eq!(uses.len(), 2, "{out}");
+    assert!(
+        uses[0].contains("--array=0-2") && uses[0].contains("\"--dependency=afterok:${J1}_0\""),
+        "{out}"
+    );
+    assert!(
+        uses[1].contains("--array=0-2") && uses[1].contains("\"--dependency=afterok:${J1}_1\""),
+        "{out}"
+    );
+}

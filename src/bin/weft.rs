@@ -8,7 +8,7 @@ use clap::{Parser, Subcommand, ValueEnum};
 
 use weft::pipeline::engine::Outcome;
 use weft::pipeline::gather::{gather, records_table};
-use weft::pipeline::{run, Pipeline, RunOptions, Verdict, Workspace};
+use weft::pipeline::{run, ExecutorKind, Pipeline, RunOptions, Verdict, Workspace};
 use weft::table::{write_table, Provenance};
 
 #[derive(Parser)]
@@ -21,6 +21,7 @@ use weft::table::{write_table, Provenance};
                   on content (blake3), not timestamps.\n\nExamples:\n  weft run pipelines/rod_waves.toml          run what is stale\n  \
                   weft status pipelines/rod_waves.toml       say what is stale and why\n  \
                   weft run pipelines/rod_waves.toml -j 2 simulate   a stage and what it needs\n  \
+                  weft run pipelines/rod_waves.toml --executor slurm   each stale stage a Slurm job (docs/pipelines.md)\n  \
                   weft gather pipelines/rod_waves.toml --stage simulate --table summary.parquet --out runs/summary.parquet"
 )]
 struct Cli {
@@ -36,13 +37,20 @@ enum Cmd {
         pipeline: Option<PathBuf>,
         /// Stages (all instances) or instances to run, with their upstream stages.
         targets: Vec<String>,
-        /// Parallel stages [default: number of cores].
+        /// Parallel stages [default: number of cores] (local executor; Slurm decides for its jobs).
         #[arg(short, long)]
         jobs: Option<usize>,
+        /// Where stages run: `local` (children of this process) or `slurm` (one Slurm job
+        /// per stale instance, a job array per sweep stage, resources from the pipeline's
+        /// [executor] table; `weft run` waits for the jobs and Ctrl-C cancels them; the
+        /// project folder must be on a file system the compute nodes share).
+        #[arg(long, value_enum, default_value_t = Exec::Local)]
+        executor: Exec,
         /// After a failure, keep running stages that do not depend on it.
         #[arg(short, long)]
         keep_going: bool,
-        /// Say what would run and why; run nothing.
+        /// Say what would run and why; run nothing (with `--executor slurm`, also print
+        /// the sbatch commands it would submit).
         #[arg(short = 'n', long)]
         dry_run: bool,
         /// Run even if fresh: every selected stage, or the named stage (repeatable).
@@ -55,7 +63,8 @@ enum Cmd {
         #[arg(short, long)]
         quiet: bool,
     },
-    /// Say for each stage instance whether it is fresh, or why it would run.
+    /// Say for each stage instance whether it is fresh, or why it would run (and its
+    /// Slurm job, while one of an interrupted `weft run --executor slurm` is queued or running).
     Status { pipeline: Option<PathBuf> },
     /// Print the stage graph.
     Dag {
@@ -87,6 +96,22 @@ enum Cmd {
         #[arg(long)]
         out: PathBuf,
     },
+    /// Run one stage instance inside a Slurm job (what `weft run --executor slurm` submits).
+    #[command(hide = true)]
+    Job {
+        /// The job's manifest (pipeline file, and instance by array task).
+        #[arg(long)]
+        manifest: PathBuf,
+        /// Array task [default: $SLURM_ARRAY_TASK_ID, or the manifest's only instance].
+        #[arg(long)]
+        task: Option<String>,
+    },
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum Exec {
+    Local,
+    Slurm,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -141,6 +166,7 @@ fn main_inner() -> anyhow::Result<ExitCode> {
             force,
             single,
             quiet,
+            executor,
         } => {
             let p = load(pipeline)?;
             let n = p.instances.len();
@@ -182,6 +208,10 @@ fn main_inner() -> anyhow::Result<ExitCode> {
                 keep_going,
                 dry_run,
                 quiet,
+                executor: match executor {
+                    Exec::Local => ExecutorKind::Local,
+                    Exec::Slurm => ExecutorKind::Slurm,
+                },
             };
             let rep = run(&p, &mut ws, &selected, &forced, &opts)?;
             if dry_run {
@@ -218,14 +248,25 @@ fn main_inner() -> anyhow::Result<ExitCode> {
             let n = p.instances.len();
             let plan = ws.plan(&p, &vec![true; n], &vec![false; n])?;
             ws.cache.save()?;
+            let jobs = match weft::pipeline::slurm::live_jobs(&p) {
+                Ok(j) => j,
+                Err(e) => {
+                    eprintln!("weft: cannot ask Slurm about the jobs of an earlier run: {e}");
+                    Default::default()
+                }
+            };
             let mut stale = 0;
             for &i in &p.order {
                 let name = &p.instances[i].name;
+                let job = jobs
+                    .get(name)
+                    .map(|(j, s)| format!(" (Slurm job {j} {s})"))
+                    .unwrap_or_default();
                 match &plan[i] {
-                    Verdict::Fresh => println!("fresh  {name}"),
+                    Verdict::Fresh => println!("fresh  {name}{job}"),
                     Verdict::Stale(r) | Verdict::Waiting(r) => {
                         stale += 1;
-                        println!("stale  {name}: {r}")
+                        println!("stale  {name}: {r}{job}")
                     }
                 }
             }
@@ -312,6 +353,10 @@ fn main_inner() -> anyhow::Result<ExitCode> {
                 }
             }
             Ok(ExitCode::SUCCESS)
+        }
+        Cmd::Job { manifest, task } => {
+            let status = weft::pipeline::slurm::run_job(&manifest, task)?;
+            Ok(ExitCode::from(status as u8))
         }
         Cmd::Gather {
             pipeline,

@@ -7,25 +7,26 @@
 //! has run, the instance is judged again on the new content of its inputs, so an
 //! upstream rerun that reproduces the same bytes reruns nothing below it.
 //!
-//! Execution: ready instances run in parallel (`-j`), each as `sh -c CMD` in the
-//! project root, with `${outputs...}` pointing at temporary siblings of the real
-//! outputs, stdout and stderr in `.weft/logs/<pipeline>/<instance>.log`. On success the
-//! temporaries are renamed into place and then the record is written: the record is the
-//! commit point, so an interrupted run never leaves an output that counts as fresh.
-//! Children get SIGKILL when `weft` dies (Linux `PR_SET_PDEATHSIG`).
+//! Execution: the scheduling loop here hands ready instances to an executor
+//! (`super::exec`): the local one runs them in parallel (`-j`) as children of `weft`,
+//! the Slurm one (`super::slurm`) as Slurm jobs. Either way each instance runs as
+//! `sh -c CMD` in the project root, with `${outputs...}` pointing at temporary siblings
+//! of the real outputs, stdout and stderr in `.weft/logs/<pipeline>/<instance>.log`. On
+//! success the temporaries are renamed into place and then the record is written: the
+//! record is the commit point, so an interrupted run never leaves an output that counts
+//! as fresh. Local children get SIGKILL when `weft` dies (Linux `PR_SET_PDEATHSIG`).
 
 use std::collections::BTreeMap;
-use std::io::{BufRead, BufReader, Write};
+use std::io::Write;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
-use std::sync::mpsc;
-use std::time::{SystemTime, UNIX_EPOCH};
 
 use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
 
+use super::exec::{log_tail, Event, Executor, Finish, Launch, LocalExecutor};
 use super::hash::HashCache;
-use super::record::{iso_utc, Record, RecordStore};
-use super::spec::{render, shell_quote, Ctx, Instance, Pipeline};
+use super::record::RecordStore;
+use super::slurm::SlurmExecutor;
+use super::spec::{shell_quote, Instance, Pipeline};
 use crate::error::{Result, WeftError};
 
 /// Why an instance must run, or that it need not.
@@ -63,8 +64,23 @@ impl Workspace {
         if !gi.exists() {
             let _ = std::fs::write(
                 &gi,
-                "# records/ is meant to be committed; the rest is local\nlogs/\ncache/\nlock\n",
+                "# records/ is meant to be committed; the rest is local\nlogs/\ncache/\njobs/\nlock\n",
             );
+        } else if let Ok(s) = std::fs::read_to_string(&gi) {
+            // Projects from before the Slurm executor: its job files are local too.
+            if !s.lines().any(|l| l.trim() == "jobs/") {
+                let _ = std::fs::write(
+                    &gi,
+                    format!(
+                        "{}jobs/\n",
+                        if s.ends_with('\n') || s.is_empty() {
+                            s
+                        } else {
+                            s + "\n"
+                        }
+                    ),
+                );
+            }
         }
         let stem = p
             .file
@@ -114,7 +130,7 @@ impl Workspace {
             .find(|p| p.is_file())
     }
 
-    fn abs(&self, p: &Path) -> PathBuf {
+    pub fn abs(&self, p: &Path) -> PathBuf {
         if p.is_absolute() {
             p.to_path_buf()
         } else {
@@ -247,6 +263,17 @@ pub struct RunOptions {
     pub keep_going: bool,
     pub dry_run: bool,
     pub quiet: bool,
+    pub executor: ExecutorKind,
+}
+
+/// Where instances run: `weft run --executor local|slurm`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ExecutorKind {
+    /// Child processes of `weft run` on this machine, `-j` at a time.
+    #[default]
+    Local,
+    /// One Slurm job per instance, a job array per sweep stage (`super::slurm`).
+    Slurm,
 }
 
 /// What happened to each instance.
@@ -283,155 +310,6 @@ impl RunReport {
             .filter(|o| matches!(o.1, Outcome::Failed { .. }))
             .count()
     }
-}
-
-fn now_unix() -> f64 {
-    SystemTime::now()
-        .duration_since(UNIX_EPOCH)
-        .map(|d| d.as_secs_f64())
-        .unwrap_or(0.0)
-}
-
-fn tmp_sibling(p: &Path, tag: &str) -> PathBuf {
-    let name = p
-        .file_name()
-        .map(|s| s.to_string_lossy().to_string())
-        .unwrap_or_default();
-    p.with_file_name(format!(".{name}.weft-{tag}-{}", std::process::id()))
-}
-
-/// Remove temporaries (`.NAME.weft-tmp-PID`, `.NAME.weft-old-PID`) left in a folder by
-/// runs whose process is gone. Called once per output folder per run.
-fn clean_stale_tmps(dir: &Path) {
-    let Ok(rd) = std::fs::read_dir(dir) else {
-        return;
-    };
-    for e in rd.flatten() {
-        let n = e.file_name().to_string_lossy().to_string();
-        if !(n.starts_with('.') && (n.contains(".weft-tmp-") || n.contains(".weft-old-"))) {
-            continue;
-        }
-        let pid = n.rsplit('-').next().and_then(|s| s.parse::<u32>().ok());
-        let alive = pid
-            .is_some_and(|p| p == std::process::id() || Path::new(&format!("/proc/{p}")).exists());
-        if !alive {
-            let _ = std::fs::remove_dir_all(e.path()).or_else(|_| std::fs::remove_file(e.path()));
-        }
-    }
-}
-
-fn remove_path(p: &Path) -> std::io::Result<()> {
-    if p.is_dir() {
-        std::fs::remove_dir_all(p)
-    } else {
-        std::fs::remove_file(p)
-    }
-}
-
-/// Move a finished temporary output into place, replacing the old one.
-fn commit_output(tmp: &Path, dest: &Path) -> std::io::Result<()> {
-    if dest.exists() {
-        let old = tmp_sibling(dest, "old");
-        std::fs::rename(dest, &old)?;
-        std::fs::rename(tmp, dest)?;
-        let _ = remove_path(&old);
-    } else {
-        std::fs::rename(tmp, dest)?;
-    }
-    Ok(())
-}
-
-struct Job {
-    idx: usize,
-    name: String,
-    command: String,
-    root: PathBuf,
-    log: PathBuf,
-    path_env: std::ffi::OsString,
-}
-
-struct Done {
-    idx: usize,
-    status: i32,
-    start: f64,
-    end: f64,
-    error: Option<String>,
-}
-
-enum Msg {
-    Progress(usize, f64),
-    Done(Done),
-}
-
-fn run_job(job: Job, tx: mpsc::Sender<Msg>) {
-    let start = now_unix();
-    let res = (|| -> std::io::Result<i32> {
-        if let Some(d) = job.log.parent() {
-            std::fs::create_dir_all(d)?;
-        }
-        let mut log = std::fs::File::create(&job.log)?;
-        writeln!(
-            log,
-            "# weft stage `{}`\n# started {}\n# command: {}\n",
-            job.name,
-            iso_utc(start),
-            job.command
-        )?;
-        let mut cmd = Command::new("sh");
-        cmd.arg("-c")
-            .arg(&job.command)
-            .current_dir(&job.root)
-            .env("PATH", &job.path_env)
-            .env("WEFT_PROGRESS", "1")
-            .env("WEFT_STAGE", &job.name)
-            .stdin(Stdio::null())
-            .stdout(Stdio::from(log.try_clone()?))
-            .stderr(Stdio::piped());
-        #[cfg(target_os = "linux")]
-        unsafe {
-            use std::os::unix::process::CommandExt;
-            cmd.pre_exec(|| {
-                // The stage dies with weft: an interrupted run leaves no orphan writing.
-                libc::prctl(libc::PR_SET_PDEATHSIG, libc::SIGKILL);
-                Ok(())
-            });
-        }
-        let mut child = cmd.spawn()?;
-        let stderr = child.stderr.take().expect("piped");
-        for line in BufReader::new(stderr).lines() {
-            let line = line?;
-            if let Some(f) = line
-                .strip_prefix("weft-progress ")
-                .and_then(|s| s.trim().parse::<f64>().ok())
-            {
-                let _ = tx.send(Msg::Progress(job.idx, f));
-            } else {
-                writeln!(log, "{line}")?;
-            }
-        }
-        let st = child.wait()?;
-        Ok(st.code().unwrap_or_else(|| {
-            #[cfg(unix)]
-            {
-                use std::os::unix::process::ExitStatusExt;
-                128 + st.signal().unwrap_or(0)
-            }
-            #[cfg(not(unix))]
-            1
-        }))
-    })();
-    let end = now_unix();
-    let (status, error) = match res {
-        Ok(s) => (s, None),
-        Err(e) => (127, Some(e.to_string())),
-    };
-    let _ = tx.send(Msg::Done(Done {
-        idx: job.idx,
-        status,
-        start,
-        end,
-        error,
-    }));
 }
 
 /// Hold the project lock while alive.
@@ -481,7 +359,6 @@ pub fn run(
     force: &[bool],
     o: &RunOptions,
 ) -> Result<RunReport> {
-    let n = p.instances.len();
     let plan = ws.plan(p, selected, force)?;
     if o.dry_run {
         let mut outcomes = vec![];
@@ -497,10 +374,67 @@ pub fn run(
                 outcomes.push((inst.name.clone(), Outcome::Fresh));
             }
         }
+        if o.executor == ExecutorKind::Slurm && plan.iter().any(|v| !v.is_fresh()) {
+            println!("\n# the sbatch commands `weft run --executor slurm` would submit:");
+            let mut ex = SlurmExecutor::new(p, true)?;
+            let quiet = RunOptions {
+                quiet: true,
+                ..o.clone()
+            };
+            schedule(p, ws, selected, force, &plan, &quiet, &mut ex, vec![])?;
+        }
         ws.cache.save()?;
         return Ok(RunReport { outcomes });
     }
     let _lock = lock(&p.root)?;
+    match o.executor {
+        ExecutorKind::Local => {
+            let live = super::slurm::live_jobs(p).unwrap_or_default();
+            if let Some((inst, (job, state))) = live.iter().next() {
+                return Err(WeftError::input(format!(
+                    "{} Slurm jobs of an earlier `weft run --executor slurm` are still queued or running (`{inst}`: job {job}, {state})",
+                    live.len()
+                ))
+                .in_file(&p.file)
+                .hint("running them here too would race them; `weft run --executor slurm` waits for them, or cancel them with scancel"));
+            }
+            let mut ex = LocalExecutor::new(ws);
+            schedule(p, ws, selected, force, &plan, o, &mut ex, vec![])
+        }
+        ExecutorKind::Slurm => {
+            let mut ex = SlurmExecutor::new(p, false)?;
+            let adopted = ex.adopt(p, selected, force, &plan)?;
+            if ex.cancelled_at_start > 0 && !o.quiet {
+                eprintln!(
+                    "cancel {} Slurm jobs of an earlier `weft run` (their work changed, they were forced, something they need is stale again, or the run died before noting them)",
+                    ex.cancelled_at_start
+                );
+            }
+            let r = schedule(p, ws, selected, force, &plan, o, &mut ex, adopted);
+            if r.is_err() {
+                ex.cancel_all();
+            }
+            r
+        }
+    }
+}
+
+/// The scheduling loop, the same for every executor: hand over each instance when it is
+/// ready (its upstream done, or for an eager executor queued), judge it on the current
+/// content of its inputs when its upstream is done, skip what a failure cuts off, stop
+/// starting new ones after a failure without `--keep-going`, and show progress.
+#[allow(clippy::too_many_arguments)]
+fn schedule(
+    p: &Pipeline,
+    ws: &mut Workspace,
+    selected: &[bool],
+    force: &[bool],
+    plan: &[Verdict],
+    o: &RunOptions,
+    ex: &mut dyn Executor,
+    adopted: Vec<(usize, String, String)>,
+) -> Result<RunReport> {
+    let n = p.instances.len();
     let stale_count = (0..n)
         .filter(|&i| selected[i] && !plan[i].is_fresh())
         .count();
@@ -517,20 +451,15 @@ pub fn run(
         )
         .expect("template"),
     );
-    main.enable_steady_tick(std::time::Duration::from_millis(250));
+    if !ex.dry() {
+        main.enable_steady_tick(std::time::Duration::from_millis(250));
+    }
     let say = |s: String| {
         if attended {
             let _ = mp.println(s);
         } else if !o.quiet {
             eprintln!("{s}");
         }
-    };
-    let path_env = {
-        let mut dirs: Vec<PathBuf> = ws.exe_dir.iter().cloned().collect();
-        dirs.extend(std::env::split_paths(
-            &std::env::var_os("PATH").unwrap_or_default(),
-        ));
-        std::env::join_paths(dirs).unwrap_or_default()
     };
     #[derive(Clone, Copy, PartialEq)]
     enum St {
@@ -544,55 +473,61 @@ pub fn run(
     let mut outcome: BTreeMap<usize, Outcome> = BTreeMap::new();
     let mut running = 0usize;
     let mut stop = false;
-    let mut forced_or_changed = force.to_vec();
-    let (tx, rx) = mpsc::channel::<Msg>();
     let mut bars: BTreeMap<usize, ProgressBar> = BTreeMap::new();
-    let mut tmp_outputs: BTreeMap<usize, Vec<(PathBuf, PathBuf)>> = BTreeMap::new();
-    let mut cleaned: std::collections::HashSet<PathBuf> = Default::default();
+    for (i, job, state) in adopted {
+        st[i] = St::Running;
+        running += 1;
+        say(format!(
+            "adopt {}: Slurm job {job} ({state}) of an earlier `weft run`",
+            p.instances[i].name
+        ));
+    }
     loop {
-        // Launch every ready instance (deps done), judging it on current content.
+        // Hand over every ready instance; those it needs must be done or, for an eager
+        // executor, handed over in an earlier pass (so that they have a job to wait on).
         let mut progressed = false;
+        let mut batch: Vec<Launch> = vec![];
+        let mut this_pass = vec![false; n];
         for &i in &p.order {
             if !selected[i] || st[i] != St::Pending {
                 continue;
             }
             let inst = &p.instances[i];
-            if inst
-                .deps
-                .iter()
-                .any(|&d| selected[d] && matches!(st[d], St::Failed | St::Skipped))
-            {
+            let deps = || inst.deps.iter().copied().filter(|&d| selected[d]);
+            if deps().any(|d| matches!(st[d], St::Failed | St::Skipped)) {
                 st[i] = St::Skipped;
                 outcome.insert(i, Outcome::Skipped);
                 say(format!("skip  {} (an upstream stage failed)", inst.name));
-
                 progressed = true;
                 continue;
             }
-            if inst
-                .deps
-                .iter()
-                .any(|&d| selected[d] && matches!(st[d], St::Pending | St::Running))
-            {
+            if deps().any(|d| st[d] == St::Pending || this_pass[d]) {
                 continue;
             }
-            if stop || running >= o.jobs.max(1) {
+            let waiting_on: Vec<usize> = deps().filter(|&d| st[d] == St::Running).collect();
+            if stop || (!waiting_on.is_empty() && !ex.eager()) {
                 continue;
             }
-            let verdict = if forced_or_changed[i] {
-                Verdict::Stale("forced".into())
-            } else {
-                ws.verdict(inst)?
-            };
-            let reason = match verdict {
-                Verdict::Fresh => {
-                    st[i] = St::Ok;
-                    outcome.insert(i, Outcome::Fresh);
-
-                    progressed = true;
-                    continue;
+            if !ex.eager() && running + batch.len() >= o.jobs.max(1) {
+                continue;
+            }
+            let reason = if force[i] {
+                "forced".to_string()
+            } else if !waiting_on.is_empty() {
+                match &plan[i] {
+                    Verdict::Stale(r) | Verdict::Waiting(r) => r.clone(),
+                    Verdict::Fresh => "upstream reruns".into(),
                 }
-                Verdict::Stale(r) | Verdict::Waiting(r) => r,
+            } else {
+                match ws.verdict(inst)? {
+                    Verdict::Fresh => {
+                        st[i] = St::Ok;
+                        outcome.insert(i, Outcome::Fresh);
+                        progressed = true;
+                        continue;
+                    }
+                    Verdict::Stale(r) | Verdict::Waiting(r) => r,
+                }
             };
             if ws.binary_of(&inst.command).is_none() {
                 let name = inst.command.split_whitespace().next().unwrap_or("");
@@ -607,155 +542,114 @@ pub fn run(
                     "build the weft binaries (`cargo build --release`) or put the tool on PATH",
                 ));
             }
-            // Temporary outputs beside the real ones.
-            let mut pairs = vec![];
-            let mut outs_tmp = vec![];
-            for (k, out) in &inst.outputs {
-                let dest = ws.abs(out);
-                if let Some(d) = dest.parent() {
-                    std::fs::create_dir_all(d).map_err(|e| WeftError::io(d, e))?;
-                }
-                if let Some(d) = dest.parent() {
-                    if cleaned.insert(d.to_path_buf()) {
-                        clean_stale_tmps(d);
-                    }
-                }
-                let tmp = tmp_sibling(&dest, "tmp");
-                let _ = remove_path(&tmp);
-                let rel = tmp
-                    .strip_prefix(&ws.root)
-                    .unwrap_or(&tmp)
-                    .display()
-                    .to_string();
-                outs_tmp.push((k.clone(), rel));
-                pairs.push((tmp, dest));
-            }
-            let ins: Vec<(String, String)> = inst
-                .inputs
-                .iter()
-                .map(|(k, v)| (k.clone(), v.display().to_string()))
-                .collect();
-            let ctx = Ctx {
-                values: &inst.values,
-                inputs: &ins,
-                outputs: &outs_tmp,
-                stage: &inst.stage,
-                instance: &inst.name,
-            };
-            let command = render(&inst.cmd_template, &ctx)
-                .map_err(|e| WeftError::input(e).in_file(&p.file).at_line(inst.line))?
-                .0;
-            tmp_outputs.insert(i, pairs);
-            let log = ws
-                .logs
-                .join(format!("{}.log", super::spec::file_name_of(&inst.name)));
             st[i] = St::Running;
-            running += 1;
-            progressed = true;
-            say(format!("run   {} ({reason})", inst.name));
-
-            let bar = mp.insert_before(&main, ProgressBar::new(1000));
-            bar.set_style(
-                ProgressStyle::with_template(
-                    "  {spinner} {msg:40!} [{bar:20}] {percent:>3}% {elapsed}",
-                )
-                .expect("template"),
-            );
-            bar.set_message(inst.name.clone());
-            bar.enable_steady_tick(std::time::Duration::from_millis(200));
-            bars.insert(i, bar);
-            let job = Job {
+            this_pass[i] = true;
+            batch.push(Launch {
                 idx: i,
-                name: inst.name.clone(),
-                command,
-                root: ws.root.clone(),
-                log,
-                path_env: path_env.clone(),
-            };
-            let txc = tx.clone();
-            std::thread::spawn(move || run_job(job, txc));
+                reason,
+                force: force[i],
+                waiting_on,
+            });
         }
-        if running == 0 && !progressed {
-            break;
+        if !batch.is_empty() {
+            running += batch.len();
+            ex.launch(p, ws, batch, &say)?;
+            progressed = true;
         }
-        if running == 0 {
+        if progressed {
             continue;
         }
-        // Wait for progress or a finished job.
-        let msg = rx.recv().expect("a running job reports back");
-        match msg {
-            Msg::Progress(i, f) => {
-                if let Some(b) = bars.get(&i) {
-                    b.set_position((f.clamp(0.0, 1.0) * 1000.0) as u64);
-                }
-            }
-            Msg::Done(d) => {
-                running -= 1;
-
-                main.inc(1);
-                if let Some(b) = bars.remove(&d.idx) {
-                    b.finish_and_clear();
-                    mp.remove(&b);
-                }
-                let inst = &p.instances[d.idx];
-                let pairs = tmp_outputs.remove(&d.idx).unwrap_or_default();
-                let mut status = d.status;
-                let mut why = d.error.clone();
-                if status == 0 {
-                    if let Some((_, dest)) = pairs.iter().find(|(tmp, _)| !tmp.exists()) {
-                        status = 1;
-                        why = Some(format!(
-                            "the command succeeded but did not write output `{}`",
-                            dest.strip_prefix(&ws.root).unwrap_or(dest).display()
-                        ));
-                    }
-                }
-                let log_rel = ws
-                    .logs
-                    .join(format!("{}.log", super::spec::file_name_of(&inst.name)));
-                let log_rel = log_rel
-                    .strip_prefix(&ws.root)
-                    .unwrap_or(&log_rel)
-                    .display()
-                    .to_string();
-                if status == 0 {
-                    for (tmp, dest) in &pairs {
-                        commit_output(tmp, dest).map_err(|e| WeftError::io(dest, e))?;
-                    }
-                } else {
-                    for (tmp, _) in &pairs {
-                        let _ = remove_path(tmp);
-                    }
-                }
-                let rec = make_record(ws, inst, status, d.start, d.end, log_rel.clone())?;
-                ws.records.put(&rec)?;
-                if status == 0 {
-                    st[d.idx] = St::Ok;
-                    outcome.insert(
-                        d.idx,
-                        Outcome::Ran {
-                            seconds: d.end - d.start,
-                        },
+        if running == 0 || ex.dry() {
+            break;
+        }
+        for ev in ex.wait(p, ws)? {
+            match ev {
+                Event::Started(i) => {
+                    let bar = mp.insert_before(&main, ProgressBar::new(1000));
+                    bar.set_style(
+                        ProgressStyle::with_template(
+                            "  {spinner} {msg:40!} [{bar:20}] {percent:>3}% {elapsed}",
+                        )
+                        .expect("template"),
                     );
-                    say(format!("done  {} ({:.2} s)", inst.name, d.end - d.start));
-                } else {
-                    st[d.idx] = St::Failed;
-                    outcome.insert(d.idx, Outcome::Failed { status });
-                    let tail = log_tail(&ws.root.join(&log_rel), 6);
-                    say(format!(
-                        "FAIL  {} (exit status {status}{}); log: {log_rel}{tail}",
-                        inst.name,
-                        why.map(|w| format!(": {w}")).unwrap_or_default()
-                    ));
-                    if !o.keep_going {
-                        stop = true;
+                    bar.set_message(p.instances[i].name.clone());
+                    bar.enable_steady_tick(std::time::Duration::from_millis(200));
+                    bars.insert(i, bar);
+                }
+                Event::Note(s) => say(s),
+                Event::Progress(i, f) => {
+                    if let Some(b) = bars.get(&i) {
+                        b.set_position((f.clamp(0.0, 1.0) * 1000.0) as u64);
                     }
                 }
-                forced_or_changed[d.idx] = false;
+                Event::Done(i, fin) => {
+                    running -= 1;
+                    main.inc(1);
+                    if let Some(b) = bars.remove(&i) {
+                        b.finish_and_clear();
+                        mp.remove(&b);
+                    }
+                    let inst = &p.instances[i];
+                    match fin {
+                        Finish::Ran { seconds } => {
+                            st[i] = St::Ok;
+                            outcome.insert(i, Outcome::Ran { seconds });
+                            say(format!("done  {} ({seconds:.2} s)", inst.name));
+                        }
+                        Finish::Fresh => {
+                            st[i] = St::Ok;
+                            outcome.insert(i, Outcome::Fresh);
+                            say(format!(
+                                "fresh {} (its upstream reproduced the same inputs)",
+                                inst.name
+                            ));
+                        }
+                        Finish::Lost { why, .. }
+                            if inst.deps.iter().any(|&d| {
+                                selected[d] && matches!(st[d], St::Failed | St::Skipped)
+                            }) =>
+                        {
+                            st[i] = St::Skipped;
+                            outcome.insert(i, Outcome::Skipped);
+                            say(format!(
+                                "skip  {} (an upstream stage failed; {why})",
+                                inst.name
+                            ));
+                        }
+                        Finish::Lost { .. } if stop => {
+                            st[i] = St::Skipped;
+                            outcome.insert(i, Outcome::NotStarted);
+                        }
+                        Finish::Lost { why, more } => {
+                            st[i] = St::Failed;
+                            outcome.insert(i, Outcome::Failed { status: 1 });
+                            say(format!("FAIL  {} ({why}); {more}", inst.name));
+                            if !o.keep_going && !stop {
+                                stop = true;
+                                ex.stop_pending(&say)?;
+                            }
+                        }
+                        Finish::Failed { status, why, log } => {
+                            st[i] = St::Failed;
+                            outcome.insert(i, Outcome::Failed { status });
+                            let tail = log_tail(&ws.root.join(&log), 6);
+                            say(format!(
+                                "FAIL  {} (exit status {status}{}); log: {log}{tail}",
+                                inst.name,
+                                why.map(|w| format!(": {w}")).unwrap_or_default()
+                            ));
+                            if !o.keep_going && !stop {
+                                stop = true;
+                                ex.stop_pending(&say)?;
+                            }
+                        }
+                    }
+                }
             }
         }
     }
     main.finish_and_clear();
+    ex.close(ws)?;
     ws.cache.save()?;
     let mut outcomes = vec![];
     for &i in &p.order {
@@ -767,72 +661,6 @@ pub fn run(
         }
     }
     Ok(RunReport { outcomes })
-}
-
-fn make_record(
-    ws: &mut Workspace,
-    inst: &Instance,
-    status: i32,
-    start: f64,
-    end: f64,
-    log: String,
-) -> Result<Record> {
-    let mut inputs = BTreeMap::new();
-    let mut input_files = BTreeMap::new();
-    for (_, p) in &inst.inputs {
-        let key = p.display().to_string();
-        if let Some(h) = ws.cache.path(&ws.abs(p))? {
-            for (f, fh) in h.files {
-                input_files.insert(format!("{key}/{f}"), fh);
-            }
-            inputs.insert(key, h.hash);
-        }
-    }
-    let mut outputs = BTreeMap::new();
-    if status == 0 {
-        for (_, p) in &inst.outputs {
-            if let Some(h) = ws.cache.path(&ws.abs(p))? {
-                outputs.insert(p.display().to_string(), h.hash);
-            }
-        }
-    }
-    let bin = ws.binary_of(&inst.command);
-    let binary_hash = match &bin {
-        Some(b) => Some(ws.cache.file(b)?),
-        None => None,
-    };
-    Ok(Record {
-        instance: inst.name.clone(),
-        stage: inst.stage.clone(),
-        command: inst.command.clone(),
-        params: inst.params.clone(),
-        inputs,
-        input_files,
-        outputs,
-        binary: bin.map(|b| b.display().to_string()),
-        binary_hash,
-        tool_version: env!("CARGO_PKG_VERSION").to_string(),
-        start_unix: start,
-        end_unix: end,
-        start: iso_utc(start),
-        end: iso_utc(end),
-        exit_status: status,
-        log,
-    })
-}
-
-/// The last non-empty lines of a log, indented, for failure messages.
-fn log_tail(p: &Path, n: usize) -> String {
-    let s = std::fs::read_to_string(p).unwrap_or_default();
-    let lines: Vec<&str> = s
-        .lines()
-        .filter(|l| !l.trim().is_empty() && !l.starts_with("# "))
-        .collect();
-    let start = lines.len().saturating_sub(n);
-    lines[start..]
-        .iter()
-        .map(|l| format!("\n    | {l}"))
-        .collect()
 }
 
 /// Shell-quoted path for messages.

@@ -1,12 +1,14 @@
 //! The pipeline engine behind `weft`: declarative study files (`pipelines/*.toml`) with
 //! make-style reruns decided on content, parallel execution, atomic outputs, one record
-//! per stage instance, and gathering of sweep outputs into one table.
+//! per stage instance, local or Slurm executors (`exec`, `slurm`), and gathering of sweep outputs into one table.
 
 pub mod engine;
+pub mod exec;
 pub mod gather;
 pub mod hash;
 pub mod record;
+pub mod slurm;
 pub mod spec;
 
-pub use engine::{run, RunOptions, Verdict, Workspace};
+pub use engine::{run, ExecutorKind, RunOptions, Verdict, Workspace};
 pub use spec::Pipeline;

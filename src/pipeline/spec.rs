@@ -43,6 +43,33 @@ struct RawFile {
     vars: BTreeMap<String, Spanned<toml::Value>>,
     #[serde(default)]
     stages: BTreeMap<String, Spanned<RawStage>>,
+    executor: Option<Spanned<RawExecutor>>,
+}
+
+/// `[executor]`: Slurm resources, with `[executor.stages.NAME]` overrides.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawExecutor {
+    partition: Option<Spanned<String>>,
+    account: Option<Spanned<String>>,
+    time: Option<Spanned<String>>,
+    memory: Option<Spanned<String>>,
+    cpus: Option<Spanned<i64>>,
+    sbatch_args: Option<Spanned<Vec<String>>>,
+    poll_seconds: Option<Spanned<f64>>,
+    #[serde(default)]
+    stages: BTreeMap<String, Spanned<RawResources>>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawResources {
+    partition: Option<Spanned<String>>,
+    account: Option<Spanned<String>>,
+    time: Option<Spanned<String>>,
+    memory: Option<Spanned<String>>,
+    cpus: Option<Spanned<i64>>,
+    sbatch_args: Option<Spanned<Vec<String>>>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -120,6 +147,112 @@ pub struct Pipeline {
     pub instances: Vec<Instance>,
     /// Instances in a topological order.
     pub order: Vec<usize>,
+    /// The `[executor]` table (Slurm resources); defaults when absent.
+    pub executor: ExecutorSpec,
+}
+
+/// Slurm resources of a stage's jobs: `[executor]`, overridden by `[executor.stages.NAME]`.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Resources {
+    pub partition: Option<String>,
+    pub account: Option<String>,
+    /// Wall-time limit in a Slurm format (`MM`, `HH:MM:SS`, `D-HH:MM`, ...).
+    pub time: Option<String>,
+    /// Memory per job (`--mem`): a number of MB, or with a K, M, G or T suffix.
+    pub memory: Option<String>,
+    pub cpus: Option<u32>,
+    /// Further `sbatch` options, passed as given (e.g. `--qos=low`).
+    pub sbatch_args: Vec<String>,
+}
+
+impl Resources {
+    /// `self` with the fields `over` sets replaced; `sbatch_args` are appended.
+    fn overridden(&self, over: &Resources) -> Resources {
+        Resources {
+            partition: over.partition.clone().or_else(|| self.partition.clone()),
+            account: over.account.clone().or_else(|| self.account.clone()),
+            time: over.time.clone().or_else(|| self.time.clone()),
+            memory: over.memory.clone().or_else(|| self.memory.clone()),
+            cpus: over.cpus.or(self.cpus),
+            sbatch_args: self
+                .sbatch_args
+                .iter()
+                .chain(&over.sbatch_args)
+                .cloned()
+                .collect(),
+        }
+    }
+}
+
+/// The `[executor]` table: what `weft run --executor slurm` asks Slurm for.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ExecutorSpec {
+    pub default: Resources,
+    pub stages: BTreeMap<String, Resources>,
+    /// How often the attached controller polls `squeue` and the jobs' result files.
+    pub poll_seconds: f64,
+}
+
+impl Default for ExecutorSpec {
+    fn default() -> Self {
+        ExecutorSpec {
+            default: Resources::default(),
+            stages: BTreeMap::new(),
+            poll_seconds: 1.0,
+        }
+    }
+}
+
+impl ExecutorSpec {
+    /// The resources of one stage's jobs.
+    pub fn for_stage(&self, stage: &str) -> Resources {
+        match self.stages.get(stage) {
+            Some(o) => self.default.overridden(o),
+            None => self.default.clone(),
+        }
+    }
+}
+
+/// `sbatch` options weft sets itself, refused in `sbatch_args`.
+const OWN_SBATCH_OPTS: &[&str] = &[
+    "--parsable",
+    "--array",
+    "-a",
+    "--dependency",
+    "-d",
+    "--kill-on-invalid-dep",
+    "--wrap",
+    "--output",
+    "-o",
+    "--error",
+    "-e",
+    "--chdir",
+    "-D",
+    "--job-name",
+    "-J",
+    "--comment",
+];
+
+/// A Slurm time limit: `MM`, `MM:SS`, `HH:MM:SS`, `D-HH`, `D-HH:MM`, `D-HH:MM:SS`, or
+/// `UNLIMITED`/`INFINITE`.
+fn is_slurm_time(s: &str) -> bool {
+    if matches!(s, "UNLIMITED" | "INFINITE" | "unlimited" | "infinite") {
+        return true;
+    }
+    let digits = |x: &str| !x.is_empty() && x.bytes().all(|b| b.is_ascii_digit());
+    let rest = match s.split_once('-') {
+        Some((d, r)) if digits(d) => r,
+        Some(_) => return false,
+        None => s,
+    };
+    let parts: Vec<&str> = rest.split(':').collect();
+    (1..=3).contains(&parts.len()) && parts.iter().all(|p| digits(p))
+}
+
+/// A Slurm memory size: a number of MB, or with a K, M, G or T suffix.
+fn is_slurm_memory(s: &str) -> bool {
+    let n = s.trim_end_matches(['K', 'M', 'G', 'T', 'k', 'm', 'g', 't']);
+    s.len() - n.len() <= 1 && !n.is_empty() && n.bytes().all(|b| b.is_ascii_digit())
 }
 
 /// Offsets of line starts, for byte offset → line number in O(log n).
@@ -239,6 +372,101 @@ pub fn render(t: &str, ctx: &Ctx) -> std::result::Result<(String, Vec<String>), 
     Ok((out, used))
 }
 
+/// Check and convert one table of Slurm resources (`key` is where it sits in the file).
+fn resources(
+    r: RawResources,
+    key: &str,
+    err: &dyn Fn(String, usize, &str) -> WeftError,
+    line_of: &dyn Fn(&str, usize) -> usize,
+) -> Result<Resources> {
+    let l = |sp: std::ops::Range<usize>| line_of("", sp.start);
+    let word = |v: Option<Spanned<String>>, name: &str| -> Result<Option<String>> {
+        match v {
+            Some(s) if s.get_ref().is_empty() || s.get_ref().contains(char::is_whitespace) => {
+                Err(err(
+                    format!("`{name}` is {:?}", s.get_ref()),
+                    l(s.span()),
+                    &format!("{key}.{name}"),
+                )
+                .expected("a Slurm name without spaces"))
+            }
+            v => Ok(v.map(|s| s.into_inner())),
+        }
+    };
+    let partition = word(r.partition, "partition")?;
+    let account = word(r.account, "account")?;
+    let time = match r.time {
+        Some(t) if !is_slurm_time(t.get_ref()) => {
+            return Err(err(
+                format!("`time` is {:?}", t.get_ref()),
+                l(t.span()),
+                &format!("{key}.time"),
+            )
+            .expected("a Slurm time limit: MM, HH:MM:SS, D-HH:MM:SS, ...")
+            .hint("e.g. time = \"02:00:00\" for two hours"))
+        }
+        t => t.map(|t| t.into_inner()),
+    };
+    let memory = match r.memory {
+        Some(m) if !is_slurm_memory(m.get_ref()) => {
+            return Err(err(
+                format!("`memory` is {:?}", m.get_ref()),
+                l(m.span()),
+                &format!("{key}.memory"),
+            )
+            .expected("a size for `sbatch --mem`: MB, or with a K, M, G or T suffix")
+            .hint("e.g. memory = \"4G\""))
+        }
+        m => m.map(|m| m.into_inner()),
+    };
+    let cpus = match r.cpus {
+        Some(c) if !(1..=1_000_000).contains(c.get_ref()) => {
+            return Err(err(
+                format!("`cpus` is {}", c.get_ref()),
+                l(c.span()),
+                &format!("{key}.cpus"),
+            )
+            .expected("a whole number of CPUs per job, at least 1"))
+        }
+        c => c.map(|c| *c.get_ref() as u32),
+    };
+    let sbatch_args = match r.sbatch_args {
+        None => vec![],
+        Some(a) => {
+            let line = l(a.span());
+            let a = a.into_inner();
+            for x in &a {
+                let opt = x.split('=').next().unwrap_or("");
+                if !x.starts_with('-') {
+                    return Err(err(
+                        format!("`sbatch_args` holds {x:?}"),
+                        line,
+                        &format!("{key}.sbatch_args"),
+                    )
+                    .expected("sbatch options, each starting with `-`, e.g. \"--qos=low\""));
+                }
+                if OWN_SBATCH_OPTS.contains(&opt) {
+                    return Err(err(
+                        format!("`sbatch_args` sets `{opt}`, which weft sets itself"),
+                        line,
+                        &format!("{key}.sbatch_args"),
+                    )
+                    .hint("weft chooses the job name, comment, array, dependencies, output file and working folder; leave them out"));
+                }
+            }
+            a
+        }
+    };
+    Ok(Resources {
+        partition,
+        account,
+        time,
+        memory,
+        cpus,
+        sbatch_args,
+    })
+}
+
 /// Lexically normalise a relative path; `None` when it climbs above its start.
 fn normalise(p: &Path) -> Option<PathBuf> {
     let mut out = PathBuf::new();
@@ -296,7 +524,7 @@ impl Pipeline {
             let line = e.span().map(|s| line_of(src, s.start)).unwrap_or(0);
             let msg = e.message().to_string();
             let hint = if msg.contains("unknown field") {
-                "a pipeline file has [pipeline], [vars] and [stages.NAME] tables; a stage has cmd, inputs, outputs, params, matrix, foreach, desc"
+                "a pipeline file has [pipeline], [vars], [stages.NAME] and [executor] tables; a stage has cmd, inputs, outputs, params, matrix, foreach, desc; [executor] has partition, account, time, memory, cpus, sbatch_args, poll_seconds and [executor.stages.NAME]"
             } else if msg.contains("did not match any variant") {
                 "inputs and outputs are a list of paths or a table of named paths"
             } else {
@@ -611,11 +839,64 @@ impl Pipeline {
                 .hint("sweep values must differ"));
             }
         }
+        let executor = match raw.executor {
+            None => ExecutorSpec::default(),
+            Some(e) => {
+                let e = e.into_inner();
+                let mut spec = ExecutorSpec {
+                    default: resources(
+                        RawResources {
+                            partition: e.partition,
+                            account: e.account,
+                            time: e.time,
+                            memory: e.memory,
+                            cpus: e.cpus,
+                            sbatch_args: e.sbatch_args,
+                        },
+                        "executor",
+                        &err,
+                        &line_of,
+                    )?,
+                    ..ExecutorSpec::default()
+                };
+                if let Some(ps) = e.poll_seconds {
+                    let v = *ps.get_ref();
+                    if !(0.05..=600.0).contains(&v) {
+                        return Err(err(
+                            format!("`poll_seconds` is {v}"),
+                            line_of(src, ps.span().start),
+                            "executor.poll_seconds",
+                        )
+                        .expected("seconds between 0.05 and 600"));
+                    }
+                    spec.poll_seconds = v;
+                }
+                for (name, r) in e.stages {
+                    let line = line_of(src, r.span().start);
+                    if !instances.iter().any(|i| i.stage == name) {
+                        let mut names: Vec<&str> =
+                            instances.iter().map(|i| i.stage.as_str()).collect();
+                        names.dedup();
+                        return Err(err(
+                            format!("`[executor.stages.{name}]` names no stage"),
+                            line,
+                            &format!("executor.stages.{name}"),
+                        )
+                        .expected(format!("one of [{}]", names.join(", "))));
+                    }
+                    let key = format!("executor.stages.{name}");
+                    spec.stages
+                        .insert(name, resources(r.into_inner(), &key, &err, &line_of)?);
+                }
+                spec
+            }
+        };
         let mut p = Pipeline {
             file: file.to_path_buf(),
             root,
             instances,
             order: vec![],
+            executor,
         };
         p.link(src)?;
         Ok(p)

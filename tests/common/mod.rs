@@ -1,6 +1,8 @@
 //! Helpers shared by the integration tests: small models built in code.
 #![allow(dead_code)]
 
+use std::path::{Path, PathBuf};
+
 use weft::model::{Analysis, ElementKind, Load, Model, PartProps, TimeLaw};
 
 /// Node 0 fixed, node 1 a point mass `m` joined to it by a link (k, c along x) and free
@@ -299,4 +301,61 @@ pub fn run_ok(exe: &str, args: &[&str]) -> String {
         String::from_utf8_lossy(&o.stderr)
     );
     String::from_utf8_lossy(&o.stderr).to_string()
+}
+
+/// Every file under `root/runs`, relative to `root`, sorted.
+pub fn tables(root: &Path) -> Vec<PathBuf> {
+    fn walk(d: &Path, out: &mut Vec<PathBuf>) {
+        for e in std::fs::read_dir(d).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                walk(&p, out);
+            } else {
+                out.push(p);
+            }
+        }
+    }
+    let mut v = vec![];
+    walk(&root.join("runs"), &mut v);
+    v.iter_mut()
+        .for_each(|p| *p = p.strip_prefix(root).unwrap().to_path_buf());
+    v.sort();
+    v
+}
+
+/// Timing columns of the weft tables: wall times and the throughput derived from them.
+pub fn timing(column: &str) -> bool {
+    column.starts_with("wall_time") || column == "element_updates_per_second"
+}
+
+/// Whether two projects' `runs/` hold the same files: tables equal column by column,
+/// the timing columns aside (Parquet metadata names paths and is not compared), other
+/// files byte for byte. Returns the number of files.
+pub fn same_outputs(a: &Path, b: &Path) -> Result<usize, String> {
+    let (ta, tb) = (tables(a), tables(b));
+    if ta != tb {
+        return Err(format!("different files:\n{ta:?}\n{tb:?}"));
+    }
+    for rel in &ta {
+        if rel.extension().is_some_and(|e| e == "parquet") {
+            let (x, y) = (
+                weft::table::Table::read(&a.join(rel)).unwrap(),
+                weft::table::Table::read(&b.join(rel)).unwrap(),
+            );
+            let (sx, sy) = (x.batch.schema(), y.batch.schema());
+            let names: Vec<&String> = sx.fields().iter().map(|f| f.name()).collect();
+            let names_y: Vec<&String> = sy.fields().iter().map(|f| f.name()).collect();
+            if names != names_y || x.num_rows() != y.num_rows() {
+                return Err(format!("{}: columns or rows differ", rel.display()));
+            }
+            for n in names.iter().filter(|n| !timing(n)) {
+                if x.batch.column_by_name(n) != y.batch.column_by_name(n) {
+                    return Err(format!("{}: column `{n}` differs", rel.display()));
+                }
+            }
+        } else if std::fs::read(a.join(rel)).unwrap() != std::fs::read(b.join(rel)).unwrap() {
+            return Err(format!("{} differs", rel.display()));
+        }
+    }
+    Ok(ta.len())
 }
