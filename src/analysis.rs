@@ -203,6 +203,16 @@ pub enum Level {
 /// reached by the incident front (a later crossing is a reflection, or a wave that came
 /// another way).
 pub fn wave_speeds(s: &Series, component: usize, level: Level) -> WaveSpeeds {
+    wave_speeds_with(s, component, level, 0.0)
+}
+
+/// [`wave_speeds`] with a slack: outwards from the node reached first, an arrival may
+/// fall back by up to `slack` seconds behind the latest one so far and still count as
+/// the incident front (a node the level reaches a little early: a tied interface node
+/// on the membrane's plane, flat, beside a crimped crossing), instead of cutting the line
+/// there. A segment whose arrival does not advance outwards gets no speed; its nodes keep
+/// the speed of their other segment.
+pub fn wave_speeds_with(s: &Series, component: usize, level: Level, slack: f64) -> WaveSpeeds {
     let n = s.node_id.len();
     let mut position = vec![0.0; n];
     for j in 1..n {
@@ -244,7 +254,7 @@ pub fn wave_speeds(s: &Series, component: usize, level: Level) -> WaveSpeeds {
             while j >= 0 && (j as usize) < n {
                 let a = &mut arrival[j as usize];
                 match *a {
-                    Some(t) if !cut && t >= last => last = t,
+                    Some(t) if !cut && t >= last - slack => last = last.max(t),
                     _ => {
                         cut = true;
                         *a = None;
@@ -259,8 +269,13 @@ pub fn wave_speeds(s: &Series, component: usize, level: Level) -> WaveSpeeds {
             if j == 0 {
                 return None;
             }
+            // Outwards from the first node reached, arrivals advance: later to the right
+            // of it, earlier to its left (a wave running against the set's order).
+            let outward = first.is_none_or(|j0| j > j0);
             match (arrival[j - 1], arrival[j]) {
-                (Some(a), Some(b)) if b != a => Some((position[j] - position[j - 1]) / (b - a)),
+                (Some(a), Some(b)) if (outward && b > a) || (!outward && b < a) => {
+                    Some((position[j] - position[j - 1]) / (b - a))
+                }
                 _ => None,
             }
         })

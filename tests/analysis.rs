@@ -675,3 +675,34 @@ fn error_stage_interpolates_a_coarser_membrane_and_needs_no_velocities() {
         "{msg}"
     );
 }
+
+/// `weft-wavespeed --slack`: a ramp front at c = 10 mm/s along nodes 1 mm apart,
+/// u = max(0, t − x/c), level 2·10⁻³ (two samples past each node's kink, where linear
+/// interpolation between samples is exact): arrival x/c + 2·10⁻³. Node 5 is reached
+/// 0.1005 early, half a sample before node 4 (what a flat tied interface node beside a
+/// crimped crossing does). Without slack the front ends at node 5; with one sample's
+/// slack (10⁻³) it goes on, the segment 4→5 that does not advance gets no speed, and
+/// every segment that does not touch node 5 keeps the exact speed c.
+#[test]
+fn slack_lets_a_node_reached_a_little_early_keep_the_front_going() {
+    use weft::analysis::{wave_speeds, wave_speeds_with, Level};
+    let c = 1e-2;
+    let ids: Vec<i64> = (0..10).collect();
+    let s = series(1000, &ids, |t, x| {
+        let early = if (x - 5e-3).abs() < 1e-12 { 0.1005 } else { 0.0 };
+        (t - x / c + early).max(0.0)
+    });
+    let strict = wave_speeds(&s, 0, Level::Absolute(2e-3));
+    let reached: Vec<bool> = strict.arrival.iter().map(|a| a.is_some()).collect();
+    assert_eq!(&reached[..5], &[true; 5]);
+    assert_eq!(&reached[5..], &[false; 5]);
+    let w = wave_speeds_with(&s, 0, Level::Absolute(2e-3), 1e-3);
+    assert!(w.arrival.iter().all(|a| a.is_some()));
+    assert!(w.segment_speed[5].is_none(), "{:?}", w.segment_speed[5]);
+    for j in [1, 2, 3, 4, 7, 8, 9] {
+        let v = w.segment_speed[j].unwrap();
+        assert!(rel(v, c) < 1e-9, "segment {j}: {v}");
+    }
+    // Node 4's speed is its other segment's alone (c), not a mean with a bogus one.
+    assert!(rel(w.node_speed[4].unwrap(), c) < 1e-9);
+}

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use serde::Serialize;
 
-use super::{components, read_series, wave_speeds, Level, WaveSpeeds};
+use super::{components, read_series, wave_speeds_with, Level, WaveSpeeds};
 use crate::error::{Result, WeftError};
 use crate::table::{batch, write_table, Col, Provenance};
 
@@ -28,6 +28,9 @@ pub struct Config {
     pub relative_level: Option<f64>,
     /// One absolute level [m or m/s] instead.
     pub level: Option<f64>,
+    /// How far [s] an arrival may fall back outwards and still count as the incident
+    /// front (0: not at all).
+    pub slack: f64,
     /// Output table.
     pub out: PathBuf,
 }
@@ -71,9 +74,13 @@ pub fn run(c: &Config) -> Result<Report> {
                 .expected("a level > 0 in the component's unit (m or m/s)"));
         }
     }
+    if !(c.slack.is_finite() && c.slack >= 0.0) {
+        return Err(WeftError::input(format!("--slack = `{}`", c.slack))
+            .expected("a time ≥ 0 in s (e.g. one output interval)"));
+    }
     let s = read_series(&c.model, &c.history, &c.set)
         .map_err(|e| e.context("cannot read the node set's history"))?;
-    let w = wave_speeds(&s, comp[0], level);
+    let w = wave_speeds_with(&s, comp[0], level, c.slack);
     let reached = w.arrival.iter().filter(|a| a.is_some()).count();
     let prov = Provenance::new(
         "wavespeed",

@@ -46,6 +46,12 @@ struct Cli {
     /// Instead, one absolute level [m or m/s] for all nodes.
     #[arg(long)]
     level: Option<f64>,
+    /// How far [s] an arrival may fall back outwards and still count as the incident
+    /// front: a node reached a little early (e.g. a tied interface node on a flat
+    /// membrane beside a crimped crossing) then no longer cuts the line there; a segment
+    /// that does not advance gets no speed. Default 0: any fall-back ends the front.
+    #[arg(long, default_value_t = 0.0)]
+    slack: f64,
     /// Output table.
     #[arg(long)]
     out: PathBuf,
@@ -65,6 +71,7 @@ fn run() -> anyhow::Result<ExitCode> {
         line_level: cli.line_level,
         relative_level: cli.relative_level,
         level: cli.level,
+        slack: cli.slack,
         out: cli.out.clone(),
     })?;
     let n = r.speeds.node_id.len();
