@@ -108,6 +108,14 @@ pub fn read_nodes_of(
             }
         })
         .collect::<Result<_>>()?;
+    // T sums squares: a value whose square overflows would give T = NaN, named nowhere.
+    for (c, col) in cols.iter().enumerate() {
+        if let Some(r) = col.iter().position(|x| x.abs() > 1e150) {
+            return Err(h
+                .value_error(COMPONENTS[c], r, format!("value `{:e}`", col[r]))
+                .expected("|value| < 1e150 (its square must not overflow)"));
+        }
+    }
     let want: HashMap<i64, usize> = nodes
         .iter()
         .enumerate()
@@ -133,6 +141,11 @@ pub fn read_nodes_of(
             values[k][j] = std::array::from_fn(|c| cols[c][r]);
             seen[j] += 1;
         }
+    }
+    if times.is_empty() {
+        return Err(WeftError::input("the history has no rows")
+            .in_file(history)
+            .hint("was the run interrupted? rerun weft-simulate"));
     }
     if let Some(j) = (0..nodes.len()).find(|&j| seen[j] != times.len()) {
         return Err(WeftError::input(format!(

@@ -22,6 +22,79 @@ pub fn main(run: impl FnOnce() -> anyhow::Result<ExitCode>) -> ExitCode {
     }
 }
 
+/// Parse the command line as clap's `C::parse()` does, except that
+/// - a usage error (an unknown flag, a value that does not parse) exits with 1, as every
+///   other refusal does, not clap's 2 (`--help` and `--version` still exit 0);
+/// - a flag's value may start with `-` (`--force -1`, `--level -inf`): the value is then
+///   judged, and named with its flag, instead of being taken for an unknown flag `-1`;
+/// - a floating-point flag given NaN or ±inf is refused, naming the flag (no flag takes
+///   an infinite value).
+pub fn parse<C: clap::Parser>() -> C {
+    let mut cmd = hyphen_values(C::command());
+    let r = cmd
+        .try_get_matches_from_mut(std::env::args_os())
+        .and_then(|mut m| {
+            if let Err(msg) = finite_values(&cmd, &m) {
+                eprintln!("error: {msg}\n  hint: give a finite number (see --help)");
+                std::process::exit(1);
+            }
+            C::from_arg_matches_mut(&mut m)
+        });
+    r.unwrap_or_else(|e| {
+        let code = if e.use_stderr() { 1 } else { 0 };
+        let _ = e.format(&mut cmd).print();
+        std::process::exit(code)
+    })
+}
+
+/// Every flag that takes exactly one value accepts one starting with `-`.
+fn hyphen_values(c: clap::Command) -> clap::Command {
+    let subs: Vec<String> = c
+        .get_subcommands()
+        .map(|s| s.get_name().to_string())
+        .collect();
+    let mut c = c.mut_args(|a| {
+        let one = a
+            .get_num_args()
+            .is_none_or(|r| r.min_values() == 1 && r.max_values() == 1);
+        if a.get_long().is_some() && a.get_action().takes_values() && one {
+            a.allow_hyphen_values(true)
+        } else {
+            a
+        }
+    });
+    for s in subs {
+        c = c.mut_subcommand(s, hyphen_values);
+    }
+    c
+}
+
+/// The first floating-point flag given on the command line with a non-finite value.
+fn finite_values(cmd: &clap::Command, m: &clap::ArgMatches) -> Result<(), String> {
+    for a in cmd.get_arguments() {
+        let id = a.get_id().as_str();
+        if a.get_value_parser().type_id() != std::any::TypeId::of::<f64>()
+            || m.value_source(id) != Some(clap::parser::ValueSource::CommandLine)
+        {
+            continue;
+        }
+        if let Ok(Some(vs)) = m.try_get_many::<f64>(id) {
+            if let Some(v) = vs.into_iter().find(|v| !v.is_finite()) {
+                return Err(format!(
+                    "--{} `{v}` is not a finite number",
+                    a.get_long().unwrap_or(id)
+                ));
+            }
+        }
+    }
+    if let Some((name, sm)) = m.subcommand() {
+        if let Some(sc) = cmd.find_subcommand(name) {
+            finite_values(sc, sm)?;
+        }
+    }
+    Ok(())
+}
+
 /// Set by `weft run` for the stages it starts: report progress as protocol lines.
 pub const PROGRESS_ENV: &str = "WEFT_PROGRESS";
 

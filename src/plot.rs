@@ -747,6 +747,14 @@ fn save(chart: &Drawing, c: &Output) -> anyhow::Result<()> {
         ))
         .into());
     }
+    if !matches!(ext.as_str(), "png" | "svg") {
+        // Before any folder is made: a refusal leaves nothing behind.
+        return Err(WeftError::input(format!(
+            "--out `{}`: unknown figure format `{ext}` (expected a .png or .svg file name)",
+            c.out.display()
+        ))
+        .into());
+    }
     if let Some(dir) = c.out.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir)
             .with_context(|| format!("cannot create `{}`", dir.display()))?;

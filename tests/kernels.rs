@@ -89,10 +89,39 @@ fn truss_force_is_minus_energy_gradient() {
     }
 }
 
+/// The link's spring law written out here, independently of the code (DESIGN.md: springs
+/// along x, y, z on the relative displacement d = x₂ − x₁ − d₀, a slider's slip s taken
+/// off the tangential part): W = ½[k_x (d_x − s_x)² + k_y (d_y − s_y)² + k_z e_z²], with
+/// e_z = d_z, or min(d_z, 0) for a unilateral (push-only) normal spring.
+fn link_energy_closed_form(
+    x1: &[f64; 3],
+    x2: &[f64; 3],
+    d0: &[f64; 3],
+    k: &[f64; 3],
+    slip: &[f64; 2],
+    unilateral: bool,
+) -> f64 {
+    let d: Vec<f64> = (0..3).map(|i| x2[i] - x1[i] - d0[i]).collect();
+    let ez = if unilateral { d[2].min(0.0) } else { d[2] };
+    0.5 * (k[0] * (d[0] - slip[0]).powi(2) + k[1] * (d[1] - slip[1]).powi(2) + k[2] * ez * ez)
+}
+
+/// The link's force on each node is minus the gradient of the closed-form energy above
+/// (central differences of that energy, not of the code's `link::energy`), through both
+/// the solver's path (`force_update_law` at rest, no slider limit) and `elastic_force_law`;
+/// and the code's stored energy is the closed form. Comparing the code's force with the
+/// code's energy (the test this one replaces) cannot catch a law wrong in both. Mutations
+/// tried, each applied to force and energy alike: k_x and k_y swapped (in
+/// `force_update_parts`, `elastic_force_law` and `energy_law`), and a unilateral spring
+/// that pulls instead of pushing (`dz >= 0.0` → `dz <= 0.0` in `normal_spring`,
+/// `min` → `max` in `energy_law`): both fail here, both passed the old test.
 #[test]
-fn link_force_is_minus_energy_gradient() {
+fn link_force_is_minus_the_gradient_of_the_closed_form_energy() {
+    use weft::solver::link::{LinkLaw, LinkState};
     let mut rng = Rng(12345);
-    for case in 0..100 {
+    let mut checked = [0usize; 2];
+    let mut worst: f64 = 0.0;
+    for case in 0..200 {
         let p = LinkProps {
             k: [
                 1e3 * (1.5 + rng.next()),
@@ -102,26 +131,69 @@ fn link_force_is_minus_energy_gradient() {
             c: [0.0; 3],
             slip_force: f64::INFINITY,
         };
+        let unilateral = case % 2 == 1;
+        let law = LinkLaw {
+            friction: None,
+            unilateral,
+        };
         let slip = [1e-3 * rng.next(), 1e-3 * rng.next()];
         let x1 = rng.vec(1e-2);
         let x2 = rng.vec(1e-2);
         let d0 = rng.vec(1e-3);
-        let f2 = link::elastic_force(&link::rel_disp(&x1, &x2, &d0), &p, &slip);
         let h = 1e-7;
+        let d = link::rel_disp(&x1, &x2, &d0);
+        if d[2].abs() < 1e3 * h {
+            continue; // the unilateral spring's kink
+        }
+        checked[unilateral as usize] += 1;
+        let w = |a: &[f64; 3], b: &[f64; 3]| {
+            link_energy_closed_form(a, b, &d0, &p.k, &slip, unilateral)
+        };
+        // The code's stored energy is the closed form.
+        let e = link::energy_law(&d, &p, &law, &slip);
+        assert!(
+            (e - w(&x1, &x2)).abs() <= 1e-12 * w(&x1, &x2).max(1e-30),
+            "case {case}: energy {e} vs closed form {}",
+            w(&x1, &x2)
+        );
+        let mut st = LinkState {
+            slip,
+            ..Default::default()
+        };
+        let f_run = link::force_update_law(&d, &[0.0; 3], &p, &law, &mut st, 0.0);
+        let f_el = link::elastic_force_law(&d, &p, &law, &slip);
+        let scale = p.k[2] * 1e-2;
         for c in 0..3 {
             let (mut xp, mut xm) = (x2, x2);
             xp[c] += h;
             xm[c] -= h;
-            let e = |x: &[f64; 3]| link::energy(&link::rel_disp(&x1, x, &d0), &p, &slip);
-            let g = (e(&xp) - e(&xm)) / (2.0 * h);
-            assert!(
-                (f2[c] + g).abs() < 1e-6 * (f2[c].abs() + 1e-3),
-                "case {case} dir {c}: {} vs {}",
-                f2[c],
-                -g
-            );
+            let g2 = (w(&x1, &xp) - w(&x1, &xm)) / (2.0 * h);
+            let (mut yp, mut ym) = (x1, x1);
+            yp[c] += h;
+            ym[c] -= h;
+            let g1 = (w(&yp, &x2) - w(&ym, &x2)) / (2.0 * h);
+            // Measured: |f + ∂W/∂x| ≤ 2.8e-11 of the scale k_z·1 cm (round-off of the
+            // differences); a wrong stiffness is off by percents of it.
+            for (name, f) in [("force_update_law", f_run), ("elastic_force_law", f_el)] {
+                worst = worst.max((f[c] + g2).abs().max((-f[c] + g1).abs()) / scale);
+                assert!(
+                    (f[c] + g2).abs() < 1e-9 * scale,
+                    "case {case} ({name}) dir {c}: node 2 force {} vs −∂W/∂x₂ = {}",
+                    f[c],
+                    -g2
+                );
+                // Node 1 carries −f (the code gives node 2's force; momentum balance).
+                assert!(
+                    (-f[c] + g1).abs() < 1e-9 * scale,
+                    "case {case} ({name}) dir {c}: node 1 force {} vs −∂W/∂x₁ = {}",
+                    -f[c],
+                    -g1
+                );
+            }
         }
     }
+    eprintln!("link: {checked:?} cases, worst |f + ∂W/∂x| = {worst:.1e} of k_z·1 cm");
+    assert!(checked[0] > 50 && checked[1] > 50, "{checked:?}");
 }
 
 #[test]

@@ -322,7 +322,7 @@ fn bench_woven(yarns: usize, end_time: f64, threads: &[usize]) -> anyhow::Result
 }
 
 fn main() -> anyhow::Result<()> {
-    let cli = Cli::parse();
+    let cli: Cli = weft::cli::parse();
     if cli.woven {
         return bench_woven(cli.woven_yarns, cli.woven_end_time, &cli.threads);
     }

@@ -51,7 +51,7 @@ fn main() -> ExitCode {
 }
 
 fn run() -> anyhow::Result<ExitCode> {
-    let cli = Cli::parse();
+    let cli: Cli = weft::cli::parse();
     let r = export::run(&export::Config {
         model: cli.model.clone(),
         out: cli.out.clone(),

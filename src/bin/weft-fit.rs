@@ -124,7 +124,7 @@ fn main() -> ExitCode {
 }
 
 fn run() -> anyhow::Result<ExitCode> {
-    let cli = Cli::parse();
+    let cli: Cli = weft::cli::parse();
     let cfg = Config {
         reference_model: cli.reference_model,
         reference_history: cli.reference_history,

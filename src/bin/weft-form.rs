@@ -100,7 +100,7 @@ fn main() -> ExitCode {
 }
 
 fn run_cli() -> anyhow::Result<ExitCode> {
-    let cli = Cli::parse();
+    let cli: Cli = weft::cli::parse();
     if let Some(n) = cli.threads {
         rayon::ThreadPoolBuilder::new()
             .num_threads(n.max(1))

@@ -280,7 +280,7 @@ fn output(c: Common) -> plot::Output {
 }
 
 fn run() -> anyhow::Result<()> {
-    let cli = Cli::parse();
+    let cli: Cli = weft::cli::parse();
     let (figure, common) = match cli.figure {
         Figure::History(a) => (
             plot::Figure::History(plot::HistoryFigure {

@@ -82,7 +82,7 @@ fn main() -> ExitCode {
 }
 
 fn run_cli() -> anyhow::Result<ExitCode> {
-    let cli = Cli::parse();
+    let cli: Cli = weft::cli::parse();
     let cfg = Config {
         model: cli.model.clone(),
         out: cli.out.clone(),

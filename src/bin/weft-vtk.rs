@@ -52,7 +52,7 @@ fn main() -> ExitCode {
 }
 
 fn run() -> anyhow::Result<ExitCode> {
-    let cli = Cli::parse();
+    let cli: Cli = weft::cli::parse();
     let r = vtk::run(&vtk::Config {
         model: cli.model.clone(),
         history: cli.history.clone(),

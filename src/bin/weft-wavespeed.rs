@@ -62,7 +62,7 @@ fn main() -> ExitCode {
 }
 
 fn run() -> anyhow::Result<ExitCode> {
-    let cli = Cli::parse();
+    let cli: Cli = weft::cli::parse();
     let r = wavespeed::run(&wavespeed::Config {
         model: cli.model,
         history: cli.history,

@@ -501,7 +501,7 @@ fn main() -> ExitCode {
 }
 
 fn run() -> anyhow::Result<ExitCode> {
-    let cli = Cli::parse();
+    let cli: Cli = weft::cli::parse();
     let mut warn = |w: &str| match w.strip_prefix("note: ") {
         Some(n) => eprintln!("note: {n}"),
         None => eprintln!("warning: {w}"),

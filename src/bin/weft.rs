@@ -155,7 +155,7 @@ fn load(p: Option<PathBuf>) -> anyhow::Result<Pipeline> {
 }
 
 fn main_inner() -> anyhow::Result<ExitCode> {
-    let cli = Cli::parse();
+    let cli: Cli = weft::cli::parse();
     match cli.cmd {
         Cmd::Run {
             pipeline,

@@ -244,6 +244,13 @@ fn check(p: &WovenBandParams) -> Result<()> {
             return bad(n, v.to_string(), "a finite value > 0");
         }
     }
+    if !(p.yarns as f64 * p.spacing).is_finite() {
+        return bad(
+            "spacing",
+            p.spacing.to_string(),
+            "a spacing whose patch, yarns × spacing, is finite",
+        );
+    }
     if p.yarns == 0 || (!p.quarter && p.yarns % 2 != 0) {
         return bad(
             "yarns",

@@ -16,20 +16,37 @@ use crate::model::{
     Tie, TimeLaw,
 };
 
+/// The most mesh lines each way a graded zone may have (10⁶ elements at most).
+const MAX_LINES: usize = 1000;
+
 /// Line positions ≥ 0: uniform h_c up to `c`, then growing by `ratio` to `outer`.
+
 pub fn graded_lines(c: f64, hc: f64, outer: f64, ratio: f64) -> Result<Vec<f64>> {
+    if !(ratio >= 1.0 && ratio.is_finite()) {
+        return Err(WeftError::input(format!(
+            "the coarse cells' growth ratio (--growth) is {ratio}"
+        ))
+        .expected("a finite ratio ≥ 1 (1: uniform cells)"));
+    }
+    let flags = "the sizes come from --length (the outer size), --centre-length or --spacing \
+                 and --yarns (the centre), and --coarsening";
     let n = (c / hc).round() as usize;
-    if n == 0 || ((n as f64) * hc - c).abs() > 1e-9 * c {
+    if !(c > 0.0 && c.is_finite() && hc > 0.0)
+        || n == 0
+        || ((n as f64) * hc - c).abs() > 1e-9 * c
+    {
         return Err(WeftError::input(format!(
             "the centre half-size {c} m is not a multiple of the coarse spacing {hc} m"
         ))
-        .expected("a coarse spacing that divides the centre zone"));
+        .expected("a coarse spacing that divides the centre zone")
+        .hint(flags));
     }
-    if !(outer > c) {
+    if !(outer > c && outer.is_finite()) {
         return Err(WeftError::input(format!(
             "outer half-size {outer} m is not larger than the centre half-size {c} m"
         ))
-        .expected("outer > centre"));
+        .expected("outer > centre, finite")
+        .hint(flags));
     }
     let mut v: Vec<f64> = (0..=n).map(|k| k as f64 * hc).collect();
     let (mut x, mut h) = (c, hc);
@@ -37,6 +54,14 @@ pub fn graded_lines(c: f64, hc: f64, outer: f64, ratio: f64) -> Result<Vec<f64>>
         h *= ratio;
         x += h;
         v.push(x);
+        if v.len() > MAX_LINES {
+            return Err(WeftError::input(format!(
+                "the graded mesh out to {outer} m would have more than {MAX_LINES} lines \
+                 each way"
+            ))
+            .expected("an outer size a few hundred centre cells across at most")
+            .hint(flags));
+        }
     }
     // The last cell ends on the boundary.
     if (outer - x) > 1e-12 {
