@@ -178,6 +178,9 @@ fn patch(kind: ElementKind) -> Model {
     m
 }
 
+/// Mutation tried (2026-11-23): the ν₁₂E₂ coupling terms of the material matrix set to
+/// 0 in `solver/membrane.rs`: this test fails (its stiffness matrix is written out by
+/// hand here, not taken from the code).
 #[test]
 fn patch_test_reproduces_a_uniform_strain_exactly() {
     // u = A·X: F = I + A uniform, so every element has the same Green strain; the interior

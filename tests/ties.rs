@@ -208,6 +208,8 @@ fn a_slave_off_its_master_edge_is_refused() {
 /// *Wave Motion in Elastic Solids*, §1.6). Measured from the kinetic energy on each side
 /// once the two pulses have separated (a travelling bar wave carries equal kinetic and
 /// strain energy). A tie that dropped its interpolation weights would reflect everything.
+/// Mutation tried (2026-11-23): every weight replaced by 1/(number of masters) in
+/// `solver/ties.rs`: this test and the two beside it fail.
 #[test]
 fn a_tied_impedance_step_reflects_and_transmits_what_the_impedances_say() {
     let (mut m, _, off) = joined();
