@@ -20,7 +20,6 @@ use crate::model::{
 const MAX_LINES: usize = 1000;
 
 /// Line positions ≥ 0: uniform h_c up to `c`, then growing by `ratio` to `outer`.
-
 pub fn graded_lines(c: f64, hc: f64, outer: f64, ratio: f64) -> Result<Vec<f64>> {
     if !(ratio >= 1.0 && ratio.is_finite()) {
         return Err(WeftError::input(format!(
