@@ -817,7 +817,11 @@ fn slack_lets_a_node_reached_a_little_early_keep_the_front_going() {
     let c = 1e-2;
     let ids: Vec<i64> = (0..10).collect();
     let s = series(1000, &ids, |t, x| {
-        let early = if (x - 5e-3).abs() < 1e-12 { 0.1005 } else { 0.0 };
+        let early = if (x - 5e-3).abs() < 1e-12 {
+            0.1005
+        } else {
+            0.0
+        };
         (t - x / c + early).max(0.0)
     });
     let strict = wave_speeds(&s, 0, Level::Absolute(2e-3));

@@ -382,13 +382,21 @@ fn a_band_stretched_past_the_steps_margin_stops_with_its_strain_named() {
         for (i, x) in nodes.iter().enumerate() {
             m.add_node(i as i64 + 1, *x);
         }
-        let part = m.add_part(1, "band", ElementKind::Quad, props(80e9, 1.6e9, 0.0, 0.8e9, 0.0));
+        let part = m.add_part(
+            1,
+            "band",
+            ElementKind::Quad,
+            props(80e9, 1.6e9, 0.0, 0.8e9, 0.0),
+        );
         for (e, ns) in elems.iter().enumerate() {
             m.add_element(e as i64 + 1, part, ns);
         }
         // λ from the Green strain E = (λ² − 1)/2; u₀ = (λ − 1) x.
         let lam = (1.0 + 2.0 * e11).sqrt();
-        m.initial_displacement = nodes.iter().map(|x| [(lam - 1.0) * x[0], 0.0, 0.0]).collect();
+        m.initial_displacement = nodes
+            .iter()
+            .map(|x| [(lam - 1.0) * x[0], 0.0, 0.0])
+            .collect();
         for (i, x) in nodes.iter().enumerate() {
             let end = x[0] < 1e-12 || (x[0] - lx).abs() < 1e-12;
             m.constraints.push((i, [end, true, true]));
@@ -402,7 +410,10 @@ fn a_band_stretched_past_the_steps_margin_stops_with_its_strain_named() {
     let s = Solver::new(&band(0.0, safety)).unwrap();
     let margin = (s.stable.dt_stable / s.stable.dt).powi(2);
     let threshold = (margin - 1.0) / 3.0;
-    eprintln!("margin {margin:.5} (1/dt_safety² = {:.5}), threshold E11 = {threshold:.4}", 1.0 / (safety * safety));
+    eprintln!(
+        "margin {margin:.5} (1/dt_safety² = {:.5}), threshold E11 = {threshold:.4}",
+        1.0 / (safety * safety)
+    );
     assert!((margin - 1.0 / (safety * safety)).abs() < 1e-9 * margin);
     let (_s, out, _) = run_in_memory(&band(0.95 * threshold, safety)).unwrap();
     let e = out.energy.last().unwrap();

@@ -233,8 +233,14 @@ fn woven_reduced_study_fits_the_girder_to_the_yarn_level_patch() {
         .replace("end_time = 5e-5", "end_time = 2e-5")
         // The 5-yarn reference's diagonal: ids 1, 52, 121, 190, 259 (0 … 4 mm).
         .replace("nodes = \"241,523,805,1087\"", "nodes = \"52,121,190\"")
-        .replace("--starts 4 --max-evaluations 40", "--starts 2 --max-evaluations 12")
-        .replace("--starts 4 --max-evaluations 50", "--starts 2 --max-evaluations 16");
+        .replace(
+            "--starts 4 --max-evaluations 40",
+            "--starts 2 --max-evaluations 12",
+        )
+        .replace(
+            "--starts 4 --max-evaluations 50",
+            "--starts 2 --max-evaluations 16",
+        );
     std::fs::write(&p, s).unwrap();
     weft_run(root, "woven_reduced.toml");
     let out = root.join("runs/woven_reduced");
@@ -257,9 +263,19 @@ fn woven_reduced_study_fits_the_girder_to_the_yarn_level_patch() {
     };
     let (trial, paper, ext) = (summary("trial"), summary("paper"), summary("extended"));
     eprintln!("T, max node error: trial {trial:?}, paper fit {paper:?}, extended fit {ext:?}");
-    assert!(ext.0 <= paper.0, "extended T {} above its start {}", ext.0, paper.0);
+    assert!(
+        ext.0 <= paper.0,
+        "extended T {} above its start {}",
+        ext.0,
+        paper.0
+    );
     assert!(ext.0 < trial.0, "extended T {} vs trial {}", ext.0, trial.0);
-    assert!(ext.1 < trial.1, "extended max error {} vs trial {}", ext.1, trial.1);
+    assert!(
+        ext.1 < trial.1,
+        "extended max error {} vs trial {}",
+        ext.1,
+        trial.1
+    );
     let count = |m: &str| {
         let s = Table::read(&out.join(format!("impact/{m}/summary.parquet"))).unwrap();
         s.i64("elements", "").unwrap()[0]
@@ -275,7 +291,10 @@ fn woven_reduced_study_fits_the_girder_to_the_yarn_level_patch() {
         assert!(out.join("figures").join(fig).exists(), "{fig}");
     }
     let again = weft_run(root, "woven_reduced.toml");
-    assert!(again.contains("fresh") && !again.contains("run "), "{again}");
+    assert!(
+        again.contains("fresh") && !again.contains("run "),
+        "{again}"
+    );
 }
 
 /// The §3 pipeline (`pipelines/woven_membrane.toml`) made small: a 4-yarn patch in a
@@ -297,12 +316,18 @@ fn woven_membrane_study_runs_small_and_the_fit_lowers_t() {
         .replace("end_time = 2e-5", "end_time = 5e-6")
         // Crossings at 1, 2, 3 mm (id 8k + 1).
         .replace("nodes = \"33,49,65\"", "nodes = \"9,17,25\"")
-        .replace("--starts 4 --max-evaluations 40", "--starts 2 --max-evaluations 10");
+        .replace(
+            "--starts 4 --max-evaluations 40",
+            "--starts 2 --max-evaluations 10",
+        );
     std::fs::write(&p, s).unwrap();
     weft_run(root, "woven_membrane.toml");
     let out = root.join("runs/woven_membrane");
     let fit = Table::read(&out.join("fit/fit_result.parquet")).unwrap();
-    let (t0, t) = (fit.f64("T_initial", "").unwrap()[0], fit.f64("T", "").unwrap()[0]);
+    let (t0, t) = (
+        fit.f64("T_initial", "").unwrap()[0],
+        fit.f64("T", "").unwrap()[0],
+    );
     eprintln!("membrane fit: T {t0:.3e} -> {t:.3e}");
     assert!(t < t0, "fit T {t} vs start {t0}");
     for run in ["impact/reference", "impact/combined", "impact_all/fitted"] {
@@ -321,9 +346,17 @@ fn woven_membrane_study_runs_small_and_the_fit_lowers_t() {
             .unwrap()[0]
     };
     assert!(nodes("combined") < nodes("reference"));
-    for fig in ["uz_crossings.png", "uz_field.png", "error_fit.png", "fit_convergence.png"] {
+    for fig in [
+        "uz_crossings.png",
+        "uz_field.png",
+        "error_fit.png",
+        "fit_convergence.png",
+    ] {
         assert!(out.join("figures").join(fig).exists(), "{fig}");
     }
     let again = weft_run(root, "woven_membrane.toml");
-    assert!(again.contains("fresh") && !again.contains("run "), "{again}");
+    assert!(
+        again.contains("fresh") && !again.contains("run "),
+        "{again}"
+    );
 }

@@ -339,7 +339,10 @@ fn band_ends_meet_the_membrane_where_the_yarn_level_patch_does() {
     let mut f = p.clone();
     f.quarter = false;
     let e = woven_reduced(&f).unwrap_err().to_string();
-    assert!(e.contains("--interface band-ends") && e.contains("--full"), "{e}");
+    assert!(
+        e.contains("--interface band-ends") && e.contains("--full"),
+        "{e}"
+    );
 }
 
 fn tilt(theta: f64, v: [f64; 3]) -> [f64; 3] {

@@ -30,10 +30,7 @@ pub fn graded_lines(c: f64, hc: f64, outer: f64, ratio: f64) -> Result<Vec<f64>>
     let flags = "the sizes come from --length (the outer size), --centre-length or --spacing \
                  and --yarns (the centre), and --coarsening";
     let n = (c / hc).round() as usize;
-    if !(c > 0.0 && c.is_finite() && hc > 0.0)
-        || n == 0
-        || ((n as f64) * hc - c).abs() > 1e-9 * c
-    {
+    if !(c > 0.0 && c.is_finite() && hc > 0.0) || n == 0 || ((n as f64) * hc - c).abs() > 1e-9 * c {
         return Err(WeftError::input(format!(
             "the centre half-size {c} m is not a multiple of the coarse spacing {hc} m"
         ))
@@ -649,9 +646,11 @@ impl WovenParams {
                 .expected("an even number ≥ 2 (a crossing at the centre)"));
         }
         if self.interface == Interface::BandEnds && !self.quarter {
-            return Err(WeftError::input("--interface band-ends with --full".to_string())
-                .expected("a quarter model (the band ends of a full patch lie on both sides)")
-                .hint("leave out --full, or use --interface crossing"));
+            return Err(
+                WeftError::input("--interface band-ends with --full".to_string())
+                    .expected("a quarter model (the band ends of a full patch lie on both sides)")
+                    .hint("leave out --full, or use --interface crossing"),
+            );
         }
         let r = &self.surround;
         let mut positive = vec![
@@ -733,8 +732,7 @@ pub fn woven_reduced(p: &WovenParams) -> Result<Model> {
     for j in 0..=n {
         for i in 0..=n {
             let (x, y) = (x0 + i as f64 * p.spacing, x0 + j as f64 * p.spacing);
-            let boundary =
-                !ends && ((x.abs() - c).abs() < 1e-12 || (y.abs() - c).abs() < 1e-12);
+            let boundary = !ends && ((x.abs() - c).abs() < 1e-12 || (y.abs() - c).abs() < 1e-12);
             // Plain weave: the warp passes over and under alternately; flat on the boundary.
             let z = if boundary {
                 0.0
@@ -890,7 +888,12 @@ pub fn woven_reduced(p: &WovenParams) -> Result<Model> {
                     eid,
                     lk,
                     &pair,
-                    [warp_at(ia, j), warp_at(ib, j), weft_at(i, ja), weft_at(i, jb)],
+                    [
+                        warp_at(ia, j),
+                        warp_at(ib, j),
+                        weft_at(i, ja),
+                        weft_at(i, jb),
+                    ],
                 );
             } else {
                 m.add_element(eid, lk, &pair);

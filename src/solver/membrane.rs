@@ -205,13 +205,18 @@ pub fn green_strain<const N: usize>(x: &[[f64; 3]; N], r: &Reference<N>) -> [f64
 /// principal stress over the stiffest modulus. Uniaxial St Venant–Kirchhoff: 1 + 3E₁₁,
 /// the tangent modulus (3λ² − 1)/2 over E. A band sheared in its plane (G ≪ E₁) stiffens
 /// little: its fibre terms do not see the shear. Returns it with the Green strain.
-pub fn stiffening<const N: usize>(x: &[[f64; 3]; N], r: &Reference<N>, m: &Material) -> (f64, [f64; 3]) {
+pub fn stiffening<const N: usize>(
+    x: &[[f64; 3]; N],
+    r: &Reference<N>,
+    m: &Material,
+) -> (f64, [f64; 3]) {
     let (_, e) = kinematics(x, r);
     let (c11, c22) = (1.0 + 2.0 * e[0], 1.0 + 2.0 * e[1]);
     let (e1, e2, g) = (m.d[0][0], m.d[1][1], m.d[2][2]);
     let material = ((e1 * c11).max(e2 * c22) + 2.0 * g * c11.max(c22)) / (e1.max(e2) + 2.0 * g);
     let sv = stress(m, &e);
-    let s_max = (0.5 * (sv[0] + sv[1])).abs() + (0.25 * (sv[0] - sv[1]).powi(2) + sv[2] * sv[2]).sqrt();
+    let s_max =
+        (0.5 * (sv[0] + sv[1])).abs() + (0.25 * (sv[0] - sv[1]).powi(2) + sv[2] * sv[2]).sqrt();
     (material + s_max / m.e_max(), e)
 }
 

@@ -1013,14 +1013,14 @@ impl Solver {
     }
 }
 
-/// Set up and run a model in the current thread pool, keeping every output sample in
-/// memory (tests, and stages that run the solver in-process).
 /// Steps between two checks of the membranes' stiffening against the step
 /// (`Solver::check_stiffening`, in `stable.rs`): often enough that a strain growing
 /// towards the margin (1/dt_safety² − 1 = 0.23 at 0.9, in 1 + 3E₁₁) is caught before it
 /// has run away; one check costs about one membrane force pass without the forces.
 const STIFFENING_CHECK_EVERY: u64 = 20;
 
+/// Set up and run a model in the current thread pool, keeping every output sample in
+/// memory (tests, and stages that run the solver in-process).
 pub fn run_in_memory(m: &Model) -> Result<(Solver, output::MemorySink, RunStats)> {
     let mut s = Solver::new(m)?;
     let mut sink = output::MemorySink::default();

@@ -115,7 +115,11 @@ impl Solver {
     /// whose step with those rows falls below the step in use stops the run, naming the
     /// element that stiffened it most: a clear message instead of the blow-up a few
     /// steps later.
-    pub(super) fn check_stiffening(&self, rows: &(Vec<f64>, Vec<f64>), dt: f64) -> crate::error::Result<()> {
+    pub(super) fn check_stiffening(
+        &self,
+        rows: &(Vec<f64>, Vec<f64>),
+        dt: f64,
+    ) -> crate::error::Result<()> {
         let x = &self.state.x;
         let nn = x.len();
         let mut extra = vec![0.0; nn];
@@ -138,10 +142,18 @@ impl Solver {
             }
             // The element that stiffened this node most (a master's may sit on its slave).
             let pick = |i: usize| -> Option<(ElementKind, i64, [f64; 3], f64)> {
-                let q = mq[i].map(|(a, e, st): (f64, usize, [f64; 3])| (a, ElementKind::Quad, self.op.el.quad.id[e], st));
-                let t = mt[i].map(|(a, e, st): (f64, usize, [f64; 3])| (a, ElementKind::Tri, self.op.el.tri.id[e], st));
+                let q = mq[i].map(|(a, e, st): (f64, usize, [f64; 3])| {
+                    (a, ElementKind::Quad, self.op.el.quad.id[e], st)
+                });
+                let t = mt[i].map(|(a, e, st): (f64, usize, [f64; 3])| {
+                    (a, ElementKind::Tri, self.op.el.tri.id[e], st)
+                });
                 match (q, t) {
-                    (Some(q), Some(t)) => Some(if q.0 >= t.0 { (q.1, q.2, q.3, q.0) } else { (t.1, t.2, t.3, t.0) }),
+                    (Some(q), Some(t)) => Some(if q.0 >= t.0 {
+                        (q.1, q.2, q.3, q.0)
+                    } else {
+                        (t.1, t.2, t.3, t.0)
+                    }),
                     (Some(q), None) => Some((q.1, q.2, q.3, q.0)),
                     (None, Some(t)) => Some((t.1, t.2, t.3, t.0)),
                     (None, None) => None,
