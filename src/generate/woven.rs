@@ -290,15 +290,14 @@ fn check(p: &WovenBandParams) -> Result<()> {
     if p.layers == 0 {
         return bad("layers", "0".into(), "≥ 1");
     }
-    if !(p.friction >= 0.0 && p.projectile_friction >= 0.0 && p.layer_gap >= 0.0) {
-        return bad(
-            "friction",
-            format!(
-                "{}, {}, gap {}",
-                p.friction, p.projectile_friction, p.layer_gap
-            ),
-            "friction and the layer gap ≥ 0",
-        );
+    for (flag, v, what) in [
+        ("friction", p.friction, "a Coulomb coefficient ≥ 0"),
+        ("projectile-friction", p.projectile_friction, "a Coulomb coefficient ≥ 0"),
+        ("layer-gap", p.layer_gap, "a clearance ≥ 0 in m"),
+    ] {
+        if !(v >= 0.0) {
+            return bad(flag, v.to_string(), what);
+        }
     }
     if !(p.projectile_velocity.is_finite() && p.projectile_velocity >= 0.0) {
         return bad(
