@@ -292,7 +292,11 @@ fn check(p: &WovenBandParams) -> Result<()> {
     }
     for (flag, v, what) in [
         ("friction", p.friction, "a Coulomb coefficient ≥ 0"),
-        ("projectile-friction", p.projectile_friction, "a Coulomb coefficient ≥ 0"),
+        (
+            "projectile-friction",
+            p.projectile_friction,
+            "a Coulomb coefficient ≥ 0",
+        ),
         ("layer-gap", p.layer_gap, "a clearance ≥ 0 in m"),
     ] {
         if !(v >= 0.0) {

@@ -458,12 +458,12 @@ pub struct MembraneGroup<const N: usize> {
 impl<const N: usize> MembraneGroup<N> {
     /// Adds each element's stiffening (see [`stiffening`]) to its nodes' stiffness rows
     /// of the stable step, (ratio − 1) × its largest eigenvalue k_max, and keeps, per
-    /// node, the element that adds most: `(added, element index, Green strain)`.
+    /// node, the element that adds most: `(added, kind, element id, Green strain)`.
     pub fn add_stiffening(
         &self,
         x: &[[f64; 3]],
         extra: &mut [f64],
-        most: &mut [Option<(f64, usize, [f64; 3])>],
+        most: &mut [Option<(f64, ElementKind, i64, [f64; 3])>],
     ) {
         for (e, ns) in self.nodes.iter().enumerate() {
             let xe: [[f64; 3]; N] = std::array::from_fn(|a| x[ns[a] as usize]);
@@ -476,7 +476,7 @@ impl<const N: usize> MembraneGroup<N> {
                 let n = n as usize;
                 extra[n] += add;
                 if most[n].is_none_or(|m| add > m.0) {
-                    most[n] = Some((add, e, strain));
+                    most[n] = Some((add, Self::KIND, self.id[e], strain));
                 }
             }
         }

@@ -815,10 +815,10 @@ impl Solver {
         let mut k = 0u64;
         let progress_every = (n_out / 200).max(1);
         let mut last_e = Energies::default();
-        let rows = self.step_rows();
+        let mut stiffening = self.stiffening_check();
         while k <= n_out {
             if self.state.step % STIFFENING_CHECK_EVERY == 0 {
-                self.check_stiffening(&rows, dt)?;
+                self.check_stiffening(&mut stiffening, dt)?;
             }
             let t0 = Instant::now();
             self.op.apply_loads(&self.state);

@@ -29,6 +29,16 @@ pub struct StableStep {
     pub element: Option<(ElementKind, i64)>,
 }
 
+/// What [`Solver::check_stiffening`] keeps through a run: the stable step's nodal
+/// stiffness and damping rows S_i, C_i, and its buffers (the stiffening added per node,
+/// and the element that added most: `(added, kind, id, Green strain)`).
+pub struct StiffeningCheck {
+    s: Vec<f64>,
+    c: Vec<f64>,
+    extra: Vec<f64>,
+    most: Vec<Option<(f64, ElementKind, i64, [f64; 3])>>,
+}
+
 /// Mass added by mass scaling.
 #[derive(Debug, Clone, Default)]
 pub struct MassScaling {
@@ -101,10 +111,17 @@ impl Solver {
         best
     }
 
-    /// The nodal stiffness and damping sums of the stable step, kept for
-    /// [`Solver::check_stiffening`].
-    pub(super) fn step_rows(&self) -> (Vec<f64>, Vec<f64>) {
-        self.nodal_sums()
+    /// The stable step's nodal rows and the buffers of [`Solver::check_stiffening`],
+    /// made once per run so that the check allocates nothing.
+    pub(super) fn stiffening_check(&self) -> StiffeningCheck {
+        let (s, c) = self.nodal_sums();
+        let nn = s.len();
+        StiffeningCheck {
+            s,
+            c,
+            extra: vec![0.0; nn],
+            most: vec![None; nn],
+        }
     }
 
     /// Stops a run whose membranes have stretched so far that the fixed step no longer
@@ -117,59 +134,39 @@ impl Solver {
     /// steps later.
     pub(super) fn check_stiffening(
         &self,
-        rows: &(Vec<f64>, Vec<f64>),
+        k: &mut StiffeningCheck,
         dt: f64,
     ) -> crate::error::Result<()> {
         let x = &self.state.x;
-        let nn = x.len();
-        let mut extra = vec![0.0; nn];
-        let (mut mq, mut mt) = (vec![None; nn], vec![None; nn]);
-        self.op.el.quad.add_stiffening(x, &mut extra, &mut mq);
-        self.op.el.tri.add_stiffening(x, &mut extra, &mut mt);
+        k.extra.fill(0.0);
+        k.most.fill(None);
+        self.op.el.quad.add_stiffening(x, &mut k.extra, &mut k.most);
+        self.op.el.tri.add_stiffening(x, &mut k.extra, &mut k.most);
         for t in &self.op.ties.ties {
             for (a, &mn) in t.masters.iter().enumerate() {
-                extra[mn] += t.w[a] * extra[t.slave];
+                k.extra[mn] += t.w[a] * k.extra[t.slave];
             }
         }
-        let (s, c) = rows;
-        for i in 0..nn {
-            if extra[i] <= 0.0 || self.fixed[i] == 0b111 || self.mass[i] <= 0.0 {
+        for i in 0..x.len() {
+            if k.extra[i] <= 0.0 || self.fixed[i] == 0b111 || self.mass[i] <= 0.0 {
                 continue;
             }
-            let dt_i = nodal_dt(s[i] + extra[i], c[i], self.mass[i], self.alpha);
+            let dt_i = nodal_dt(k.s[i] + k.extra[i], k.c[i], self.mass[i], self.alpha);
             if dt_i >= dt {
                 continue;
             }
             // The element that stiffened this node most (a master's may sit on its slave).
-            let pick = |i: usize| -> Option<(ElementKind, i64, [f64; 3], f64)> {
-                let q = mq[i].map(|(a, e, st): (f64, usize, [f64; 3])| {
-                    (a, ElementKind::Quad, self.op.el.quad.id[e], st)
-                });
-                let t = mt[i].map(|(a, e, st): (f64, usize, [f64; 3])| {
-                    (a, ElementKind::Tri, self.op.el.tri.id[e], st)
-                });
-                match (q, t) {
-                    (Some(q), Some(t)) => Some(if q.0 >= t.0 {
-                        (q.1, q.2, q.3, q.0)
-                    } else {
-                        (t.1, t.2, t.3, t.0)
-                    }),
-                    (Some(q), None) => Some((q.1, q.2, q.3, q.0)),
-                    (None, Some(t)) => Some((t.1, t.2, t.3, t.0)),
-                    (None, None) => None,
-                }
-            };
-            let who = pick(i).or_else(|| {
+            let who = k.most[i].or_else(|| {
                 self.op
                     .ties
                     .ties
                     .iter()
                     .filter(|t| t.masters.contains(&i))
-                    .filter_map(|t| pick(t.slave))
-                    .max_by(|a, b| a.3.total_cmp(&b.3))
+                    .filter_map(|t| k.most[t.slave])
+                    .max_by(|a, b| a.0.total_cmp(&b.0))
             });
             let what = match who {
-                Some((kind, id, e, _)) => format!(
+                Some((_, kind, id, e)) => format!(
                     "{} `{id}` has stretched to a Green strain of [{:.3}, {:.3}, {:.3}] (E₁₁, E₂₂, 2E₁₂)",
                     kind.name(),
                     e[0],
