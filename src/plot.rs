@@ -833,7 +833,12 @@ where
         .light_line_style(RGBColor(235, 235, 235))
         .y_label_formatter(&|v| {
             if log {
-                format!("{:.0e}", 10f64.powf(*v))
+                // Ticks between decades (10^−2.5 …) need a second digit to tell apart.
+                if (*v - v.round()).abs() < 1e-9 {
+                    format!("{:.0e}", 10f64.powf(v.round()))
+                } else {
+                    format!("{:.1e}", 10f64.powf(*v))
+                }
             } else {
                 tick(*v)
             }
