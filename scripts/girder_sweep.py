@@ -3,7 +3,7 @@
 
     python3 scripts/girder_sweep.py > pipelines/girder_sweep.toml                (the default)
     python3 scripts/girder_sweep.py --cells 4,6,8,10,12,14 --ratios 7 \\
-        --combined-cells 12,16 --membrane-cells 4,6,8 > pipelines/girder_sweep.toml   (larger)
+        --combined-cells 12,16 --membrane-cells 4,8 > pipelines/girder_sweep.toml   (larger)
 
 A pipeline's sweep values are literal, so the grid (and the closed forms beside each
 point, which --expected needs as numbers) is written out here rather than computed in TOML.
@@ -16,13 +16,18 @@ T = L * math.sqrt(RHO_G / E)          # tension pulse period (the girder_membran
 PERIODS = {"tension": T, "shear": 40 * T}
 
 
+def g_name(n, k, n_r):
+    return f"g{n}-r{k}" if k < n_r else f"heldout-g{n}"
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--cells", default="5,6,7,8,9,10", help="N_g of the same-mesh sweep")
     ap.add_argument("--ratios", type=int, default=5,
                     help="b/a values, log-spaced over the paper's 1/20..1/8 (eq. 3)")
     ap.add_argument("--combined-cells", default="12", help="N_g of the combined sweep")
-    ap.add_argument("--membrane-cells", default="4,6", help="N_m of the combined sweep")
+    ap.add_argument("--membrane-cells", default="4,8",
+                    help="N_m of the combined sweep (multiples of 4: the zone's edges at L/4, 3L/4)")
     ap.add_argument("--starts", type=int, default=4, help="dynamic multistart starts")
     ap.add_argument("--evaluations", type=int, default=400, help="dynamic evaluations per start")
     ap.add_argument("--heldout", default="7,0.085",
@@ -40,20 +45,25 @@ def main():
     girders = sorted(set((n, k) for n in cells + ccells for k in range(n_r)))
     ratios.append(hr)          # index n_r: the held-out ratio
     girders.append((hn, n_r))
-    membranes = sorted(set(cells + mcells + [hn]))
-    # One fit instance per (x, mode): same-mesh (N_m = N_g, matched by position, all
-    # nodes) and combined (N_m < N_g, interpolated, the central zone).
+    membranes = sorted(set(cells + [hn]))
+    for n in ccells + mcells:
+        if n % 4:
+            ap.error(f"--combined-cells and --membrane-cells must be multiples of 4 (got {n}): "
+                     "the girder zone's edges lie at L/4 and 3L/4 on both grids")
+    # One fit instance per (x, approach): same-mesh (N_m = N_g, all nodes) and combined
+    # (the Fig. 5b model: N_m membrane cells around a girder zone of N_g; the zone's
+    # nodes compared). Both match the girder's nodes by position.
     fits = []
     for n in cells:
         for k in range(n_r):
-            fits.append((n, k, n, "position", "reference"))
+            fits.append((n, k, n, "same-mesh", "reference", f"membrane/{n}"))
     for n in ccells:
         for k in range(n_r):
             for m in mcells:
-                fits.append((n, k, m, "interpolate", "centre"))
+                fits.append((n, k, m, "combined", "centre", f"combined/{g_name(n, k, n_r)}-m{m}"))
 
     def g(n, k):
-        return f"g{n}-r{k}" if k < n_r else f"heldout-g{n}"
+        return g_name(n, k, n_r)
 
     out = []
     w = out.append
@@ -66,18 +76,17 @@ def main():
 #
 # Written by scripts/girder_sweep.py (the sweep values are literal): to scale up, e.g.
 #   python3 scripts/girder_sweep.py --cells 4,6,8,10,12,14 --ratios 7 \\
-#       --combined-cells 12,16 --membrane-cells 4,6,8 > pipelines/girder_sweep.toml
+#       --combined-cells 12,16 --membrane-cells 4,8 > pipelines/girder_sweep.toml
 #
 # Grid: N_g = {cells}, b/a = {', '.join(f'{r:.4f}' for r in ratios)} (log-spaced over
 # the paper's eq. 3 range 1/20..1/8; b_g = (b/a)·L/N_g); L = 0.1 m, E = 150 GPa,
 # ρ_g = 7800 kg/m³, b = h, joints rigid, clamp holding translations (girder_membrane.toml).
 # - same mesh (x = {{b_g, N_g}}): the membrane on the girder's nodes, all nodes compared;
-# - combined (x = {{b_g, N_m, N_g}}, the paper's Fig. 5b reduced to its comparison): a
-#   coarser membrane of N_m = {mcells} cells against the girder of N_g = {ccells} cells,
-#   the membrane interpolated with its own shape functions at the girder's nodes of the
-#   central L/2 × L/2 zone (`--match interpolate --set centre`). The girder zone is not
-#   embedded in the membrane: the combined generator (weft-weave combined) carries a
-#   transverse centre load only, not the in-plane tension and shear cases fitted here.
+# - combined (x = {{b_g, N_m, N_g}}, the paper's Fig. 5b): a membrane of N_m = {mcells}
+#   cells per side with a girder zone L/2 × L/2 at its centre (the rods of the girder of
+#   N_g = {ccells} cells, tied to the membrane around it; `weft-weave membrane
+#   --girder-cells`), fitted so that the zone's nodes move as the full girder's central
+#   zone does (`--set centre`, matched by position; the paper's reference nodes).
 # Each x is fitted statically ({{G, s}}; ρ does not enter a static solve, from a poor start)
 # and then dynamically ({{G, s, ρ}}, {a.starts} starts × {a.evaluations} evaluations) from the
 # static fit's membranes (G and s fitted, ρ still the poor start): from the poor start
@@ -110,6 +119,19 @@ params = "--param membrane.G12:1e7:1e11:log --param membrane.s:1e-6:1e-2:log"
     w("]")
     w('outputs = { model = "${out}/membrane/${cells}/${case}" }\n')
 
+    combos = sorted(set((n, k, m) for n, k, m, approach, _, _ in fits if approach == "combined"))
+    if combos:
+        w("[stages.combined]")
+        w('desc = "the combined models (Fig. 5b): the start membrane of N_m cells around the girder zone, both load cases"')
+        w('cmd = "weft-weave membrane --cells ${N_m} --girder-cells ${N_g} --rod-width ${b} --load-case ${case} --period ${period} ${start} --out ${outputs.model}"')
+        w("foreach = [")
+        for n, k, m in combos:
+            b = ratios[k] * L / n
+            for case, p in PERIODS.items():
+                w(f'  {{ name = "{g(n, k)}", N_g = {n}, N_m = {m}, b = {b:.10e}, case = "{case}", period = {p:.15e} }},')
+        w("]")
+        w('outputs = { model = "${out}/combined/${name}-m${N_m}/${case}" }\n')
+
     w("[stages.girder_run]")
     w('desc = "the girders\' static solve and explicit run"')
     w('cmd = "weft-simulate --quiet ${flag} --model ${inputs.model} --out ${outputs.run}"')
@@ -132,24 +154,25 @@ params = "--param membrane.G12:1e7:1e11:log --param membrane.s:1e-6:1e-2:log"
                 w(f'desc = "{where}: the membrane\'s {{G, s, ρ}} fitted dynamically from the static fit (multistart)"')
                 extra = (f"--param membrane.rho:1e3:1e5:log --expected membrane.rho=${{rho_cf}} "
                          f"--starts {a.starts} --max-evaluations {a.evaluations}")
-            w(f'''cmd = """weft-fit --quiet --threads 1 --components ux,uy --set ${{set}} --match ${{match}} ${{params}} {extra} \\
+            w(f'''cmd = """weft-fit --quiet --threads 1 --components ux,uy --set ${{set}} ${{params}} {extra} \\
   --expected membrane.G12=${{G_cf}} --expected membrane.s=${{s_cf}} \\
   --reference-model ${{inputs.gt}} --reference-history ${{inputs.rt}}/history.parquet --model ${{inputs.mt}} \\
   --reference-model ${{inputs.gs}} --reference-history ${{inputs.rs}}/history.parquet --model ${{inputs.ms}} \\
   --out ${{outputs.fit}}"""''')
             w("foreach = [")
-            for n, k, m, match, st in fits:
+            for n, k, m, approach, st, initial in fits:
                 r = ratios[k]
                 b = r * L / n
-                w(f'  {{ name = "{g(n, k)}", N_g = {n}, b_g = {b:.10e}, ratio = {r:.10e}, N_m = {m}, '
-                  f'match = "{match}", set = "{st}", '
+                fit = f"{g(n, k)}-m{m}" if approach == "same-mesh" else f"{g(n, k)}-zone-m{m}"
+                w(f'  {{ name = "{g(n, k)}", fit = "{fit}", approach = "{approach}", N_g = {n}, b_g = {b:.10e}, '
+                  f'ratio = {r:.10e}, N_m = {m}, set = "{st}", initial = "{initial}", '
                   f'G_cf = {E * r * r / 2:.10e}, s_cf = {r * r * L / n:.10e}, rho_cf = {RHO_G * (2 - r):.10e} }},')
             w("]")
             w(f'inputs = {{ gt = "${{out}}/girder/${{name}}/tension", gs = "${{out}}/girder/${{name}}/shear", '
               f'rt = "${{out}}/runs/${{name}}/{mode}-tension", rs = "${{out}}/runs/${{name}}/{mode}-shear", '
-              + ('mt = "${out}/membrane/${N_m}/tension", ms = "${out}/membrane/${N_m}/shear" }' if mode == "static" else
-                 f'mt = "${{out}}/{prefix}/static/${{name}}-m${{N_m}}/models/tension", ms = "${{out}}/{prefix}/static/${{name}}-m${{N_m}}/models/shear" }}'))
-            w(f'outputs = {{ fit = "${{out}}/{prefix}/{mode}/${{name}}-m${{N_m}}" }}\n')
+              + ('mt = "${out}/${initial}/tension", ms = "${out}/${initial}/shear" }' if mode == "static" else
+                 f'mt = "${{out}}/{prefix}/static/${{fit}}/models/tension", ms = "${{out}}/{prefix}/static/${{fit}}/models/shear" }}'))
+            w(f'outputs = {{ fit = "${{out}}/{prefix}/{mode}/${{fit}}" }}\n')
 
     fit_stages("fit", fits, "each girder x")
     for mode in ["static", "dynamic"]:
@@ -163,7 +186,7 @@ outputs = {{ table = "${{out}}/sweep_{mode}.parquet" }}
     xs = f"b_g={hb:.10e},N_g={hn}"
     w(f"""[stages.surrogate]
 desc = "regression and the paper's network search (n1 = 3..17 × tanh, logistic × {a.restarts} restarts) on the same-mesh dynamic fits: x = {{b_g, N_g}} → y = {{G, s, ρ}}"
-cmd = "weft-surrogate train --table ${{inputs.table}} --filter match=position --inputs b_g,N_g --outputs membrane.G12,membrane.s,membrane.rho --restarts {a.restarts} --out ${{outputs.dir}}"
+cmd = "weft-surrogate train --table ${{inputs.table}} --filter approach=same-mesh --inputs b_g,N_g --outputs membrane.G12,membrane.s,membrane.rho --restarts {a.restarts} --out ${{outputs.dir}}"
 inputs = {{ table = "${{out}}/sweep_dynamic.parquet" }}
 outputs = {{ dir = "${{out}}/surrogate" }}
 
@@ -204,7 +227,7 @@ matrix = {{ case = ["tension", "shear"] }}
 inputs = {{ g = "${{out}}/girder/{g(hn, n_r)}/${{case}}", gr = "${{out}}/runs/{g(hn, n_r)}/dynamic-${{case}}", m = "${{out}}/heldout/predicted/${{case}}", mr = "${{out}}/heldout/runs/${{case}}" }}
 outputs = {{ dir = "${{out}}/heldout/error/${{case}}" }}
 """)
-    fit_stages("heldout_fit", [(hn, n_r, hn, "position", "reference")], "the held-out x, fitted directly")
+    fit_stages("heldout_fit", [(hn, n_r, hn, "same-mesh", "reference", f"membrane/{hn}")], "the held-out x, fitted directly")
     out_txt = "\n".join(out)
     print(out_txt)
 

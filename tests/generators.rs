@@ -458,3 +458,116 @@ fn an_unloaded_model_at_rest_runs_with_no_energy_error() {
     // 1 µm/s over its whole mass.
     assert!(scale < 0.5 * mass * 1e-12, "{scale} vs {mass} kg");
 }
+
+/// The paper's Fig. 5b: the membrane of N_m cells per side with a girder zone L/2 × L/2
+/// at its centre (rods of the girder of N_g cells per side), its closed-form equivalent
+/// membrane around it (s = b²/a, ρ = ρ_g(2 − b/a), a = L/N_g; Gibson & Ashby §4.3,
+/// DESIGN.md §8).
+fn zone_membrane(nm: usize, ng: usize, lc: LoadCase) -> (MembraneParams, Model) {
+    use weft::generate::square::GirderZone;
+    let z = GirderZone {
+        length: 0.05,
+        cells: ng,
+        youngs_modulus: 1.5e11,
+        density: 7800.0,
+        rod_width: 0.1 / (10.0 * ng as f64),
+        rigid: true,
+    };
+    let (s, rho, g) = z.equivalent(0.1);
+    let p = MembraneParams {
+        square: sq(nm, lc),
+        youngs_modulus: 1.5e11,
+        poisson_ratio: 0.0,
+        shear_modulus: g,
+        thickness: s,
+        density: rho,
+        girder_zone: Some(z),
+    };
+    let m = membrane(&p).unwrap();
+    (p, m)
+}
+
+#[test]
+fn a_membrane_with_a_girder_zone_weighs_and_stretches_as_the_lattice() {
+    for (nm, ng) in [(4usize, 12usize), (8, 8), (4, 20)] {
+        let (p, m) = zone_membrane(nm, ng, LoadCase::Tension);
+        let z = p.girder_zone.as_ref().unwrap();
+        let (a, b) = (0.1 / ng as f64, z.rod_width);
+        let nz = ng / 2;
+        // Every boundary node of the zone tied once, to the hole's edge it lies on.
+        assert_eq!(m.ties.len(), 4 * nz, "N_m = {nm}, N_g = {ng}");
+        let centre = &m.node_sets["centre"];
+        assert_eq!(centre.len(), (nz + 1) * (nz + 1));
+        let (lo, hi) = (0.025 - 1e-12, 0.075 + 1e-12);
+        assert!(centre.iter().all(|&n| {
+            let x = m.coords[n];
+            (lo..=hi).contains(&x[0]) && (lo..=hi).contains(&x[1])
+        }));
+        // The zone's nodes sit where the full girder's `centre` nodes do, so that
+        // position matching pairs them (the paper's reference nodes).
+        let (g, _) = girder(&gp(ng, LoadCase::Tension, true)).unwrap();
+        let key = |m: &Model, n: usize| {
+            let x = m.coords[n];
+            ((x[0] * 1e9).round() as i64, (x[1] * 1e9).round() as i64)
+        };
+        let mut mine: Vec<_> = centre.iter().map(|&n| key(&m, n)).collect();
+        let mut theirs: Vec<_> = g.node_sets["centre"].iter().map(|&n| key(&g, n)).collect();
+        mine.sort();
+        theirs.sort();
+        assert_eq!(mine, theirs);
+        // Mass: the lattice's areal density ρ_g·b²(2 − b/a)/a over all of L², the zone
+        // as rods (its boundary rods half) and the rest as the equivalent membrane.
+        let mass = Solver::new(&m).unwrap().physical_mass;
+        let exact = 7800.0 * b * b * (2.0 - b / a) / a * 0.01;
+        assert!(rel(mass, exact) < 1e-12, "{mass} vs {exact}");
+        // Static tension (ν = 0): uniform strain ε = F/(E·s·L) = F/(E·b²·N_g) in the
+        // membrane and in the zone's rods alike, so u_x = ε·x at every node, the tied
+        // boundary included (a linear field is exact on the hole's edges).
+        let u = Solver::new(&m).unwrap().solve_static(&m).unwrap().u;
+        let eps = 100.0 / (1.5e11 * b * b * ng as f64);
+        let worst = (0..m.num_nodes())
+            .map(|n| (u[n][0] - eps * m.coords[n][0]).abs().max(u[n][1].abs()))
+            .fold(0.0, f64::max);
+        eprintln!("N_m = {nm}, N_g = {ng}: {:.2e} of ε·L", worst / (eps * 0.1));
+        // Measured: 4.7e-10, 2.6e-10, 1.1e-9 of ε·L (the sparse solve's round-off).
+        assert!(
+            worst < 1e-8 * eps * 0.1,
+            "N_m = {nm}, N_g = {ng}: {worst:e} m"
+        );
+    }
+}
+
+#[test]
+fn a_girder_zone_that_misses_the_grid_is_refused_with_a_hint() {
+    use weft::generate::square::GirderZone;
+    let mk = |nm: usize, ng: usize, length: f64| {
+        membrane(&MembraneParams {
+            girder_zone: Some(GirderZone {
+                length,
+                cells: ng,
+                youngs_modulus: 1.5e11,
+                density: 7800.0,
+                rod_width: 1e-3,
+                rigid: true,
+            }),
+            ..MembraneParams::paper_default(sq(nm, LoadCase::Tension))
+        })
+        .err()
+        .expect("an error")
+        .to_string()
+    };
+    let e = mk(6, 12, 0.05);
+    assert!(
+        e.contains("membrane's grid lines") && e.contains("multiple of 4"),
+        "{e}"
+    );
+    let e = mk(4, 10, 0.05);
+    assert!(
+        e.contains("girder's grid lines") && e.contains("--girder-cells"),
+        "{e}"
+    );
+    let e = mk(4, 12, 0.1);
+    assert!(e.contains("--zone-length"), "{e}");
+    let e = mk(4, 100, 0.05);
+    assert!(e.contains("--rod-width") && e.contains("L/N_g"), "{e}");
+}

@@ -6,7 +6,7 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 use weft::generate::rod::RodParams;
-use weft::generate::square::{GirderParams, LoadCase, MembraneParams, Square};
+use weft::generate::square::{GirderParams, GirderZone, LoadCase, MembraneParams, Square};
 use weft::generate::weave::{self, Spec};
 use weft::generate::zones::{
     Centre, CombinedParams, Interface, MembraneProps, PretensionStart, SurroundParams, WovenParams,
@@ -45,7 +45,8 @@ enum Model {
     Girder(GirderArgs),
     /// The same square meshed with N × N membrane quads (the equivalent membrane),
     /// clamped at x = 0 and loaded at x = L. Defaults: the closed-form equivalent of the
-    /// default girder (s = b²/a, ρ = ρ_g(2 − b/a), G = E(b/a)²/2 with b/a = 0.1).
+    /// default girder (s = b²/a, ρ = ρ_g(2 − b/a), G = E(b/a)²/2 with b/a = 0.1). With
+    /// --girder-cells, the paper's combined model (Fig. 5b): a girder zone at the centre.
     Membrane(MembraneArgs),
     /// A dense centre zone (rigid girder or fine membrane) inside a coarse membrane whose
     /// elements grow with distance from the centre, joined by tied interfaces; pinned outer
@@ -454,6 +455,28 @@ struct MembraneArgs {
     /// Density ρ [kg/m³] [default: ρ_g(2 − b/a) = 14820].
     #[arg(long)]
     density: Option<f64>,
+    /// The paper's combined model (Fig. 5b): a girder zone of side --zone-length at the
+    /// centre, the rods of a girder of this many cells per side L (N_g), tied to the
+    /// membrane (N_m = --cells) around it. The membrane's defaults then follow the zone's
+    /// girder: s = b²/a, ρ = ρ_g(2 − b/a), G = E(b/a)²/2 with a = L/N_g. Node set
+    /// `centre`: the zone's nodes (the paper's reference nodes).
+    #[arg(long)]
+    girder_cells: Option<usize>,
+    /// Side of the girder zone L_m [m] [default: L/2]; its edges must lie on both grids.
+    #[arg(long, requires = "girder_cells")]
+    zone_length: Option<f64>,
+    /// Girder zone: rod width = thickness b [m] [default: L/(10 N_g)].
+    #[arg(long, requires = "girder_cells")]
+    rod_width: Option<f64>,
+    /// Girder zone: the rods' Young's modulus [Pa] [default: --youngs-modulus].
+    #[arg(long, requires = "girder_cells")]
+    rod_modulus: Option<f64>,
+    /// Girder zone: the rods' density ρ_g [kg/m³].
+    #[arg(long, default_value_t = 7800.0, requires = "girder_cells")]
+    rod_density: f64,
+    /// Girder zone: joints rigid (beams) or pinned (trusses).
+    #[arg(long, value_enum, default_value_t = Joints::Rigid, requires = "girder_cells")]
+    joints: Joints,
 }
 
 #[derive(clap::Args)]
@@ -671,20 +694,34 @@ fn run() -> anyhow::Result<ExitCode> {
             );
         }
         Model::Membrane(a) => {
-            let d = MembraneParams::paper_default(a.square.square());
+            let mut d = MembraneParams::paper_default(a.square.square());
+            let l = a.square.length;
+            let zone = a.girder_cells.map(|ng| GirderZone {
+                length: a.zone_length.unwrap_or(0.5 * l),
+                cells: ng,
+                youngs_modulus: a.rod_modulus.unwrap_or(a.youngs_modulus),
+                density: a.rod_density,
+                rod_width: a.rod_width.unwrap_or(l / (10.0 * ng.max(1) as f64)),
+                rigid: a.joints == Joints::Rigid,
+            });
+            if let Some(z) = &zone {
+                (d.thickness, d.density, d.shear_modulus) = z.equivalent(l);
+            }
             let p = MembraneParams {
                 youngs_modulus: a.youngs_modulus,
                 poisson_ratio: a.poisson_ratio,
                 shear_modulus: a.shear_modulus.unwrap_or(d.shear_modulus),
                 thickness: a.thickness.unwrap_or(d.thickness),
                 density: a.density.unwrap_or(d.density),
+                girder_zone: zone,
                 ..d
             };
             let m = weave::run(&Spec::Membrane(p.clone()), &a.square.out, &mut warn)?;
             eprintln!(
-                "weft-weave membrane: {} nodes, {} quads, s = {:.3e} m, ρ = {:.1} kg/m³, G = {:.3e} Pa -> {}",
+                "weft-weave membrane: {} nodes, {} elements{}, s = {:.3e} m, ρ = {:.1} kg/m³, G = {:.3e} Pa -> {}",
                 m.num_nodes(),
                 m.num_elements(),
+                if p.girder_zone.is_some() { " (quads and the girder zone's rods)" } else { " (quads)" },
                 p.thickness,
                 p.density,
                 p.shear_modulus,

@@ -17,6 +17,7 @@ use serde::Serialize;
 
 use crate::error::{Result, WeftError};
 use crate::generate::grid::rectangle;
+use crate::generate::zones::{tie_to_hole, Coarse};
 use crate::model::{Analysis, ElementKind, Load, Model, PartProps, TimeLaw};
 
 /// Where the square is loaded.
@@ -79,6 +80,41 @@ fn positive(name: &str, v: f64, unit: &str) -> Result<()> {
 /// Nodes of the (cells+1)² grid, clamps, loads, sets and analysis shared by both models.
 /// `rotations` clamps the rotations at x = 0 too (beams).
 fn frame(m: &mut Model, sq: &Square, e: f64, rho: f64, rotations: bool) -> Result<()> {
+    let n = sq.cells;
+    let id = |i: usize, j: usize| j * (n + 1) + i;
+    clamp_load_analysis(m, sq, e, rho, rotations, &id, id(n / 2, n / 2))?;
+    m.node_sets
+        .insert("reference".into(), (0..(n + 1) * (n + 1)).collect());
+    m.node_sets
+        .insert("axis_x".into(), (0..=n).map(|i| id(i, 0)).collect());
+    m.node_sets
+        .insert("diagonal".into(), (0..=n).map(|i| id(i, i)).collect());
+    m.node_sets
+        .insert("loaded_edge".into(), (0..=n).map(|j| id(n, j)).collect());
+    // Index test with integers: 4i ∈ [N, 3N] ⇔ |x − L/2| ≤ L/4 exactly. (N = 1 has no
+    // node there, and no `centre` set.)
+    let centre: Vec<usize> = (0..=n)
+        .flat_map(|j| (0..=n).map(move |i| (i, j)))
+        .filter(|&(i, j)| (n..=3 * n).contains(&(4 * i)) && (n..=3 * n).contains(&(4 * j)))
+        .map(|(i, j)| id(i, j))
+        .collect();
+    if !centre.is_empty() {
+        m.node_sets.insert("centre".into(), centre);
+    }
+    Ok(())
+}
+
+/// The clamp at x = 0, the load and the analysis, on the nodes `id(i, j)` of the N × N
+/// grid's clamped (i = 0) and loaded (i = N) edges; a transverse load acts at `centre`.
+fn clamp_load_analysis(
+    m: &mut Model,
+    sq: &Square,
+    e: f64,
+    rho: f64,
+    rotations: bool,
+    id: &dyn Fn(usize, usize) -> usize,
+    centre: usize,
+) -> Result<()> {
     positive("length", sq.length, "in m")?;
     if sq.cells == 0 {
         return Err(WeftError::input("--cells = `0`").expected("at least 1 cell per side"));
@@ -89,7 +125,6 @@ fn frame(m: &mut Model, sq: &Square, e: f64, rho: f64, rotations: bool) -> Resul
         );
     }
     let n = sq.cells;
-    let id = |i: usize, j: usize| j * (n + 1) + i;
     for j in 0..=n {
         m.constraints.push((id(0, j), [true, true, true]));
         if rotations {
@@ -124,29 +159,11 @@ fn frame(m: &mut Model, sq: &Square, e: f64, rho: f64, rotations: bool) -> Resul
         LoadCase::Transverse => {
             m.loads.push(Load {
                 id: 1,
-                node: id(n / 2, n / 2),
+                node: centre,
                 force: [0.0, 0.0, sq.force],
                 law,
             });
         }
-    }
-    m.node_sets
-        .insert("reference".into(), (0..(n + 1) * (n + 1)).collect());
-    m.node_sets
-        .insert("axis_x".into(), (0..=n).map(|i| id(i, 0)).collect());
-    m.node_sets
-        .insert("diagonal".into(), (0..=n).map(|i| id(i, i)).collect());
-    m.node_sets
-        .insert("loaded_edge".into(), (0..=n).map(|j| id(n, j)).collect());
-    // Index test with integers: 4i ∈ [N, 3N] ⇔ |x − L/2| ≤ L/4 exactly. (N = 1 has no
-    // node there, and no `centre` set.)
-    let centre: Vec<usize> = (0..=n)
-        .flat_map(|j| (0..=n).map(move |i| (i, j)))
-        .filter(|&(i, j)| (n..=3 * n).contains(&(4 * i)) && (n..=3 * n).contains(&(4 * j)))
-        .map(|(i, j)| id(i, j))
-        .collect();
-    if !centre.is_empty() {
-        m.node_sets.insert("centre".into(), centre);
     }
     let end = sq.end_time.unwrap_or(t);
     m.analysis = Analysis {
@@ -308,6 +325,44 @@ pub struct MembraneParams {
     pub shear_modulus: f64,
     pub thickness: f64,
     pub density: f64,
+    /// The paper's combined model (Fig. 5b): a girder zone at the centre of the square.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub girder_zone: Option<GirderZone>,
+}
+
+/// A girder zone L_m × L_m at the centre of the membrane square (the paper's Fig. 5b):
+/// the rods of the girder of N_g cells per side L inside it, the membrane (N_m cells per
+/// side) around it with a hole there, the zone's boundary nodes tied to the hole's edges.
+/// The rods on the zone's boundary stand for half a cell (the membrane carries the other
+/// half): half the modulus and half the density, as the girder's edge rods.
+#[derive(Debug, Clone, Serialize)]
+pub struct GirderZone {
+    /// Side of the zone L_m [m], centred on the square.
+    pub length: f64,
+    /// Girder cells per side of the whole square, N_g (the zone has N_g·L_m/L).
+    pub cells: usize,
+    /// The rods' E [Pa] and ρ [kg/m³] (the prism's; the crossings are not counted twice,
+    /// as in `girder`).
+    pub youngs_modulus: f64,
+    pub density: f64,
+    /// Rod width = thickness b [m].
+    pub rod_width: f64,
+    /// Rigid joints (beams) or pinned joints (trusses).
+    pub rigid: bool,
+}
+
+impl GirderZone {
+    /// The membrane that is the closed-form equivalent of this zone's girder (DESIGN.md
+    /// §8, b = h, rigid joints): s = b²/a, ρ = ρ_g(2 − b/a), G = E(b/a)²/2, a = L/N_g.
+    pub fn equivalent(&self, length: f64) -> (f64, f64, f64) {
+        let a = length / self.cells.max(1) as f64;
+        let r = self.rod_width / a;
+        (
+            self.rod_width * r,
+            self.density * (2.0 - r),
+            self.youngs_modulus * r * r / 2.0,
+        )
+    }
 }
 
 impl MembraneParams {
@@ -324,7 +379,20 @@ impl MembraneParams {
             thickness: (r * a) * (r * a) / a,
             density: 7800.0 * (2.0 - r),
             square,
+            girder_zone: None,
         }
+    }
+}
+
+fn membrane_part(p: &MembraneParams) -> PartProps {
+    PartProps {
+        youngs_modulus_1: Some(p.youngs_modulus),
+        youngs_modulus_2: Some(p.youngs_modulus),
+        poisson_ratio_12: Some(p.poisson_ratio),
+        shear_modulus_12: Some(p.shear_modulus),
+        thickness: Some(p.thickness),
+        density: Some(p.density),
+        ..Default::default()
     }
 }
 
@@ -337,25 +405,15 @@ pub fn membrane(p: &MembraneParams) -> Result<Model> {
     if n == 0 {
         return Err(WeftError::input("--cells = `0`").expected("at least 1 cell per side"));
     }
+    if let Some(z) = &p.girder_zone {
+        return membrane_with_girder_zone(p, z);
+    }
     let mut m = Model::default();
     let (nodes, elems) = rectangle(n, n, l, l, ElementKind::Quad);
     for (i, x) in nodes.iter().enumerate() {
         m.add_node(i as i64 + 1, *x);
     }
-    let part = m.add_part(
-        1,
-        "membrane",
-        ElementKind::Quad,
-        PartProps {
-            youngs_modulus_1: Some(p.youngs_modulus),
-            youngs_modulus_2: Some(p.youngs_modulus),
-            poisson_ratio_12: Some(p.poisson_ratio),
-            shear_modulus_12: Some(p.shear_modulus),
-            thickness: Some(p.thickness),
-            density: Some(p.density),
-            ..Default::default()
-        },
-    );
+    let part = m.add_part(1, "membrane", ElementKind::Quad, membrane_part(p));
     for (e, ns) in elems.iter().enumerate() {
         m.add_element(e as i64 + 1, part, ns);
     }
@@ -363,6 +421,236 @@ pub fn membrane(p: &MembraneParams) -> Result<Model> {
     if p.square.load_case != LoadCase::Transverse {
         for i in 0..m.num_nodes() {
             m.constraints.push((i, [false, false, true]));
+        }
+    }
+    m.validate()?;
+    resolve_pulse(&mut m)?;
+    Ok(m)
+}
+
+/// The index k with k·a = x (to 10⁻⁹ L), if x lies on a grid line of spacing a.
+fn grid_line(x: f64, a: f64, l: f64) -> Option<usize> {
+    let k = (x / a).round();
+    (k >= 0.0 && (k * a - x).abs() <= 1e-9 * l).then_some(k as usize)
+}
+
+/// `membrane --girder-cells`: the square of N_m membrane cells per side with the girder
+/// zone at its centre (the paper's Fig. 5b). Node sets: `centre` (the zone's girder
+/// nodes: the paper's reference nodes), `reference` (every node, the girder's where a
+/// membrane node coincides with one on the zone's boundary), `axis_x`, `diagonal`,
+/// `loaded_edge` as in the plain square.
+fn membrane_with_girder_zone(p: &MembraneParams, z: &GirderZone) -> Result<Model> {
+    let (n, l) = (p.square.cells, p.square.length);
+    positive("length", l, "in m")?;
+    positive("zone-length", z.length, "in m")?;
+    positive("rod-modulus", z.youngs_modulus, "in Pa")?;
+    positive("rod-density", z.density, "in kg/m³")?;
+    positive("rod-width", z.rod_width, "in m")?;
+    if z.cells == 0 {
+        return Err(WeftError::input("--girder-cells = `0`")
+            .expected("at least 1 girder cell per side of the square"));
+    }
+    if z.length >= l {
+        return Err(WeftError::input(format!(
+            "--zone-length = `{}` m is not smaller than the square's side L = {l} m",
+            z.length
+        ))
+        .expected("0 < L_m < L: the membrane surrounds the girder zone"));
+    }
+    let (am, ag) = (l / n as f64, l / z.cells as f64);
+    let z0 = 0.5 * (l - z.length);
+    let (i0, i1) = match (grid_line(z0, am, l), grid_line(z0 + z.length, am, l)) {
+        (Some(a), Some(b)) if a >= 1 && b < n => (a, b),
+        _ => {
+            return Err(WeftError::input(format!(
+                "the girder zone's edges at x, y = {z0:.6} and {:.6} m are not on the membrane's \
+                 grid lines (multiples of L/N_m = {am} m, N_m = --cells = {n})",
+                z0 + z.length
+            ))
+            .expected("(L − L_m)/2 a multiple of L/N_m")
+            .hint("with the default L_m = L/2, choose --cells a multiple of 4"))
+        }
+    };
+    let (g0, g1) = match (grid_line(z0, ag, l), grid_line(z0 + z.length, ag, l)) {
+        (Some(a), Some(b)) => (a, b),
+        _ => {
+            return Err(WeftError::input(format!(
+                "the girder zone's edges at x, y = {z0:.6} and {:.6} m are not on the girder's \
+                 grid lines (multiples of L/N_g = {ag} m, N_g = --girder-cells = {})",
+                z0 + z.length,
+                z.cells
+            ))
+            .expected("(L − L_m)/2 a multiple of L/N_g")
+            .hint("with the default L_m = L/2, choose --girder-cells a multiple of 4"))
+        }
+    };
+    let nz = g1 - g0;
+    let b = z.rod_width;
+    if b >= ag {
+        return Err(WeftError::input(format!(
+            "--rod-width = `{b}` m is not smaller than the girder's cell L/N_g = {ag} m"
+        ))
+        .expected("b < L/N_g"));
+    }
+    let mut m = Model::default();
+    // The membrane's nodes, none strictly inside the zone.
+    let inside = |i: usize, j: usize| i0 < i && i < i1 && i0 < j && j < i1;
+    let mut grid = vec![usize::MAX; (n + 1) * (n + 1)];
+    let mut nid = 1i64;
+    for j in 0..=n {
+        for i in 0..=n {
+            if !inside(i, j) {
+                grid[j * (n + 1) + i] = m.add_node(nid, [i as f64 * am, j as f64 * am, 0.0]);
+                nid += 1;
+            }
+        }
+    }
+    let part = m.add_part(1, "membrane", ElementKind::Quad, membrane_part(p));
+    let mut eid = 1i64;
+    for j in 0..n {
+        for i in 0..n {
+            if (i0..i1).contains(&i) && (i0..i1).contains(&j) {
+                continue;
+            }
+            let g = |i: usize, j: usize| grid[j * (n + 1) + i];
+            m.add_element(
+                eid,
+                part,
+                &[g(i, j), g(i + 1, j), g(i + 1, j + 1), g(i, j + 1)],
+            );
+            eid += 1;
+        }
+    }
+    // The girder's nodes and rods, as `girder` builds them.
+    let w = nz + 1;
+    let mut zone = Vec::with_capacity(w * w);
+    for j in 0..=nz {
+        for i in 0..=nz {
+            zone.push(m.add_node(nid, [z0 + i as f64 * ag, z0 + j as f64 * ag, 0.0]));
+            nid += 1;
+        }
+    }
+    let (kind, rho) = (
+        if z.rigid {
+            ElementKind::Beam
+        } else {
+            ElementKind::Truss
+        },
+        z.density * (1.0 - b / (2.0 * ag)),
+    );
+    let props = |f: f64| {
+        if z.rigid {
+            PartProps {
+                youngs_modulus: Some(f * z.youngs_modulus),
+                density: Some(f * rho),
+                width: Some(b),
+                height: Some(b),
+                poisson_ratio: Some(0.0),
+                ..Default::default()
+            }
+        } else {
+            PartProps {
+                youngs_modulus: Some(f * z.youngs_modulus),
+                density: Some(f * rho),
+                area: Some(b * b),
+                ..Default::default()
+            }
+        }
+    };
+    let rods = m.add_part(2, "rods", kind, props(1.0));
+    let half = m.add_part(3, "half_rods", kind, props(0.5));
+    let gid = |i: usize, j: usize| zone[j * w + i];
+    for j in 0..=nz {
+        for i in 0..=nz {
+            let edge = |k: usize| k == 0 || k == nz;
+            if i < nz {
+                m.add_element(
+                    eid,
+                    if edge(j) { half } else { rods },
+                    &[gid(i, j), gid(i + 1, j)],
+                );
+                eid += 1;
+            }
+            if j < nz {
+                m.add_element(
+                    eid,
+                    if edge(i) { half } else { rods },
+                    &[gid(i, j), gid(i, j + 1)],
+                );
+                eid += 1;
+            }
+        }
+    }
+    // Tie the zone's boundary to the hole's four sides.
+    let side = |axis: usize, k: usize| -> (usize, f64, Vec<usize>) {
+        let ns = (i0..=i1)
+            .map(|t| {
+                if axis == 0 {
+                    grid[t * (n + 1) + k]
+                } else {
+                    grid[k * (n + 1) + t]
+                }
+            })
+            .collect();
+        (axis, k as f64 * am, ns)
+    };
+    let hole = Coarse {
+        hole_sides: vec![side(0, i0), side(0, i1), side(1, i0), side(1, i1)],
+        outer: vec![],
+    };
+    let boundary: Vec<usize> = (0..=nz)
+        .flat_map(|j| (0..=nz).map(move |i| (i, j)))
+        .filter(|&(i, j)| i == 0 || i == nz || j == 0 || j == nz)
+        .map(|(i, j)| gid(i, j))
+        .collect();
+    tie_to_hole(&mut m, &hole, &boundary)?;
+    if p.square.load_case == LoadCase::Transverse && nz % 2 != 0 {
+        return Err(WeftError::input(format!(
+            "the girder zone has {nz} cells per side: no node at its centre for the transverse load"
+        ))
+        .expected("an even number of girder cells across the zone")
+        .hint("choose --girder-cells (and --zone-length) so that N_g·L_m/L is even"));
+    }
+    let g = |i: usize, j: usize| grid[j * (n + 1) + i];
+    clamp_load_analysis(
+        &mut m,
+        &p.square,
+        p.youngs_modulus,
+        p.density,
+        false,
+        &g,
+        gid(nz / 2, nz / 2),
+    )?;
+    // Sets: the zone's nodes win where a membrane node coincides with one.
+    let on_zone_edge =
+        |i: usize, j: usize| (i0..=i1).contains(&i) && (i0..=i1).contains(&j) && !inside(i, j);
+    let mut reference: Vec<usize> = (0..=n)
+        .flat_map(|j| (0..=n).map(move |i| (i, j)))
+        .filter(|&(i, j)| !inside(i, j) && !on_zone_edge(i, j))
+        .map(|(i, j)| g(i, j))
+        .collect();
+    reference.extend(zone.iter().copied());
+    m.node_sets.insert("reference".into(), reference);
+    m.node_sets.insert("centre".into(), zone.clone());
+    m.node_sets
+        .insert("axis_x".into(), (0..=n).map(|i| g(i, 0)).collect());
+    let mut diagonal: Vec<usize> = (0..=n)
+        .filter(|&i| !inside(i, i) && !on_zone_edge(i, i))
+        .map(|i| g(i, i))
+        .chain((0..=nz).map(|i| gid(i, i)))
+        .collect();
+    diagonal.sort_by(|&a, &b| m.coords[a][0].total_cmp(&m.coords[b][0]));
+    m.node_sets.insert("diagonal".into(), diagonal);
+    m.node_sets
+        .insert("loaded_edge".into(), (0..=n).map(|j| g(n, j)).collect());
+    if p.square.load_case != LoadCase::Transverse {
+        for i in 0..m.num_nodes() {
+            m.constraints.push((i, [false, false, true]));
+        }
+        if z.rigid {
+            for &i in &zone {
+                m.rot_constraints.push((i, [true, true, false]));
+            }
         }
     }
     m.validate()?;
