@@ -25,7 +25,8 @@ def main():
     ap.add_argument("--cells", default="5,6,7,8,9,10", help="N_g of the same-mesh sweep")
     ap.add_argument("--ratios", type=int, default=5,
                     help="b/a values, log-spaced over the paper's 1/20..1/8 (eq. 3)")
-    ap.add_argument("--combined-cells", default="12", help="N_g of the combined sweep")
+    ap.add_argument("--combined-cells", default="12,16",
+                    help="N_g of the combined sweep (multiples of 4; two or more for its surrogate)")
     ap.add_argument("--membrane-cells", default="4,8",
                     help="N_m of the combined sweep (multiples of 4: the zone's edges at L/4, 3L/4)")
     ap.add_argument("--starts", type=int, default=4, help="dynamic multistart starts")
@@ -190,10 +191,17 @@ cmd = "weft-surrogate train --table ${{inputs.table}} --filter approach=same-mes
 inputs = {{ table = "${{out}}/sweep_dynamic.parquet" }}
 outputs = {{ dir = "${{out}}/surrogate" }}
 
+[stages.surrogate_combined]
+desc = "the same on the combined-model dynamic fits (Fig. 5b): x = {{b_g, N_m, N_g}} → y = {{G, s, ρ, Δ = T}}, as the paper's §4 ends"
+cmd = "weft-surrogate train --table ${{inputs.table}} --filter approach=combined --inputs b_g,N_m,N_g --outputs membrane.G12,membrane.s,membrane.rho,T --restarts {a.restarts} --out ${{outputs.dir}}"
+inputs = {{ table = "${{out}}/sweep_dynamic.parquet" }}
+outputs = {{ dir = "${{out}}/surrogate_combined" }}
+
 [stages.surrogate_figure]
-desc = "test MSE against n1 per activation, the regression's and the paper's (its Fig. 6b)"
-cmd = "mkdir -p ${{outputs.figs}} && weft-plot surrogate --search ${{inputs.dir}}/search.parquet --surrogate ${{inputs.dir}}/surrogate.json --mark 'paper: 11 tansig, 0.0333=11:0.0333' --title 'Network search: test MSE (normalised outputs)' --out ${{outputs.figs}}/surrogate_search.png"
-inputs = {{ dir = "${{out}}/surrogate" }}
+desc = "test MSE against n1 per activation, the regression's and the paper's (its Fig. 6b), for both surrogates"
+cmd = '''mkdir -p ${{outputs.figs}} && weft-plot surrogate --search ${{inputs.dir}}/search.parquet --surrogate ${{inputs.dir}}/surrogate.json --mark 'paper: 11 tansig, 0.0333=11:0.0333' --title 'Network search, same mesh x = {{b_g, N_g}}: test MSE (normalised outputs)' --out ${{outputs.figs}}/surrogate_search.png && \\
+  weft-plot surrogate --search ${{inputs.cdir}}/search.parquet --surrogate ${{inputs.cdir}}/surrogate.json --mark 'paper: 11 tansig, 0.0333=11:0.0333' --title 'Network search, combined model x = {{b_g, N_m, N_g}} → {{G, s, ρ, Δ}}: test MSE' --out ${{outputs.figs}}/surrogate_search_combined.png'''
+inputs = {{ dir = "${{out}}/surrogate", cdir = "${{out}}/surrogate_combined" }}
 outputs = {{ figs = "${{out}}/figures" }}
 
 # The held-out x = (N_g = {hn}, b/a = {hr}; b_g = {hb:.6e} m), not in the training grid: the
