@@ -255,20 +255,44 @@ pub struct Problem {
     pub objective: Objective,
 }
 
-/// The quantity a fit matches.
+/// One wave whose arrival times a fit matches: `component` (0..6 = ux … vz) reaching
+/// `level` (as `weft-wavespeed` measures them).
 #[derive(Debug, Clone, Copy)]
+pub struct ArrivalTerm {
+    pub component: usize,
+    pub level: crate::analysis::Level,
+}
+
+/// The quantity a fit matches.
+#[derive(Debug, Clone)]
 pub enum Objective {
     /// The paper's T over the node set and `components`.
     Displacement,
-    /// Arrival times of a wave along the (ordered) node set, the first time `component`
-    /// (0..6 = ux … vz) reaches `level` at each node (as `weft-wavespeed` measures them):
-    /// W = Σ(t_c − t_r)² / Σ(t_c² + t_r²) over the nodes the reference wave reaches, T's
-    /// form for arrival times (0 equal); a node the candidate's wave never reaches counts
-    /// as reached at the end of its run. Matching arrival times matches the wave speeds.
-    Arrival {
-        component: usize,
-        level: crate::analysis::Level,
+    /// Arrival times of waves along the (ordered) node set: for each term, the first time
+    /// its component reaches its level at each node, the incident front only (`slack` as
+    /// in [`crate::analysis::wave_speeds_with`]): W = Σ(t_c − t_r)² / Σ(t_c² + t_r²) over
+    /// the nodes the reference wave reaches, T's form for arrival times (0 equal); a node
+    /// the candidate's wave never reaches counts as reached at the end of its run. The
+    /// objective is the mean W over the terms. Matching arrival times matches the wave
+    /// speeds.
+    Arrival { terms: Vec<ArrivalTerm>, slack: f64 },
+    /// T + `weight` × the mean W of `terms`: displacements and wave speeds together
+    /// (the paper's §3 asks for both).
+    Both {
+        terms: Vec<ArrivalTerm>,
+        slack: f64,
+        weight: f64,
     },
+}
+
+impl Objective {
+    /// The arrival terms, if the objective has any.
+    pub fn arrival_terms(&self) -> &[ArrivalTerm] {
+        match self {
+            Objective::Displacement => &[],
+            Objective::Arrival { terms, .. } | Objective::Both { terms, .. } => terms,
+        }
+    }
 }
 
 /// The arrival-time mismatch W of a candidate against a reference (see
@@ -281,19 +305,21 @@ pub fn arrival_mismatch(
     tol: f64,
 ) -> Result<f64> {
     let pairs = crate::analysis::match_nodes(reference, candidate, tol)?;
-    arrival_mismatch_paired(reference, candidate, &pairs, component, level)
+    arrival_mismatch_paired(reference, candidate, &pairs, component, level, 0.0)
 }
 
-/// [`arrival_mismatch`] with reference node j paired to candidate entry `pairs[j]`.
+/// [`arrival_mismatch`] with reference node j paired to candidate entry `pairs[j]`, and
+/// the front's `slack` [s] (see [`crate::analysis::wave_speeds_with`]).
 pub fn arrival_mismatch_paired(
     reference: &Series,
     candidate: &Series,
     pairs: &[usize],
     component: usize,
     level: crate::analysis::Level,
+    slack: f64,
 ) -> Result<f64> {
-    let wr = crate::analysis::wave_speeds(reference, component, level);
-    let wc = crate::analysis::wave_speeds(candidate, component, level);
+    let wr = crate::analysis::wave_speeds_with(reference, component, level, slack);
+    let wc = crate::analysis::wave_speeds_with(candidate, component, level, slack);
     let end = *candidate.t.last().expect("samples");
     let (mut num, mut den, mut n) = (0.0, 0.0, 0);
     for (j, &k) in pairs.iter().enumerate() {
@@ -319,7 +345,7 @@ pub fn arrival_mismatch_paired(
 impl Problem {
     /// Check the cases once: node sets exist and match the references.
     pub fn check(&self) -> Result<()> {
-        if self.static_mode && matches!(self.objective, Objective::Arrival { .. }) {
+        if self.static_mode && !self.objective.arrival_terms().is_empty() {
             return Err(WeftError::input("a wave-arrival objective with --static")
                 .expected("an explicit (dynamic) fit: a static solve has no waves"));
         }
@@ -396,19 +422,41 @@ impl Problem {
     pub fn case_t(&self, k: usize, x: &[f64]) -> Result<f64> {
         let c = &self.cases[k];
         let (cand, pairs) = self.candidate_response(c, &self.model_at(k, x))?;
-        if let Objective::Arrival { component, level } = self.objective {
+        let t = || -> Result<f64> {
+            Ok(mismatch_paired(
+                &c.reference,
+                &cand,
+                &pairs,
+                &self.components,
+                self.static_mode,
+            )?
+            .t_value)
+        };
+        let w = |terms: &[ArrivalTerm], slack: f64| -> Result<f64> {
             let aligned = aligned(&cand, &pairs, &c.reference);
             let identity: Vec<usize> = (0..pairs.len()).collect();
-            return arrival_mismatch_paired(&c.reference, &aligned, &identity, component, level);
+            let mut sum = 0.0;
+            for a in terms {
+                sum += arrival_mismatch_paired(
+                    &c.reference,
+                    &aligned,
+                    &identity,
+                    a.component,
+                    a.level,
+                    slack,
+                )?;
+            }
+            Ok(sum / terms.len().max(1) as f64)
+        };
+        match &self.objective {
+            Objective::Displacement => t(),
+            Objective::Arrival { terms, slack } => w(terms, *slack),
+            Objective::Both {
+                terms,
+                slack,
+                weight,
+            } => Ok(t()? + weight * w(terms, *slack)?),
         }
-        Ok(mismatch_paired(
-            &c.reference,
-            &cand,
-            &pairs,
-            &self.components,
-            self.static_mode,
-        )?
-        .t_value)
     }
 
     /// Mean T over the cases at `x` (physical values).

@@ -7,7 +7,9 @@ use std::time::Instant;
 use arrow_array::RecordBatch;
 use serde::Serialize;
 
-use super::{fit, parse_param, Case, Evaluation, FitResult, Method, Objective, Options, Problem};
+use super::{
+    fit, parse_param, ArrivalTerm, Case, Evaluation, FitResult, Method, Objective, Options, Problem,
+};
 use crate::analysis::{components, read_series_of, Level};
 use crate::error::{Result, WeftError};
 use crate::model::io::{read_model, write_model};
@@ -22,6 +24,8 @@ pub enum ObjectiveKind {
     Displacement,
     // Wave arrival times along the ordered node set.
     Arrival,
+    // T plus the arrival-time mismatch.
+    Both,
 }
 
 /// Settings of one fit, as `weft-fit`'s flags give them (and as its tables' provenance
@@ -45,6 +49,13 @@ pub struct Config {
     pub objective: ObjectiveKind,
     pub arrival_component: String,
     pub relative_level: f64,
+    /// `COMPONENT:LEVEL` arrival terms at absolute levels (empty: one term,
+    /// `arrival_component` at `relative_level` of each node's peak).
+    pub arrival: Vec<String>,
+    /// The front's slack [s] (as `weft-wavespeed --slack`).
+    pub arrival_slack: f64,
+    /// `both`: the arrival mismatch's weight beside T.
+    pub arrival_weight: f64,
     pub static_mode: bool,
     pub method: Method,
     pub starts: usize,
@@ -79,6 +90,58 @@ fn check(ok: bool, what: String) -> Result<()> {
     } else {
         Err(WeftError::input(what))
     }
+}
+
+/// The arrival terms of `--objective arrival|both`: each `--arrival COMPONENT:LEVEL` at its
+/// absolute level, or without any, `--arrival-component` at `--relative-level` of each
+/// node's peak.
+fn arrival_terms(c: &Config) -> Result<Vec<ArrivalTerm>> {
+    if c.arrival.is_empty() {
+        let k = components(&c.arrival_component)?;
+        check(
+            k.len() == 1,
+            format!(
+                "--arrival-component takes one component, got `{}`",
+                c.arrival_component
+            ),
+        )?;
+        check(
+            c.relative_level > 0.0 && c.relative_level <= 1.0,
+            format!(
+                "--relative-level {}: expected a fraction of the peak in (0, 1]",
+                c.relative_level
+            ),
+        )?;
+        return Ok(vec![ArrivalTerm {
+            component: k[0],
+            level: Level::Relative(c.relative_level),
+        }]);
+    }
+    c.arrival
+        .iter()
+        .map(|spec| {
+            let bad = |why: &str| {
+                WeftError::input(format!("--arrival `{spec}`: {why}")).expected(
+                    "COMPONENT:LEVEL, e.g. `ux:5e-5` (the level in m, or m/s for vx … vz)",
+                )
+            };
+            let (comp, level) = spec.split_once(':').ok_or_else(|| bad("no `:`"))?;
+            let k = components(comp.trim()).map_err(|_| bad("unknown component"))?;
+            if k.len() != 1 {
+                return Err(bad("one component per --arrival"));
+            }
+            let v: f64 = level
+                .trim()
+                .parse()
+                .ok()
+                .filter(|v: &f64| v.is_finite() && *v > 0.0)
+                .ok_or_else(|| bad("the level is not a finite number > 0"))?;
+            Ok(ArrivalTerm {
+                component: k[0],
+                level: Level::Absolute(v),
+            })
+        })
+        .collect()
 }
 
 /// Evaluations a fit may make at most: the length of its progress.
@@ -122,26 +185,43 @@ pub fn run(c: &Config, on_eval: &(dyn Fn(&Evaluation) + Sync)) -> Result<Report>
         ),
     )?;
     let objective = match c.objective {
-        ObjectiveKind::Displacement => Objective::Displacement,
-        ObjectiveKind::Arrival => {
-            let k = components(&c.arrival_component)?;
+        ObjectiveKind::Displacement => {
             check(
-                k.len() == 1,
+                c.arrival.is_empty(),
                 format!(
-                    "--arrival-component takes one component, got `{}`",
-                    c.arrival_component
+                    "--arrival {} with --objective displacement; expected --objective arrival or both",
+                    c.arrival.join(" --arrival ")
                 ),
             )?;
+            Objective::Displacement
+        }
+        ObjectiveKind::Arrival | ObjectiveKind::Both => {
+            let terms = arrival_terms(c)?;
             check(
-                c.relative_level > 0.0 && c.relative_level <= 1.0,
+                c.arrival_slack >= 0.0 && c.arrival_slack.is_finite(),
                 format!(
-                    "--relative-level {}: expected a fraction of the peak in (0, 1]",
-                    c.relative_level
+                    "--arrival-slack {}: expected a time ≥ 0 in s",
+                    c.arrival_slack
                 ),
             )?;
-            Objective::Arrival {
-                component: k[0],
-                level: Level::Relative(c.relative_level),
+            if c.objective == ObjectiveKind::Arrival {
+                Objective::Arrival {
+                    terms,
+                    slack: c.arrival_slack,
+                }
+            } else {
+                check(
+                    c.arrival_weight > 0.0 && c.arrival_weight.is_finite(),
+                    format!(
+                        "--arrival-weight {}: expected a finite weight > 0",
+                        c.arrival_weight
+                    ),
+                )?;
+                Objective::Both {
+                    terms,
+                    slack: c.arrival_slack,
+                    weight: c.arrival_weight,
+                }
             }
         }
     };
@@ -149,8 +229,10 @@ pub fn run(c: &Config, on_eval: &(dyn Fn(&Evaluation) + Sync)) -> Result<Report>
     let mut prov_inputs: Vec<PathBuf> = vec![];
     for k in 0..n {
         let mut needed = comps.clone();
-        if let Objective::Arrival { component, .. } = objective {
-            needed.push(component);
+        for a in objective.arrival_terms() {
+            if !needed.contains(&a.component) {
+                needed.push(a.component);
+            }
         }
         let reference = read_series_of(
             &c.reference_model[k],
