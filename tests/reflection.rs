@@ -114,7 +114,7 @@ fn two_bars(b: &Bar2) -> Model {
     m.constraints.push((0, [true, true, true]));
     m.constraints
         .push((*bar2.last().unwrap(), [true, true, true]));
-    launch_pulse(&mut m, &["bar1".into()], 0, 0.0, L1 / 5.0, 1.0).unwrap();
+    launch_pulse(&mut m, &["bar1".into()], 0, 0.0, L1 / 5.0, 1.0, None).unwrap();
     m.analysis.end_time = 2.7 * L1 / c1();
     m.analysis.output_interval = L1 / c1() / 50.0;
     m
@@ -309,6 +309,24 @@ fn stage_writes_both_tables_and_refuses_bad_input() {
     })
     .unwrap();
     assert_eq!(r.energies.names, vec!["bar1", "probe"]);
+    // A box of every node holds what the two parts hold together (each node's mass, each
+    // element once), at every time.
+    let r = energy::run(&energy::Config {
+        source: None,
+        ..measure(
+            dir.path(),
+            &["bar1", "bar2", "all=box:-1,1,-1,1,-1,1"],
+            None,
+        )
+    })
+    .unwrap();
+    for k in 0..r.energies.t.len() {
+        let (a, b) = (
+            r.energies.total(0)[k] + r.energies.total(1)[k],
+            r.energies.total(2)[k],
+        );
+        assert!((a - b).abs() <= 1e-12 * b, "{a} vs {b}");
+    }
 
     let err = |c: energy::Config| format!("{:#}", energy::run(&c).unwrap_err());
     let e = err(measure(dir.path(), &["bar1", "nosuch"], None));
@@ -316,6 +334,8 @@ fn stage_writes_both_tables_and_refuses_bad_input() {
         e.contains("no part `nosuch`") && e.contains("`bar2`"),
         "{e}"
     );
+    let e = err(measure(dir.path(), &["far=box:2,3,-1,1,-1,1"], None));
+    assert!(e.contains("no node in the box"), "{e}");
     let e = err(measure(dir.path(), &["set:nosuch"], None));
     assert!(
         e.contains("no node set `nosuch`") && e.contains("`probe`"),

@@ -4,7 +4,8 @@
 //! ([`launch_pulse`], `weft-energy pulse`): an initial velocity on a strip of nodes
 //! instead of a projectile.
 //!
-//! Regions are groups of parts (by name) or node sets. At each output time of a history
+//! Regions are groups of parts (by name), node sets, or the nodes in a box of reference
+//! coordinates (treated as a node set). At each output time of a history
 //! written with every node (`weft-simulate --all-nodes`):
 //! - **kinetic** [J]: Σᵢ ½ mᵢᴿ |vᵢ|², with mᵢᴿ node i's lumped mass from the region's own
 //!   elements, by the solver's lumping ([`crate::solver::Families`]: half a truss's mass to
@@ -53,6 +54,9 @@ pub enum RegionSpec {
     Parts(Vec<String>),
     /// The nodes of a node set (whole nodal masses, shares of the elements).
     Set(String),
+    /// The nodes whose reference coordinates lie in a box, [min, max] along x, y, z
+    /// (as a node set).
+    Box([[f64; 2]; 3]),
 }
 
 /// A named region.
@@ -64,12 +68,13 @@ pub struct Region {
 
 impl Region {
     /// Parse `NAME=PART[,PART…]` (a group of parts), `set:SET` (a node set, named after
-    /// it) or `PART` (one part, named after it).
+    /// it), `NAME=box:XMIN,XMAX,YMIN,YMAX,ZMIN,ZMAX` (the nodes in a box of reference
+    /// coordinates [m], as a node set) or `PART` (one part, named after it).
     pub fn parse(s: &str) -> Result<Region> {
         let s = s.trim();
         let bad = || {
             WeftError::input(format!("--region `{s}`"))
-                .expected("`NAME=PART[,PART…]`, `set:SET` or `PART`")
+                .expected("`NAME=PART[,PART…]`, `set:SET`, `NAME=box:XMIN,XMAX,YMIN,YMAX,ZMIN,ZMAX` or `PART`")
         };
         if let Some(set) = s.strip_prefix("set:") {
             if set.is_empty() {
@@ -78,6 +83,24 @@ impl Region {
             return Ok(Region {
                 name: set.to_string(),
                 spec: RegionSpec::Set(set.to_string()),
+            });
+        }
+        if let Some((name, b)) = s.split_once("=box:") {
+            let v: Vec<f64> = b
+                .split(',')
+                .map(|x| x.trim().parse::<f64>())
+                .collect::<std::result::Result<_, _>>()
+                .map_err(|_| bad())?;
+            if name.trim().is_empty()
+                || v.len() != 6
+                || v.iter().any(|x| x.is_nan())
+                || (0..3).any(|d| v[2 * d] > v[2 * d + 1])
+            {
+                return Err(bad().hint("six numbers, min ≤ max along each axis (inf allowed)"));
+            }
+            return Ok(Region {
+                name: name.trim().to_string(),
+                spec: RegionSpec::Box(std::array::from_fn(|d| [v[2 * d], v[2 * d + 1]])),
             });
         }
         if let Some((name, parts)) = s.split_once('=') {
@@ -228,6 +251,24 @@ pub fn region_energies(
                 let mut sel = vec![false; nn];
                 for &i in nodes {
                     sel[i] = true;
+                }
+                any_set = true;
+                part_sel.push(None);
+                set_sel.push(Some(sel));
+            }
+            RegionSpec::Box(b) => {
+                let sel: Vec<bool> = m
+                    .coords
+                    .iter()
+                    .map(|x| (0..3).all(|d| x[d] >= b[d][0] && x[d] <= b[d][1]))
+                    .collect();
+                if !sel.contains(&true) {
+                    return Err(WeftError::input(format!(
+                        "region `{}`: no node in the box {b:?}",
+                        r.name
+                    ))
+                    .expected("a box [min, max] along x, y, z holding some nodes")
+                    .hint("check it against the model's coordinates (nodes.parquet)"));
                 }
                 any_set = true;
                 part_sel.push(None);
@@ -647,8 +688,9 @@ pub fn run(c: &Config) -> Result<Report> {
 /// [from, to] (a smooth bell, zero at both ends, so that a lattice carries it with
 /// little dispersion). Nodes held in that direction (constraints, symmetry planes) and
 /// tied nodes (which move with their masters) get none; other initial velocities of the
-/// chosen nodes are replaced; the projectiles are removed. Returns the number of nodes
-/// given a velocity.
+/// chosen nodes are replaced; the projectiles are removed. `within`, when given, limits
+/// the nodes further to a box of reference coordinates, [min, max] along x, y, z.
+/// Returns the number of nodes given a velocity.
 pub fn launch_pulse(
     m: &mut Model,
     parts: &[String],
@@ -656,6 +698,7 @@ pub fn launch_pulse(
     from: f64,
     to: f64,
     velocity: f64,
+    within: Option<[[f64; 2]; 3]>,
 ) -> Result<usize> {
     if !(from.is_finite() && to.is_finite() && from < to) {
         return Err(WeftError::input(format!("strip {from:e} m to {to:e} m"))
@@ -703,7 +746,9 @@ pub fn launch_pulse(
     let mut count = 0;
     for i in 0..nn {
         let x = m.coords[i][axis];
-        if chosen[i] && !held[i] && x >= from && x <= to {
+        let inside = within
+            .is_none_or(|b| (0..3).all(|d| m.coords[i][d] >= b[d][0] && m.coords[i][d] <= b[d][1]));
+        if chosen[i] && !held[i] && inside && x >= from && x <= to {
             let s = (std::f64::consts::PI * (x - from) / (to - from)).sin();
             let mut v3 = [0.0; 3];
             v3[axis] = velocity * s * s;
@@ -734,6 +779,8 @@ pub struct PulseConfig {
     pub from: f64,
     pub to: f64,
     pub velocity: f64,
+    /// Only nodes in this box: XMIN,XMAX,YMIN,YMAX,ZMIN,ZMAX [m].
+    pub within: Option<String>,
     pub out: PathBuf,
 }
 
@@ -748,8 +795,15 @@ pub fn run_pulse(c: &PulseConfig) -> Result<usize> {
             return Err(WeftError::input(format!("--axis `{a}`")).expected("x, y or z"));
         }
     };
+    let within = match &c.within {
+        None => None,
+        Some(w) => match Region::parse(&format!("within=box:{w}"))?.spec {
+            RegionSpec::Box(b) => Some(b),
+            _ => unreachable!("a box region"),
+        },
+    };
     let mut m = read_model(&c.model)?;
-    let n = launch_pulse(&mut m, &c.parts, axis, c.from, c.to, c.velocity)?;
+    let n = launch_pulse(&mut m, &c.parts, axis, c.from, c.to, c.velocity, within)?;
     let prov = Provenance::new("pulse", serde_json::to_value(c).expect("config serialises"));
     write_model(&m, &c.out, &prov)?;
     Ok(n)

@@ -70,8 +70,9 @@ struct MeasureArgs {
     /// history.parquet of a run of that model with every node (weft-simulate --all-nodes).
     #[arg(long)]
     history: PathBuf,
-    /// A region (repeat): NAME=PART[,PART…] (a group of parts), set:SET (a node set) or
-    /// PART. Default: one region per part.
+    /// A region (repeat): NAME=PART[,PART…] (a group of parts), set:SET (a node set),
+    /// NAME=box:XMIN,XMAX,YMIN,YMAX,ZMIN,ZMAX (the nodes in a box of reference
+    /// coordinates [m], as a node set; inf allowed) or PART. Default: one region per part.
     #[arg(long)]
     region: Vec<String>,
     /// The region the pulse starts in: measure its reflection fraction.
@@ -113,6 +114,10 @@ struct PulseArgs {
     /// Peak velocity [m/s] (at the middle of the strip).
     #[arg(long)]
     velocity: f64,
+    /// Only the nodes in this box of reference coordinates: XMIN,XMAX,YMIN,YMAX,ZMIN,ZMAX
+    /// [m] (inf allowed), e.g. the yarns of a reference's inner patch only.
+    #[arg(long)]
+    within: Option<String>,
     /// Output model folder.
     #[arg(long)]
     out: PathBuf,
@@ -163,6 +168,7 @@ fn run() -> anyhow::Result<ExitCode> {
                 from: a.from,
                 to: a.to,
                 velocity: a.velocity,
+                within: a.within,
                 out: a.out.clone(),
             })?;
             eprintln!(
