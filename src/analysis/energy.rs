@@ -443,7 +443,7 @@ pub fn reflection(
             (t[k], e[k], "maximum".to_string())
         }
     };
-    if !(energy_launched > 0.0) {
+    if energy_launched.is_nan() || energy_launched <= 0.0 {
         return Err(WeftError::input(format!(
             "region `{source}` holds no energy at the launch (t = {launch_time:e} s: {energy_launched:e} J)"
         ))
@@ -526,7 +526,7 @@ pub fn read_history(
     for r in 0..t.len() {
         if times.last() != Some(&t[r]) {
             if let Some(&last) = times.last() {
-                if !(t[r] > last) {
+                if t[r].is_nan() || t[r] <= last {
                     return Err(h
                         .value_error("t", r, format!("time `{}` after `{last}`", t[r]))
                         .expected("rows ordered by time, as weft-simulate writes them"));
@@ -551,12 +551,11 @@ pub fn read_history(
             .hint("was the run interrupted? rerun weft-simulate"));
     }
     // A node must be there at every time or never.
-    for i in 0..nn {
+    for (i, id) in m.node_id.iter().enumerate() {
         let first = u[0][i][0].is_finite();
         if let Some(k) = (1..times.len()).find(|&k| u[k][i][0].is_finite() != first) {
             return Err(WeftError::input(format!(
-                "node `{}` is in the history at some output times only (not at t = {:e} s)",
-                m.node_id[i],
+                "node `{id}` is in the history at some output times only (not at t = {:e} s)",
                 if first { times[k] } else { times[0] }
             ))
             .in_file(history)
