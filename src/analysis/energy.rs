@@ -445,7 +445,7 @@ pub fn reflection(
     };
     if energy_launched.is_nan() || energy_launched <= 0.0 {
         return Err(WeftError::input(format!(
-            "region `{source}` holds no energy at the launch (t = {launch_time:e} s: {energy_launched:e} J)"
+            "region `{source}` holds no energy at the launch time {launch_time:e} s (--launch, or the default: its largest): {energy_launched:e} J"
         ))
         .expected("a pulse launched in the source region")
         .hint("--source names the region the pulse starts in (weft-energy pulse puts it on a strip of a part's nodes)"));
@@ -513,6 +513,15 @@ pub fn read_history(
         .iter()
         .map(|n| h.f64(n, cols))
         .collect::<Result<_>>()?;
+    // Energies sum squares: a value whose square overflows would give inf, named nowhere;
+    // NaN marks a node the history lacks below, so none may come from the file.
+    for (k, col) in c.iter().enumerate() {
+        if let Some(r) = col.iter().position(|x| x.is_nan() || x.abs() > 1e150) {
+            return Err(h
+                .value_error(super::COMPONENTS[k], r, format!("value `{:e}`", col[r]))
+                .expected("a finite value, |value| < 1e150 (its square must not overflow)"));
+        }
+    }
     let index: HashMap<i64, usize> = m
         .node_id
         .iter()
@@ -796,9 +805,12 @@ pub fn run_pulse(c: &PulseConfig) -> Result<usize> {
     };
     let within = match &c.within {
         None => None,
-        Some(w) => match Region::parse(&format!("within=box:{w}"))?.spec {
-            RegionSpec::Box(b) => Some(b),
-            _ => unreachable!("a box region"),
+        Some(w) => match Region::parse(&format!("within=box:{w}")).map(|r| r.spec) {
+            Ok(RegionSpec::Box(b)) => Some(b),
+            _ => {
+                return Err(WeftError::input(format!("--within `{w}`"))
+                    .expected("XMIN,XMAX,YMIN,YMAX,ZMIN,ZMAX: six numbers [m], min ≤ max along each axis (inf allowed)"));
+            }
         },
     };
     let mut m = read_model(&c.model)?;

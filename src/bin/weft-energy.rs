@@ -20,11 +20,11 @@ use weft::analysis::energy;
                   fraction of its energy still there after the pulse has passed the interface: the reflection \
                   fraction R (≈ 0 for a well-matched interface; ((Z₁ − Z₂)/(Z₁ + Z₂))² between two bars of \
                   impedances Z = A√(Eρ)).\n\nExample:\n  \
-                  weft-energy pulse --model runs/combined --part warp --axis x --from 0 --to 2e-3 --velocity 5 --out runs/pulse\n  \
+                  weft-energy pulse --model runs/combined --part warp_1 --axis x --from 0 --to 2e-3 --velocity 5 --out runs/pulse\n  \
                   weft-simulate --all-nodes --model runs/pulse --out runs/pulse-out\n  \
                   weft-energy measure --model runs/pulse --history runs/pulse-out/history.parquet \\\n    \
-                  --region patch=warp,weft --region coarse_membrane --source patch \\\n    \
-                  --window-start 2.5e-6 --window-end 3.5e-6 --out-dir runs/pulse-energy"
+                  --region patch=warp_1,weft_1 --region coarse_membrane --source patch \\\n    \
+                  --launch 0 --window-start 1.8e-6 --window-end 2.2e-6 --out-dir runs/pulse-energy"
 )]
 struct Cli {
     #[command(subcommand)]
@@ -57,7 +57,7 @@ enum Command {
         along that axis: a smooth in-plane (longitudinal) pulse. Nodes held in that direction (constraints, a \
         symmetry plane) and tied nodes get none. A strip that starts on a symmetry plane sends the whole pulse \
         outwards (the half that runs towards the plane comes back from it).\n\nExample:\n  \
-        weft-energy pulse --model runs/combined --part warp --axis x --from 0 --to 2e-3 --velocity 5 --out runs/pulse"
+        weft-energy pulse --model runs/combined --part warp_1 --axis x --from 0 --to 2e-3 --velocity 5 --out runs/pulse"
     )]
     Pulse(PulseArgs),
 }
