@@ -1,6 +1,7 @@
 //! Measure-and-match analyses on `history.parquet`: wave speeds along a line of nodes
 //! (the paper's §3) and the displacement mismatch T between two models (its eq. 2).
 
+pub mod energy;
 pub mod error;
 pub mod interp;
 pub mod wavespeed;

@@ -219,56 +219,8 @@ impl ElementResults {
     /// Add the rows of output time `t` from the history sample (u, v of the output
     /// nodes, in the history's order).
     pub fn sample(&mut self, t: f64, u: &[[f64; 3]], v: &[[f64; 3]]) {
-        let pos = |i: usize| -> [f64; 3] {
-            let j = self.slot[i];
-            std::array::from_fn(|d| self.x0[i][d] + u[j][d])
-        };
-        let vel = |i: usize| v[self.slot[i]];
-        for (e, item) in self.items.iter().enumerate() {
-            let mut q = [None; 15];
-            match item {
-                Item::Truss {
-                    nodes,
-                    k,
-                    l0,
-                    tension_only,
-                } => {
-                    let (x1, x2) = (pos(nodes[0]), pos(nodes[1]));
-                    let l = dist(&x1, &x2);
-                    q[0] = Some((l - l0) / l0);
-                    q[1] = Some(truss::axial_force(&x1, &x2, *k, *l0, *tension_only));
-                    q[14] = Some(truss::energy(&x1, &x2, *k, *l0, *tension_only));
-                }
-                Item::Beam { nodes, l0, ea } => {
-                    let eps = (dist(&pos(nodes[0]), &pos(nodes[1])) - l0) / l0;
-                    q[0] = Some(eps);
-                    q[1] = Some(ea * eps);
-                }
-                Item::Link {
-                    nodes,
-                    d0,
-                    k,
-                    c,
-                    slider,
-                } => {
-                    let (x1, x2) = (pos(nodes[0]), pos(nodes[1]));
-                    let (v1, v2) = (vel(nodes[0]), vel(nodes[1]));
-                    let mut w = 0.0;
-                    for d in 0..3 {
-                        let dd = x2[d] - x1[d] - d0[d];
-                        q[2 + d] = Some(dd);
-                        w += 0.5 * k[d] * dd * dd;
-                        if !slider {
-                            q[5 + d] = Some(k[d] * dd + c[d] * (v2[d] - v1[d]));
-                        }
-                    }
-                    if !slider {
-                        q[14] = Some(w);
-                    }
-                }
-                Item::Tri(mb) => membrane_row(mb, &pos, &mut q),
-                Item::Quad(mb) => membrane_row(mb, &pos, &mut q),
-            }
+        for e in 0..self.items.len() {
+            let q = self.quantities(e, u, v);
             self.rows.t.push(t);
             self.rows.id.push(self.id[e]);
             self.rows.part_id.push(self.part_id[e]);
@@ -277,6 +229,83 @@ impl ElementResults {
                 self.rows.q[c].push(v);
             }
         }
+    }
+
+    /// The stored elastic energy [J] of selected element `e` (the `energy` column: None
+    /// for beams and links with a slider) at the history sample u, v (of the output
+    /// nodes, in the history's order). Used by [`crate::analysis::energy`].
+    pub fn energy(&self, e: usize, u: &[[f64; 3]], v: &[[f64; 3]]) -> Option<f64> {
+        self.quantities(e, u, v)[14]
+    }
+
+    /// Id of the part of selected element `e` (the `part_id` column).
+    pub fn element_part_id(&self, e: usize) -> i64 {
+        self.part_id[e]
+    }
+
+    /// Node indices of selected element `e`.
+    pub fn element_nodes(&self, e: usize) -> &[usize] {
+        match &self.items[e] {
+            Item::Truss { nodes, .. } | Item::Beam { nodes, .. } | Item::Link { nodes, .. } => {
+                nodes
+            }
+            Item::Tri(mb) => &mb.nodes,
+            Item::Quad(mb) => &mb.nodes,
+        }
+    }
+
+    /// The quantity columns of selected element `e` at a history sample.
+    fn quantities(&self, e: usize, u: &[[f64; 3]], v: &[[f64; 3]]) -> [Option<f64>; 15] {
+        let pos = |i: usize| -> [f64; 3] {
+            let j = self.slot[i];
+            std::array::from_fn(|d| self.x0[i][d] + u[j][d])
+        };
+        let vel = |i: usize| v[self.slot[i]];
+        let mut q = [None; 15];
+        match &self.items[e] {
+            Item::Truss {
+                nodes,
+                k,
+                l0,
+                tension_only,
+            } => {
+                let (x1, x2) = (pos(nodes[0]), pos(nodes[1]));
+                let l = dist(&x1, &x2);
+                q[0] = Some((l - l0) / l0);
+                q[1] = Some(truss::axial_force(&x1, &x2, *k, *l0, *tension_only));
+                q[14] = Some(truss::energy(&x1, &x2, *k, *l0, *tension_only));
+            }
+            Item::Beam { nodes, l0, ea } => {
+                let eps = (dist(&pos(nodes[0]), &pos(nodes[1])) - l0) / l0;
+                q[0] = Some(eps);
+                q[1] = Some(ea * eps);
+            }
+            Item::Link {
+                nodes,
+                d0,
+                k,
+                c,
+                slider,
+            } => {
+                let (x1, x2) = (pos(nodes[0]), pos(nodes[1]));
+                let (v1, v2) = (vel(nodes[0]), vel(nodes[1]));
+                let mut w = 0.0;
+                for d in 0..3 {
+                    let dd = x2[d] - x1[d] - d0[d];
+                    q[2 + d] = Some(dd);
+                    w += 0.5 * k[d] * dd * dd;
+                    if !slider {
+                        q[5 + d] = Some(k[d] * dd + c[d] * (v2[d] - v1[d]));
+                    }
+                }
+                if !slider {
+                    q[14] = Some(w);
+                }
+            }
+            Item::Tri(mb) => membrane_row(mb, &pos, &mut q),
+            Item::Quad(mb) => membrane_row(mb, &pos, &mut q),
+        }
+        q
     }
 
     /// Write `elements.parquet` (atomically).

@@ -12,8 +12,8 @@
 //!   string, a path that does not exist, in an otherwise valid command.
 //! - fit param: `--param` specs with bad bounds, lower ≥ upper, log with lower ≤ 0, an
 //!   unknown part or property, a bad factor, an initial value outside the bounds...
-//! - history: `history.parquet` handed to weft-wavespeed, weft-vtk, weft-plot history and
-//!   field, weft-error (both histories) and weft-fit, with each column missing, null, NaN,
+//! - history: `history.parquet` handed to weft-wavespeed, weft-vtk, weft-energy measure,
+//!   weft-plot history and field, weft-error (both histories) and weft-fit, with each column missing, null, NaN,
 //!   ±inf, of the wrong type; node ids dangling, negative, duplicated; times out of order
 //!   or duplicated; a node's sample missing; no rows; the file truncated, not Parquet,
 //!   empty or absent.
@@ -816,6 +816,48 @@ fn cli_cases(fx: &Fixtures) -> Vec<Case> {
             false,
         ),
         (
+            "weft-energy",
+            vec!["measure"],
+            [
+                "--model",
+                &rod,
+                "--history",
+                &rod_h,
+                "--region",
+                "rod",
+                "--source",
+                "rod",
+                "--out-dir",
+                "{dir}/energy",
+            ]
+            .iter()
+            .map(|x| x.to_string())
+            .collect(),
+            false,
+        ),
+        (
+            "weft-energy",
+            vec!["pulse"],
+            [
+                "--model",
+                &rod,
+                "--part",
+                "rod",
+                "--from",
+                "0",
+                "--to",
+                "0.05",
+                "--velocity",
+                "1",
+                "--out",
+                "{dir}/pulse",
+            ]
+            .iter()
+            .map(|x| x.to_string())
+            .collect(),
+            false,
+        ),
+        (
             "weft-vtk",
             vec![],
             ["--model", &rod, "--history", &rod_h, "--out", "{dir}/vtk"]
@@ -1309,6 +1351,22 @@ fn history_cases(fx: &Fixtures) -> Vec<Case> {
             "weft-vtk",
             true,
             vec!["--model", &rod, "--history", h, "--out", "{dir}/vtk"],
+        ),
+        (
+            "weft-energy measure",
+            "weft-energy",
+            true,
+            vec![
+                "measure",
+                "--model",
+                &rod,
+                "--history",
+                h,
+                "--source",
+                "rod",
+                "--out-dir",
+                "{dir}/energy",
+            ],
         ),
         (
             "weft-plot history",

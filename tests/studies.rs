@@ -304,7 +304,8 @@ fn woven_reduced_study_fits_the_girder_to_the_yarn_level_patch() {
 /// membrane's in-plane front runs within the paper's reported speed difference of the
 /// reference's; the combined model
 /// has fewer nodes than the reference (the point of the reduction, counted, not timed);
-/// every run's energy balance within 1 %; a second run does nothing.
+/// the fitted membrane reflects less of a pulse than the start (below); every run's
+/// energy balance within 1 %; a second run does nothing.
 #[test]
 fn woven_membrane_study_runs_small_and_the_fit_lowers_t() {
     let dir = project_with("woven_membrane.toml");
@@ -321,10 +322,34 @@ fn woven_membrane_study_runs_small_and_the_fit_lowers_t() {
         .replace(
             "--starts 4 --max-evaluations 40",
             "--starts 2 --max-evaluations 10",
-        );
+        )
+        // The pulse from a 1 mm strip; its tail has passed the interface at 3.5 mm by
+        // (3.5 + 1) mm / 6.8 km/s = 0.66 µs, the part reflected there is back at it from
+        // the symmetry plane at (2.5 + 7) mm / 7.5 km/s = 1.3 µs.
+        .replace("pulse_to = 2e-3", "pulse_to = 1e-3")
+        .replace("pulse_end = 4e-6", "pulse_end = 1.5e-6")
+        .replace("window_start = 1.8e-6", "window_start = 0.8e-6")
+        .replace("window_end = 2.2e-6", "window_end = 1.0e-6")
+        .replace("patch_box = 9.51e-3", "patch_box = 3.51e-3");
     std::fs::write(&p, s).unwrap();
     weft_run(root, "woven_membrane.toml");
     let out = root.join("runs/woven_membrane");
+    // Reflection at the interface (issue 12, item 5). The start membrane's impedance per
+    // unit width, √(E t · ρ t) ∝ √(0.1 × 0.4), is 2.4 × below the paper's √(0.3 × 0.8),
+    // which matches the warp's (E A/p · ρ A/p); the fit moves E and ρ towards the paper's
+    // (it lowers T), so the mismatch, hence the reflected energy ((Z₁ − Z₂)/(Z₁ + Z₂))²
+    // (Graff §1.5), falls. The reference has no interface at all: the least left in the
+    // patch. Measured: R 0.906 (start), 0.816 (paper), 0.726 (fitted), 0.094 (reference).
+    let r = |m: &str| {
+        Table::read(&out.join(format!("reflection/{m}/reflection.parquet")))
+            .unwrap()
+            .f64("reflection", "")
+            .unwrap()[0]
+    };
+    let (r0, rp, rf, rr) = (r("start"), r("paper"), r("fitted"), r("reference"));
+    eprintln!("reflection: start {r0:.3}, paper {rp:.3}, fitted {rf:.3}, reference {rr:.3}");
+    assert!(rf < r0, "the fitted membrane reflects {rf}, the start {r0}");
+    assert!(rr < rf.min(rp), "reference {rr}, paper {rp}, fitted {rf}");
     let fit = Table::read(&out.join("fit/fit_result.parquet")).unwrap();
     let (t0, t) = (
         fit.f64("T_initial", "").unwrap()[0],
