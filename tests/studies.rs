@@ -339,7 +339,7 @@ fn woven_membrane_study_runs_small_and_the_fit_lowers_t() {
     // which matches the warp's (E A/p · ρ A/p); the fit moves E and ρ towards the paper's
     // (it lowers T), so the mismatch, hence the reflected energy ((Z₁ − Z₂)/(Z₁ + Z₂))²
     // (Graff §1.5), falls. The reference has no interface at all: the least left in the
-    // patch. Measured: R 0.906 (start), 0.816 (paper), 0.726 (fitted), 0.094 (reference).
+    // patch. Measured: R 0.906 (start), 0.816 (paper), 0.739 (fitted), 0.094 (reference).
     let r = |m: &str| {
         Table::read(&out.join(format!("reflection/{m}/reflection.parquet")))
             .unwrap()
