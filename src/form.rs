@@ -391,6 +391,10 @@ pub fn tile_start(m: &Model, cell: &Model, cell_name: &str) -> Result<Vec<[f64; 
 }
 
 /// [`form`] from a start other than the generated geometry (a tiled smaller patch).
+/// Rounds of the tied model's final settling, each with the membrane's pre-stress
+/// corrected by the tension the previous one left in the bands.
+const MEMBRANE_ROUNDS: usize = 6;
+
 pub fn form_from(
     m: &Model,
     p: &Params,
@@ -458,7 +462,8 @@ pub fn form_from(
         .hint("form the generator's model, not a formed one"));
     }
     let tension = [p.warp_tension, p.weft_tension];
-    // The held yarn ends, and the section each end node carries.
+    // The yarn ends: held at the patch edge, or tied to a membrane around the patch (the
+    // §3 combined model); and the section each end node carries.
     let held: Vec<bool> = {
         let mut h = vec![false; m.num_nodes()];
         for (n, c) in &m.constraints {
@@ -466,7 +471,17 @@ pub fn form_from(
                 h[*n] = true;
             }
         }
+        for t in &m.ties {
+            h[t.slave] = true;
+        }
         h
+    };
+    let tied: Vec<bool> = {
+        let mut t = vec![false; m.num_nodes()];
+        for tie in &m.ties {
+            t[tie.slave] = true;
+        }
+        t
     };
     let thick = |e: usize| -> f64 {
         if quads.thickness.is_empty() {
@@ -527,12 +542,35 @@ pub fn form_from(
     }
     if ends.is_empty() {
         return Err(WeftError::input(
-            "no yarn end is held in x, y and z: nothing holds the tension",
+            "no yarn end is held in x, y and z or tied to a membrane: nothing holds the tension",
         )
         .in_file("constraints.parquet")
-        .hint("generate the patch with --edge clamped"));
+        .hint("generate the patch with --edge clamped, or with --membrane-length"));
     }
+    // Tied ends (the §3 combined model): the patch is formed as a patch alone, its ends
+    // held and pulled as below with the membrane set aside (untied, unloaded: it does not
+    // move), and the ties come back in the formed model with the membrane pre-stressed to
+    // pull the ends with the residual tension (its displacement-limited pull would go
+    // slack while the crimped yarns straighten: measured, a 10 × 10 patch formed against
+    // the pre-stressed membrane kept no tension at all). The solver keeps each formed
+    // slave's offset from its masters (the ends slid along their yarns while forming).
+    let tied_ends = ends.values().flatten().filter(|&&n| tied[n]).count();
+    if tied_ends > 0 && tied_ends < ends.values().map(|v| v.len()).sum::<usize>() {
+        return Err(WeftError::input(
+            "some yarn ends are tied to a membrane and others held: expected one or the other",
+        )
+        .in_file("ties.parquet"));
+    }
+    let membrane_pulls = tied_ends > 0;
     let mut mm = m.clone();
+    if membrane_pulls {
+        mm.ties.retain(|t| !tied[t.slave]);
+        for n in 0..m.num_nodes() {
+            if tied[n] {
+                mm.constraints.push((n, [true; 3]));
+            }
+        }
+    }
     mm.projectiles.clear();
     mm.loads.clear();
     mm.initial_velocities.clear();
@@ -572,6 +610,38 @@ pub fn form_from(
             c[end_fam[*n]] = false;
         }
     }
+    // The membrane's pre-stress: the yarns' tension per unit length of the edge their ends
+    // are tied to, N₀ = Σ T (the ends' section shares) / c = T·layers/p for the quarter
+    // patch whose edge runs from the symmetry plane to c; S₀ = N₀/s in material axes 1 = x
+    // (the warp's ends on x = c), 2 = y.
+    let mut stress0: Option<(Vec<usize>, [f64; 3])> = None;
+    if membrane_pulls {
+        let membrane: Vec<usize> = (0..quads.len())
+            .filter(|&e| family(m, quads.part[e]).is_none())
+            .collect();
+        let s = membrane.iter().map(|&e| thick(e)).fold(0.0, f64::max);
+        let mut s0 = [0.0; 3];
+        for (f, s0f) in s0.iter_mut().take(2).enumerate() {
+            let (mut total, mut c) = (0.0, 0.0f64);
+            for ((ff, _, _, _), nodes) in &ends {
+                if *ff == f {
+                    total += tension[f] * nodes.iter().map(|&n| share[n]).sum::<f64>() / section[f];
+                    for &n in nodes {
+                        c = c.max(m.coords[n][f].abs());
+                    }
+                }
+            }
+            if membrane.is_empty() || !(s > 0.0) || !(c > 0.0) {
+                return Err(WeftError::input(
+                    "the yarn ends are tied, but to no membrane quads of known thickness",
+                )
+                .in_file("ties.parquet")
+                .hint("generate the combined model with `weft-weave woven --membrane-length`"));
+            }
+            *s0f = total / c / s;
+        }
+        stress0 = Some((membrane, s0));
+    }
     let t_max = if quads.thickness.is_empty() {
         m.parts
             .iter()
@@ -597,25 +667,115 @@ pub fn form_from(
         .filter(|&n| end_fam[n] != usize::MAX)
         .map(|n| (n, 1u8 << end_fam[n]))
         .collect();
-    let st = solver.relax(
-        &RelaxOptions {
-            max_steps: p.max_steps,
-            min_steps: p.min_steps.min(p.max_steps),
-            check_every: p.check_every,
-            alpha: p.damping,
-            kinetic_tolerance: p.kinetic_tolerance,
-            force_tolerance: p.force_tolerance,
-            force_scale: pull.iter().map(|f| norm(f)).fold(0.0, f64::max),
-            creep_window: ((p.creep_time / (solver.stable.dt / (1.0 + p.damping).sqrt())).ceil()
-                as u64)
-                .max(1),
-            creep_tolerance: p.creep_tolerance * t_max,
-            work_offset: credited,
-            contact_damping: p.contact_damping,
-            hold_in_rest_test: hold,
-        },
-        progress,
-    )?;
+    let mut opts = RelaxOptions {
+        max_steps: p.max_steps,
+        min_steps: p.min_steps.min(p.max_steps),
+        check_every: p.check_every,
+        alpha: p.damping,
+        kinetic_tolerance: p.kinetic_tolerance,
+        force_tolerance: p.force_tolerance,
+        force_scale: pull.iter().map(|f| norm(f)).fold(0.0, f64::max),
+        creep_window: ((p.creep_time / (solver.stable.dt / (1.0 + p.damping).sqrt())).ceil()
+            as u64)
+            .max(1),
+        creep_tolerance: p.creep_tolerance * t_max,
+        work_offset: credited,
+        contact_damping: p.contact_damping,
+        hold_in_rest_test: hold,
+    };
+    let mut st = solver.relax(&opts, progress)?;
+    // Tied ends: with the patch formed, the ties and the membrane's pre-stress come back
+    // and the whole model settles once more (the band ends meet the flat membrane at the
+    // straight runs' slope, whose alternating z pull the membrane edge takes by rippling).
+    // The bands' tension: the volume mean of (P ê₁)·f̂₁ × the yarn's section, per family.
+    let band_tension = |solver: &Solver| -> [f64; 2] {
+        let x = &solver.state.x;
+        let qs = &solver.op.el.quad;
+        let mut tens = [f64::NAN; 2];
+        for (f, t) in tens.iter_mut().enumerate() {
+            let (mut sv, mut v) = (0.0, 0.0);
+            for e in 0..qs.id.len() {
+                if family(m, quads.part[e]) != Some(f) {
+                    continue;
+                }
+                let xe: [[f64; 3]; 4] = std::array::from_fn(|a| x[qs.nodes[e][a] as usize]);
+                let vol = qs.reference[e].area * qs.thickness[e];
+                sv += tension_1(&xe, &qs.reference[e], &qs.material[e]) * vol;
+                v += vol;
+            }
+            if v > 0.0 {
+                *t = sv / v * section[f];
+            }
+        }
+        tens
+    };
+    if let (true, Some((membrane, s0))) = (st.converged, stress0.as_mut()) {
+        // The membrane's pull is displacement-limited: where its edge ripples, the band
+        // ends follow it and the crimped yarns go slacker (measured 0.453 N of 0.5 at the
+        // 10 × 10), so S₀ is corrected until the bands carry the requested tension to
+        // 0.3 %.
+        let first = st.clone();
+        opts.hold_in_rest_test = vec![];
+        let s0_closed = *s0;
+        let mut last: [Option<(f64, f64)>; 2] = [None, None];
+        for _ in 0..MEMBRANE_ROUNDS {
+            let mut m2 = m.clone();
+            m2.projectiles.clear();
+            m2.loads.clear();
+            m2.initial_velocities.clear();
+            m2.contacts = mm.contacts.clone();
+            m2.initial_displacement = solver
+                .state
+                .x
+                .iter()
+                .zip(&m.coords)
+                .map(|(a, b)| sub(a, b))
+                .collect();
+            let b = m2.elements.get_mut(&ElementKind::Quad).expect("quads");
+            if b.stress0.is_empty() {
+                b.stress0 = vec![[0.0; 3]; b.len()];
+            }
+            for &e in membrane.iter() {
+                b.stress0[e] = *s0;
+            }
+            let before = st.clone();
+            solver = Solver::new(&m2)?;
+            opts.work_offset = before.removed + before.kinetic + credited;
+            opts.creep_window = ((p.creep_time / (solver.stable.dt / (1.0 + p.damping).sqrt()))
+                .ceil() as u64)
+                .max(1);
+            st = solver.relax(&opts, progress)?;
+            st.steps += before.steps;
+            st.removed += before.removed;
+            st.contact_force = st.contact_force.max(first.contact_force);
+            if !st.converged {
+                break;
+            }
+            let t = band_tension(&solver);
+            let off = (0..2)
+                .filter(|&f| tension[f] > 0.0)
+                .map(|f| (t[f] / tension[f] - 1.0).abs())
+                .fold(0.0, f64::max);
+            if off <= 3e-3 {
+                break;
+            }
+            // Secant on S₀ ↦ T per family (the first round scales by T/T₁): the bands
+            // take only part of a change in S₀, the membrane's own relief the rest.
+            for f in 0..2 {
+                if tension[f] > 0.0 && t[f] > 0.0 {
+                    let next = match last[f] {
+                        Some((s_prev, t_prev)) if (t[f] - t_prev).abs() > 1e-6 * tension[f] => {
+                            s0[f] + (tension[f] - t[f]) * (s0[f] - s_prev) / (t[f] - t_prev)
+                        }
+                        _ => s0[f] * tension[f] / t[f],
+                    };
+                    last[f] = Some((s0[f], t[f]));
+                    // Never below half or above four times the closed form N₀/s.
+                    s0[f] = next.clamp(0.5 * s0_closed[f], 4.0 * s0_closed[f]);
+                }
+            }
+        }
+    }
     let dt = st.dt;
     let work = st.removed + st.kinetic + credited;
     let ratio = if work > 0.0 { st.kinetic / work } else { 0.0 };
@@ -658,25 +818,10 @@ pub fn form_from(
     }
     // Tension in the bands: volume mean of (P ê₁)·f̂₁ × section area, per family.
     let fi = solver.internal_forces();
-    let qs = &solver.op.el.quad;
-    let mut tens = [f64::NAN; 2];
+    let tens = band_tension(&solver);
     let mut end_t = [f64::NAN; 2];
     for f in 0..2 {
-        let (mut sv, mut v) = (0.0, 0.0);
-        for e in 0..qs.id.len() {
-            if family(m, quads.part[e]) != Some(f) {
-                continue;
-            }
-            let xe: [[f64; 3]; 4] = std::array::from_fn(|a| x[qs.nodes[e][a] as usize]);
-            let t = tension_1(&xe, &qs.reference[e], &qs.material[e]);
-            let vol = qs.reference[e].area * qs.thickness[e];
-            sv += t * vol;
-            v += vol;
-        }
         let a = section[f];
-        if v > 0.0 {
-            tens[f] = sv / v * a;
-        }
         // At the ends: the internal force along the yarn on the end nodes, per yarn end.
         let full: Vec<&Vec<usize>> = ends
             .iter()
@@ -715,6 +860,15 @@ pub fn form_from(
     // The formed model.
     let mut out = m.clone();
     out.initial_displacement = x.iter().zip(&m.coords).map(|(a, b)| sub(a, b)).collect();
+    if let Some((membrane, s0)) = &stress0 {
+        let b = out.elements.get_mut(&ElementKind::Quad).expect("quads");
+        if b.stress0.is_empty() {
+            b.stress0 = vec![[0.0; 3]; b.len()];
+        }
+        for &e in membrane {
+            b.stress0[e] = *s0;
+        }
+    }
     for c in &mut out.contacts {
         c.initial_penetration = InitialPenetration::Keep;
     }

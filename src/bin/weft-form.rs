@@ -24,6 +24,10 @@ use weft::form::{run, Config, Params};
                   thickness within --creep-time (the pretensioned patch's slow drum mode settles last; forming takes \
                   17 s for the 6 × 6 quarter and 40 s for the 10 × 10 on 2 cores; --creep-tolerance 1000 turns the \
                   test off). A large patch can start from a formed smaller one (--start-from).\n\n\
+                  A patch tied into a membrane (`weft-weave woven --membrane-length`, the paper's §3 combined model) \
+                  is formed the same way as a patch alone, then its ties come back with the membrane pre-stressed \
+                  (s0_11, s0_22 of its quads) and the whole model settles again, S₀ corrected until the bands carry \
+                  the requested tension (2 min for the 10 × 10 in a 29.5 mm membrane).\n\n\
                   Writes the formed model (the reference geometry unchanged, the formed positions as the nodes' initial \
                   displacement ux0, uy0, uz0 in nodes.parquet, the yarn ends held where they came to rest, contacts \
                   `keep` with their friction, the projectile raised by as much as the fabric rose) and form.parquet \

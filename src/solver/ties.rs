@@ -1,5 +1,6 @@
 //! Tied interfaces: a slave node on a master edge (2 nodes), triangle (3) or quad (4)
-//! moves with its masters, x_s = Σ w_a x_a, v_s = Σ w_a v_a, with the weights of its
+//! moves with its masters, x_s = Σ w_a x_a (+ the offset a formed model's initial
+//! displacements give it), v_s = Σ w_a v_a, with the weights of its
 //! reference position on the master entity; its mass and every force on it go to the
 //! masters with the same weights (so momentum is exchanged exactly and the work of the
 //! slave's forces is the work on the masters).
@@ -15,6 +16,10 @@ pub struct Tie {
     pub masters: Vec<usize>,
     /// Interpolation weights, ≥ 0, summing to 1.
     pub w: Vec<f64>,
+    /// x_s − Σ w_a x_a kept from the initial state: the initial displacements' difference
+    /// u₀,s − Σ w_a u₀,a (a formed model whose tied nodes moved apart while forming; zero
+    /// without initial displacements).
+    pub offset: [f64; 3],
 }
 
 /// Weights of a point on a master edge (2 nodes: projection), triangle (barycentric) or
@@ -129,10 +134,23 @@ impl Ties {
             }
             mass[t.slave] = 0.0;
             is_slave[t.slave] = true;
+            let mut offset = [0.0; 3];
+            if !m.initial_displacement.is_empty() {
+                let u0 = &m.initial_displacement;
+                for d in 0..3 {
+                    offset[d] = u0[t.slave][d]
+                        - t.masters
+                            .iter()
+                            .zip(&w)
+                            .map(|(&a, wa)| wa * u0[a][d])
+                            .sum::<f64>();
+                }
+            }
             ties.push(Tie {
                 slave: t.slave,
                 masters: t.masters.clone(),
                 w,
+                offset,
             });
         }
         Ok(Ties { ties, is_slave })
@@ -188,7 +206,11 @@ impl Ties {
                     }
                 }
             }
-            x[t.slave] = xs;
+            x[t.slave] = [
+                xs[0] + t.offset[0],
+                xs[1] + t.offset[1],
+                xs[2] + t.offset[2],
+            ];
             v[t.slave] = vs;
             if let Some(vn) = vn.as_deref_mut() {
                 vn[t.slave] = vns;
