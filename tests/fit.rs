@@ -643,7 +643,7 @@ fn displacement_and_arrival_objective_recovers_density_and_thickness() {
     let (g, s, rho) = (7.5e8, 1e-4, 14820.0);
     let reference = membrane_model(10, LoadCase::Tension, p, g, s, rho);
     let cand = membrane_model(10, LoadCase::Tension, p, g, 3e-4, 6000.0);
-    let mut r = respond(&reference, "axis_x", false).unwrap();
+    let r = respond(&reference, "axis_x", false).unwrap();
     let peak = r
         .values
         .iter()
