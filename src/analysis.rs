@@ -56,14 +56,7 @@ pub fn read_series_of(model: &Path, history: &Path, set: &str, needed: &[usize])
             "model `{}` has no node set `{set}`",
             model.display()
         ))
-        .expected(format!(
-            "one of {}",
-            m.node_sets
-                .keys()
-                .map(|k| format!("`{k}`"))
-                .collect::<Vec<_>>()
-                .join(", ")
-        ))
+        .expected(format!("one of {}", m.node_set_names()))
     })?;
     read_nodes_of(&m, history, nodes, &format!("of set `{set}`"), needed)
 }

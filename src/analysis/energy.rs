@@ -237,16 +237,8 @@ pub fn region_energies(
             }
             RegionSpec::Set(s) => {
                 let nodes = m.node_sets.get(s).ok_or_else(|| {
-                    WeftError::input(format!("region `{}`: no node set `{s}`", r.name)).expected(
-                        format!(
-                            "a node set of the model: {}",
-                            m.node_sets
-                                .keys()
-                                .map(|k| format!("`{k}`"))
-                                .collect::<Vec<_>>()
-                                .join(", ")
-                        ),
-                    )
+                    WeftError::input(format!("region `{}`: no node set `{s}`", r.name))
+                        .expected(format!("a node set of the model: {}", m.node_set_names()))
                 })?;
                 let mut sel = vec![false; nn];
                 for &i in nodes {

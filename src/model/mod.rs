@@ -343,6 +343,16 @@ impl Model {
         self.node_id.len()
     }
 
+    /// The model's node set names, each in backticks, comma-separated (for messages that
+    /// say which sets there are).
+    pub fn node_set_names(&self) -> String {
+        self.node_sets
+            .keys()
+            .map(|k| format!("`{k}`"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    }
+
     /// Add a node; returns its index.
     pub fn add_node(&mut self, id: i64, x: [f64; 3]) -> usize {
         self.node_id.push(id);

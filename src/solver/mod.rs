@@ -412,11 +412,7 @@ fn output_nodes(m: &Model) -> Result<Vec<usize>> {
                 .in_column("history_sets")
                 .expected(format!(
                     "one of the model's node sets: {}",
-                    m.node_sets
-                        .keys()
-                        .map(|k| format!("`{k}`"))
-                        .collect::<Vec<_>>()
-                        .join(", ")
+                    m.node_set_names()
                 ))
         })?;
         for &i in set {
