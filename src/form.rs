@@ -684,9 +684,6 @@ pub fn form_from(
         hold_in_rest_test: hold,
     };
     let mut st = solver.relax(&opts, progress)?;
-    // Tied ends: with the patch formed, the ties and the membrane's pre-stress come back
-    // and the whole model settles once more (the band ends meet the flat membrane at the
-    // straight runs' slope, whose alternating z pull the membrane edge takes by rippling).
     // The bands' tension: the volume mean of (P ê₁)·f̂₁ × the yarn's section, per family.
     let band_tension = |solver: &Solver| -> [f64; 2] {
         let x = &solver.state.x;
@@ -709,6 +706,9 @@ pub fn form_from(
         }
         tens
     };
+    // Tied ends: with the patch formed, the ties and the membrane's pre-stress come back
+    // and the whole model settles once more (the band ends meet the flat membrane at the
+    // straight runs' slope, whose alternating z pull the membrane edge takes by rippling).
     if let (true, Some((membrane, s0))) = (st.converged, stress0.as_mut()) {
         // The membrane's pull is displacement-limited: where its edge ripples, the band
         // ends follow it and the crimped yarns go slacker (measured 0.453 N of 0.5 at the
@@ -718,6 +718,8 @@ pub fn form_from(
         opts.hold_in_rest_test = vec![];
         let s0_closed = *s0;
         let mut last: [Option<(f64, f64)>; 2] = [None, None];
+        let mut off = f64::INFINITY;
+        let mut measured = [f64::NAN; 2];
         for _ in 0..MEMBRANE_ROUNDS {
             let mut m2 = m.clone();
             m2.projectiles.clear();
@@ -752,7 +754,8 @@ pub fn form_from(
                 break;
             }
             let t = band_tension(&solver);
-            let off = (0..2)
+            measured = t;
+            off = (0..2)
                 .filter(|&f| tension[f] > 0.0)
                 .map(|f| (t[f] / tension[f] - 1.0).abs())
                 .fold(0.0, f64::max);
@@ -774,6 +777,23 @@ pub fn form_from(
                     s0[f] = next.clamp(0.5 * s0_closed[f], 4.0 * s0_closed[f]);
                 }
             }
+        }
+        if st.converged && off > 0.01 {
+            return Err(WeftError::input(format!(
+                "the membrane around the patch, pre-stressed at up to {:.3e} / {:.3e} Pa ({:.2} / {:.2} × T/(p·s)), \
+                 leaves {:.4} / {:.4} N in the warp / weft bands after {MEMBRANE_ROUNDS} rounds",
+                s0[0],
+                s0[1],
+                s0[0] / s0_closed[0].max(f64::MIN_POSITIVE),
+                s0[1] / s0_closed[1].max(f64::MIN_POSITIVE),
+                measured[0],
+                measured[1]
+            ))
+            .expected(format!(
+                "the requested tension {} / {} N to 1 %",
+                tension[0], tension[1]
+            ))
+            .hint("a membrane much smaller than the patch cannot hold the tension: raise --membrane-length"));
         }
     }
     let dt = st.dt;
