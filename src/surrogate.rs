@@ -440,27 +440,13 @@ impl levenberg_marquardt::LeastSquaresProblem<f64, nalgebra::Dyn, nalgebra::Dyn>
         // Early stopping: one Jacobian per accepted step.
         let e = self.epochs.get() + 1;
         self.epochs.set(e);
-        let vmse = if self.val.0.is_empty() {
-            mse(
-                &self
-                    .train
-                    .0
-                    .iter()
-                    .map(|x| net.predict(x))
-                    .collect::<Vec<_>>(),
-                self.train.1,
-            )
+        // The validation rows decide; without any, the training rows.
+        let (xs, ys) = if self.val.0.is_empty() {
+            (self.train.0, self.train.1)
         } else {
-            mse(
-                &self
-                    .val
-                    .0
-                    .iter()
-                    .map(|x| net.predict(x))
-                    .collect::<Vec<_>>(),
-                self.val.1,
-            )
+            (self.val.0, self.val.1)
         };
+        let vmse = mse(&xs.iter().map(|x| net.predict(x)).collect::<Vec<_>>(), ys);
         {
             let mut b = self.best.borrow_mut();
             if vmse < b.0 {
