@@ -445,3 +445,105 @@ fn keep_mode_pushes_from_the_first_step_with_the_full_depth() {
     );
     assert!(s.op.surfaces.initial.is_empty());
 }
+
+/// A node pressed into a crease: two fixed quads meeting along the y axis at slopes ±s
+/// (a valley, as a weft node lies under a warp's tent at a crossing), the ball on the
+/// crease line, inside both faces by the same depth.
+///
+/// ```text
+///        o        ball on x = 0, inside both faces by g
+///   ╲         ╱
+///     ╲     ╱     z = s|x|, x ∈ [−a, a], y ∈ [0, b]
+///       ╲ ╱
+/// ```
+///
+/// Oracles: mirror symmetry about x = 0 — the two faces tie, so each takes half the
+/// reaction and the face nodes at x = −a and x = +a are pushed alike (mirror images);
+/// Newton's third law — the band's nodes take exactly minus the ball's force; the
+/// ball's force is vertical (the penetration-weighted normal of the two faces) with the
+/// magnitude k g of the penalty. (Given to the first face in face order alone, as before,
+/// the reaction pushed one side only.)
+#[test]
+fn a_node_in_a_crease_pushes_both_faces_alike() {
+    let (a, b, slope, t) = (0.5e-3, 0.5e-3, 0.2f64, 1e-4);
+    let mut m = Model::default();
+    let band = m.add_part(
+        1,
+        "band",
+        ElementKind::Quad,
+        PartProps {
+            youngs_modulus_1: Some(80e9),
+            youngs_modulus_2: Some(80e9),
+            shear_modulus_12: Some(30e9),
+            density: Some(1e6),
+            thickness: Some(t),
+            ..Default::default()
+        },
+    );
+    let mut id = 0;
+    let mut node = |m: &mut Model, x: f64, y: f64| {
+        id += 1;
+        let n = m.add_node(id, [x, y, slope * x.abs()]);
+        m.constraints.push((n, [true; 3]));
+        n
+    };
+    let left = [node(&mut m, -a, 0.0), node(&mut m, -a, b)];
+    let mid = [node(&mut m, 0.0, 0.0), node(&mut m, 0.0, b)];
+    let right = [node(&mut m, a, 0.0), node(&mut m, a, b)];
+    m.add_element(1, band, &[left[0], mid[0], mid[1], left[1]]);
+    m.add_element(2, band, &[mid[0], right[0], right[1], mid[1]]);
+    // The ball at height z on x = 0: its distance to each face's mid-surface is
+    // z·cos θ (θ = atan s), so it is inside both by g = t − z cos θ.
+    let (depth, mass, dt) = (0.2 * t, 1e-6, 1e-8);
+    let cos = 1.0 / (1.0 + slope * slope).sqrt();
+    let z = (t - depth) / cos;
+    let bn = ball(&mut m, [0.0, 0.5 * b, z], mass);
+    let mut c = ContactDef::new(1, Slave::Set("ball".into()), band);
+    c.slave_thickness = Some(t);
+    c.initial_penetration = InitialPenetration::Keep;
+    m.contacts.push(c);
+    m.analysis = Analysis {
+        end_time: 1e-6,
+        output_interval: 1e-6,
+        time_step: Some(dt),
+        ..Analysis::default()
+    };
+    let mut s = Solver::new(&m).unwrap();
+    let (st, mass_n) = (s.state.clone(), s.mass.clone());
+    s.op.contact_and_ties(&st, &mass_n, dt);
+    let f = s.op.fcon[bn];
+    let k = 0.1 * mass / (dt * dt);
+    println!(
+        "crease: ball {f:?} N (k g = {:.6e} N); x = −a nodes {:?} {:?}, x = +a nodes {:?} {:?}",
+        k * depth,
+        s.op.fcon[left[0]],
+        s.op.fcon[left[1]],
+        s.op.fcon[right[0]],
+        s.op.fcon[right[1]]
+    );
+    assert!(
+        rel(f[2], k * depth) < 1e-9 && f[0].abs() < 1e-9 * f[2],
+        "{f:?}"
+    );
+    for (l, r) in left.iter().zip(&right) {
+        let (fl, fr) = (s.op.fcon[*l], s.op.fcon[*r]);
+        // Each side pushed (a few % of the force: the feet lie a bit off the crease)
+        // and pushed alike: the mirror image to round-off.
+        assert!(fl[2] < -1e-3 * f[2], "{fl:?}");
+        assert!(
+            (fl[0] + fr[0]).abs() < 1e-12 * f[2]
+                && (fl[1] - fr[1]).abs() < 1e-12 * f[2]
+                && (fl[2] - fr[2]).abs() < 1e-12 * f[2],
+            "{fl:?} {fr:?}"
+        );
+    }
+    let mut sum = [0.0; 3];
+    for n in left.iter().chain(&mid).chain(&right) {
+        for d in 0..3 {
+            sum[d] += s.op.fcon[*n][d];
+        }
+    }
+    for d in 0..3 {
+        assert!((sum[d] + f[d]).abs() < 1e-12 * f[2], "{sum:?} {f:?}");
+    }
+}

@@ -7,7 +7,8 @@
 //! its mid-surface to x_s, d = |x_s − q|, n = (x_s − q)/d the normal from the face to the
 //! node, t_F = Σ_a w_a t_a the face thickness at q; g = (t_s + t_F)/2 − d − g₀ the
 //! penetration (g₀: the depth at which a node started inside, see below); m* = min(m_s,
-//! m_F) with m_F the mean nodal mass of the face; κ_c = 0.1 × penalty_scale.
+//! m_F) with m_F the faces' nodal masses interpolated at the feet (λ-weighted, below);
+//! κ_c = 0.1 × penalty_scale.
 //!
 //! Phases, after the DESIGN notes §11 and LS-DYNA's contact:
 //! - **broad phase** ([`Grid`]): the faces' bounding boxes, inflated by
@@ -20,7 +21,12 @@
 //! - **narrow phase** (pure kernels [`closest_on_face`], [`pair_force`]): the faces'
 //!   bounding boxes once per step; per slave, the candidates whose box is within its reach
 //!   (a branch-free pass), then the closest point on each of those; of the faces it
-//!   penetrates, the one of largest penetration (ties: the first in face order); normal force
+//!   penetrates, the one of largest penetration sets g, and all of them share the rest:
+//!   the normal is their penetration-weighted mean, and the reaction −f goes to each
+//!   penetrated face F in the share λ_F = g_F/Σg (to its nodes by the foot's weights), the
+//!   foot's mass and velocity being the λ-weighted ones, so that a node over a vertex or
+//!   in a crease, whose faces tie, pushes them all alike and nothing jumps as faces come
+//!   and go; normal force
 //!   f_n = k g with k = κ_c m*/Δt² (LS-DYNA's SOFT = 1 idea: the contact spring alone has
 //!   ω Δt ≤ √(2κ_c), so it does not cut the step; the step is still reduced by
 //!   √(s² − κ_c/2)/s as a guard, see `Solver::set_time_step`); one geometry evaluation gives the
@@ -36,8 +42,9 @@
 //!   its depth g₀ (the force acts only beyond it, and g₀ shrinks as the node leaves), or
 //!   stops the run when the definition says `error`.
 //! - **determinism**: slaves are processed in parallel fixed chunks, each writing only its
-//!   own result slot; the results are scattered onto the nodes serially in slave order,
-//!   so 1 and N threads give bit-identical forces.
+//!   own result slot and its chunk's list of reaction shares; the results are gathered
+//!   onto the nodes in chunk order (the slaves, then their reactions), so 1 and N threads
+//!   give bit-identical forces.
 
 use rayon::prelude::*;
 
@@ -156,10 +163,10 @@ pub fn closest_on_quad(p: &[f64; 3], x: &[[f64; 3]; 4], a: [f64; 3], b: [f64; 3]
 /// What one slave's contact gives at one step.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct PairOut {
-    /// Face index (u32::MAX: no contact).
+    /// Face of largest penetration (u32::MAX: no contact).
     pub face: u32,
-    pub w: [f64; 4],
-    /// Force on the slave [N] (the face nodes get −w_a f).
+    /// Force on the slave [N] (the nodes of each penetrated face F get −λ_F w_{F,a} f,
+    /// see [`Reaction`]).
     pub f: [f64; 3],
     /// Stored energy ½ k g² + |f_t|²/(2k) [J].
     pub stored: f64,
@@ -168,6 +175,19 @@ pub struct PairOut {
     /// Penetration g (beyond a tracked initial one) [m].
     pub g: f64,
 }
+
+/// A share of a slave's reaction: the nodes of `face` get −w_a f_slave (w already
+/// multiplied by the face's share λ_F = g_F/Σg of the penetrations).
+#[derive(Debug, Clone, Copy)]
+pub struct Reaction {
+    pub slave: u32,
+    pub face: u32,
+    pub w: [f64; 4],
+}
+
+/// Most faces one slave's reaction is shared over (a node at a quad vertex penetrates the
+/// four faces around it; more only in crushed regions, where the deepest are kept).
+const MAX_SHARED: usize = 8;
 
 /// Per-slave history.
 #[derive(Debug, Clone, Copy, Default)]
@@ -316,6 +336,8 @@ pub struct Side {
     /// Per fixed chunk of slaves: the slaves in contact (indices), and the stored energy
     /// and the friction work of the chunk, summed in chunk order.
     chunk_active: Vec<Vec<u32>>,
+    /// ... the shares of their reactions over the faces they penetrate, in slave order ...
+    chunk_reactions: Vec<Vec<Reaction>>,
     chunk_sums: Vec<[f64; 2]>,
 }
 
@@ -503,6 +525,7 @@ impl Side {
             cand: vec![],
             face_box: vec![],
             chunk_active: vec![],
+            chunk_reactions: vec![],
             chunk_sums: vec![],
         }
     }
@@ -628,30 +651,44 @@ impl Side {
         let dt2 = dt * dt;
         let nchunks = self.slaves.len().div_ceil(SLAVE_CHUNK);
         self.chunk_active.resize_with(nchunks, Vec::new);
+        self.chunk_reactions.resize_with(nchunks, Vec::new);
         self.chunk_sums.resize(nchunks, [0.0; 2]);
         type Chunk<'c> = (
             usize,
             (
-                ((&'c mut [PairOut], &'c mut [SlaveState]), &'c mut Vec<u32>),
+                (
+                    ((&'c mut [PairOut], &'c mut [SlaveState]), &'c mut Vec<u32>),
+                    &'c mut Vec<Reaction>,
+                ),
                 &'c mut [f64; 2],
             ),
         );
         let body =
-            |(ci, (((outs, sts), active), sums)): Chunk| {
+            |(ci, ((((outs, sts), active), reactions), sums)): Chunk| {
                 active.clear();
+                reactions.clear();
                 *sums = [0.0; 2];
                 for (j, (o, st)) in outs.iter_mut().zip(sts.iter_mut()).enumerate() {
                     let si = ci * SLAVE_CHUNK + j;
                     let s = slaves[si] as usize;
                     let p = x[s];
                     // The candidate of largest raw penetration.
-                    let mut best: Option<(u32, [f64; 4], f64, [f64; 3])> = None;
+                    let mut best: Option<(u32, f64, [f64; 3])> = None;
                     // Σ g n over the faces the node penetrates, and how many: in a concave
                     // crease (a node under a tent of two faces) both feet are valid and the
                     // nearer one's normal flips as the node crosses the bisector; the
                     // penetration-weighted normal turns continuously instead.
                     let (mut n_sum, mut n_count) = ([0.0f64; 3], 0u32);
                     let (mut tg_sum, mut g_sum) = ([0.0f64; 3], 0.0f64);
+                    // The faces it penetrates (face, weights, g), the deepest MAX_SHARED: the
+                    // reaction is shared over them as the normal is, so that a node over a
+                    // vertex or a ridge, whose faces tie, pushes them all alike (the deepest
+                    // alone, ties to the first in face order, pushed one side only, and the
+                    // reaction jumped between faces as the node moved: measured, a formed weave
+                    // tiled from its mirror-symmetric cell was out of balance by 0.10 of the
+                    // crossing force at the vertex's neighbours, and drifted when left alone).
+                    let mut pen = [(0u32, [0.0f64; 4], 0.0f64); MAX_SHARED];
+                    let mut n_pen = 0usize;
                     let reach = 0.5 * (slave_t[si] + face_t_max);
                     let r2 = reach * reach;
                     // Only faces the node penetrates (g > 0) matter: a node whose best g is
@@ -694,6 +731,21 @@ impl Side {
                             }
                             let dist = d2.sqrt();
                             let g = c - dist;
+                            if n_pen < MAX_SHARED {
+                                pen[n_pen] = (fi, w, g);
+                                n_pen += 1;
+                            } else {
+                                // Full: replace the shallowest (the first of equals).
+                                let mut k = 0;
+                                for j in 1..MAX_SHARED {
+                                    if pen[j].2 < pen[k].2 {
+                                        k = j;
+                                    }
+                                }
+                                if g > pen[k].2 {
+                                    pen[k] = (fi, w, g);
+                                }
+                            }
                             if dist > 0.0 {
                                 let tg = thickness_gradient(&face_t[fi as usize], &xf, nf);
                                 for d in 0..3 {
@@ -703,7 +755,7 @@ impl Side {
                                 g_sum += g;
                                 n_count += 1;
                             }
-                            if best.as_ref().is_none_or(|b| g > b.2) {
+                            if best.as_ref().is_none_or(|b| g > b.1) {
                                 let n = if dist > 0.0 {
                                     [r[0] / dist, r[1] / dist, r[2] / dist]
                                 } else {
@@ -715,7 +767,7 @@ impl Side {
                                         [0.0, 0.0, 1.0]
                                     }
                                 };
-                                best = Some((fi, w, g, n));
+                                best = Some((fi, g, n));
                             }
                         }
                     }
@@ -723,7 +775,7 @@ impl Side {
                         face: u32::MAX,
                         ..Default::default()
                     };
-                    let g_raw = best.as_ref().map_or(f64::NEG_INFINITY, |b| b.2);
+                    let g_raw = best.as_ref().map_or(f64::NEG_INFINITY, |b| b.1);
                     if initial {
                         st.g0 = if keep { 0.0 } else { g_raw.max(0.0) };
                         if let Some(b) = &best {
@@ -738,22 +790,35 @@ impl Side {
                     }
                     let g = g_raw - st.g0;
                     match best {
-                        Some((fi, w, _, mut n)) if g > 0.0 => {
+                        Some((fi, _, mut n)) if g > 0.0 => {
                             if n_count > 1 {
                                 let l = dot(&n_sum, &n_sum).sqrt();
                                 if l > 0.0 {
                                     n = [n_sum[0] / l, n_sum[1] / l, n_sum[2] / l];
                                 }
                             }
-                            let f = &faces[fi as usize];
+                            // Shares λ_F = g_F/Σg of the penetrated faces; the foot's mass
+                            // and velocity are their λ-weighted interpolations, so that the
+                            // penalty and the friction slip are continuous as faces come and
+                            // go, and the power of the shared reaction is −f·v_foot.
+                            let g_pen: f64 = pen[..n_pen].iter().map(|e| e.2).sum();
                             let ms = slave_m[si];
-                            let fm = &face_m[fi as usize];
-                            let mf: f64 = (0..nf).map(|a| w[a] * fm[a]).sum();
+                            let (mut mf, mut vf) = (0.0f64, [0.0f64; 3]);
+                            for &(fj, wj, gj) in &pen[..n_pen] {
+                                let lam = gj / g_pen;
+                                let fn_ = &faces[fj as usize];
+                                let fm = &face_m[fj as usize];
+                                for a in 0..nf {
+                                    let la = lam * wj[a];
+                                    mf += la * fm[a];
+                                    let va = &v[fn_[a] as usize];
+                                    for d in 0..3 {
+                                        vf[d] += la * va[d];
+                                    }
+                                }
+                            }
                             let mstar = if ms > 0.0 { ms.min(mf) } else { mf };
                             let k = kappa * mstar / dt2;
-                            let vf: [f64; 3] = std::array::from_fn(|d| {
-                                (0..nf).map(|a| w[a] * v[f[a] as usize][d]).sum()
-                            });
                             let vr = sub(&v[s], &vf);
                             let vn = dot(&vr, &n);
                             let vt = [vr[0] - vn * n[0], vr[1] - vn * n[1], vr[2] - vn * n[2]];
@@ -781,12 +846,19 @@ impl Side {
                             }
                             out = PairOut {
                                 face: fi,
-                                w,
                                 f: force,
                                 stored,
                                 dissipated: diss,
                                 g,
                             };
+                            for &(fj, wj, gj) in &pen[..n_pen] {
+                                let lam = gj / g_pen;
+                                reactions.push(Reaction {
+                                    slave: si as u32,
+                                    face: fj,
+                                    w: std::array::from_fn(|a| lam * wj[a]),
+                                });
+                            }
                         }
                         _ => {
                             // Open: what the stick spring stored is dissipated.
@@ -810,6 +882,7 @@ impl Side {
                 .chunks_mut(SLAVE_CHUNK)
                 .zip(self.state.chunks_mut(SLAVE_CHUNK))
                 .zip(self.chunk_active.iter_mut())
+                .zip(self.chunk_reactions.iter_mut())
                 .zip(self.chunk_sums.iter_mut())
                 .enumerate()
                 .for_each(body);
@@ -818,6 +891,7 @@ impl Side {
                 .par_chunks_mut(SLAVE_CHUNK)
                 .zip(self.state.par_chunks_mut(SLAVE_CHUNK))
                 .zip(self.chunk_active.par_iter_mut())
+                .zip(self.chunk_reactions.par_iter_mut())
                 .zip(self.chunk_sums.par_iter_mut())
                 .enumerate()
                 .for_each(body);
@@ -1160,10 +1234,10 @@ impl SurfaceContact {
             }
         }
         // Gather onto the nodes: the nodes are split into one block per thread, and each
-        // block takes the contributions to its nodes in the canonical order (side, slave,
-        // the slave then its face's nodes), so every node's sum is the same whatever the
-        // split: bit-identical for any thread count, and parallel. `fcon` must be zero at
-        // the slaves' and faces' nodes before (the operator clears it).
+        // block takes the contributions to its nodes in the canonical order (side, chunk,
+        // the chunk's slaves, then their reactions' face nodes), so every node's sum is the
+        // same whatever the split: bit-identical for any thread count, and parallel. `fcon`
+        // must be zero at the slaves' and faces' nodes before (the operator clears it).
         let sides = &self.sides;
         let active: usize = sides
             .iter()
@@ -1179,21 +1253,24 @@ impl SurfaceContact {
         let gather = |(b, block): (usize, &mut [[f64; 3]])| {
             let (lo, hi) = (b * bs, b * bs + block.len());
             for s in sides {
-                for &si in s.chunk_active.iter().flatten() {
-                    let si = si as usize;
-                    let o = &s.out[si];
-                    let sl = s.slaves[si] as usize;
-                    if (lo..hi).contains(&sl) {
-                        add(&mut block[sl - lo], &o.f);
+                for (active, reactions) in s.chunk_active.iter().zip(&s.chunk_reactions) {
+                    for &si in active {
+                        let sl = s.slaves[si as usize] as usize;
+                        if (lo..hi).contains(&sl) {
+                            add(&mut block[sl - lo], &s.out[si as usize].f);
+                        }
                     }
-                    let f = &s.faces[o.face as usize];
-                    for a in 0..s.nf {
-                        let n = f[a] as usize;
-                        if (lo..hi).contains(&n) {
-                            add(
-                                &mut block[n - lo],
-                                &[-o.w[a] * o.f[0], -o.w[a] * o.f[1], -o.w[a] * o.f[2]],
-                            );
+                    for r in reactions {
+                        let f = &s.out[r.slave as usize].f;
+                        let face = &s.faces[r.face as usize];
+                        for a in 0..s.nf {
+                            let n = face[a] as usize;
+                            if (lo..hi).contains(&n) {
+                                add(
+                                    &mut block[n - lo],
+                                    &[-r.w[a] * f[0], -r.w[a] * f[1], -r.w[a] * f[2]],
+                                );
+                            }
                         }
                     }
                 }
