@@ -11,7 +11,9 @@
 //! a the crimp amplitude: the warp at y_j = jp follows z = (−1)^j a cos(πx/p), the weft at
 //! x_i = ip follows z = −(−1)^i a cos(πy/p), so that they alternate over and under at
 //! every crossing (a plain weave, symmetric about x = 0 and y = 0: the quarter model has
-//! symmetry planes there, through the centre lines of the middle yarns).
+//! symmetry planes there, through the centre lines of the middle yarns). The full patch
+//! has its yarns at (j + ½)p and the phase x − p/2, so that its crests too lie at the
+//! crossings.
 //!
 //! Discretisation: `per_spacing` quads per spacing along, `across` quads across the width.
 //! A one-point quad takes the mean of its nodal thicknesses, which under-integrates the
@@ -437,11 +439,13 @@ pub fn woven(p: &WovenBandParams) -> Result<(Model, WovenInfo)> {
                 let mut idx = vec![vec![usize::MAX; na + 1]; n_along + 1];
                 for i in 0..=n_along {
                     let s = lo + (hi - lo) * i as f64 / n_along as f64;
-                    // Warp (fam 0) follows (−1)^j a cos(πx/p); weft −(−1)^j a cos(πy/p).
+                    // Warp (fam 0) follows (−1)^j a cos(π(x − x₀)/p); weft
+                    // −(−1)^j a cos(π(y − x₀)/p), x₀ a yarn centre line (0 in the quarter,
+                    // p/2 in the full patch), so that the crests lie at the crossings.
                     let z = zl
                         + if fam == 0 { sign(j) } else { -sign(j) }
                             * amp
-                            * (std::f64::consts::PI * s / p.spacing).cos();
+                            * (std::f64::consts::PI * (s - centre(0)) / p.spacing).cos();
                     top = top.max(z + 0.5 * t_centre);
                     for k in k0..=na {
                         let r = c + offs[k];
