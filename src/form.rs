@@ -56,6 +56,8 @@ use crate::solver::vec3::{norm, sub};
 use crate::solver::Solver;
 use crate::table::{batch, write_table, Col, Provenance, Table};
 
+pub mod cell;
+
 /// Forming parameters.
 #[derive(Debug, Clone, Serialize)]
 pub struct Params {
@@ -150,6 +152,11 @@ pub struct Report {
     /// How far the fabric's top rose [m] (the projectile is moved up by as much).
     pub top_rise: f64,
     pub wall_seconds: f64,
+    /// Where forming started: `geometry`, `cell` (tiled from the formed periodic cell) or
+    /// `patch` (tiled from a formed smaller patch).
+    pub start: String,
+    /// The periodic cell's forming, when the start was `cell` (zeros otherwise).
+    pub cell: CellSummary,
 }
 
 /// Yarn family of a part: 0 warp (along x), 1 weft (along y).
@@ -225,7 +232,34 @@ pub struct Start {
     pub u: Vec<[f64; 3]>,
     /// Forming work credited to it [J] (the work that formed the state it came from).
     pub work: f64,
+    /// The formed periodic cell it was tiled from, if it was: the patch is then tested
+    /// at rest first, and taken as it is if it stays ([`cell`]).
+    pub cell: Option<CellSummary>,
 }
+
+/// What forming the periodic cell did (for the report).
+#[derive(Debug, Clone, Copy, Default, Serialize)]
+pub struct CellSummary {
+    pub rounds: usize,
+    pub steps: u64,
+    /// The cell's planes moved by δ_x, δ_y [m], and the force across them per yarn [N].
+    pub stretch: [f64; 2],
+    pub tension: [f64; 2],
+}
+
+/// Where forming starts (`weft-form --start`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum StartMode {
+    /// The periodic cell formed alone and reflected over the patch ([`cell`]), then tested
+    /// at rest (relaxed further only if it moves).
+    Cell,
+    /// The generated geometry, relaxed whole.
+    Geometry,
+}
+
+/// Relative accuracy of the tension across the periodic cell's planes.
+pub const CELL_TENSION_TOLERANCE: f64 = 1e-3;
 
 /// Form `m` (a woven model from `weft-weave woven`): the formed model and the report.
 pub fn form(
@@ -529,13 +563,18 @@ pub fn form_from(
         )
         .hint("form a model from `weft-weave woven`"));
     };
+    // The yarns' centre lines lie at x₀ + jp (x₀ = 0 in a quarter patch, p/2 in a full
+    // one, whose yarns straddle x = 0): a node's yarn is the nearest centre line.
+    let phase = m.node_sets["axis_x"]
+        .first()
+        .map_or(0.0, |&n| m.coords[n][0].rem_euclid(spacing));
     for n in 0..m.num_nodes() {
         if end_fam[n] == usize::MAX {
             continue;
         }
         let f = end_fam[n];
         let across = 1 - f;
-        let yarn = (m.coords[n][across] / spacing).round() as i64;
+        let yarn = ((m.coords[n][across] - phase) / spacing).round() as i64;
         ends.entry((f, end_sign[n] as i64, yarn, end_part[n]))
             .or_default()
             .push(n);
@@ -682,6 +721,9 @@ pub fn form_from(
         work_offset: credited,
         contact_damping: p.contact_damping,
         hold_in_rest_test: hold,
+        // A patch tiled from its formed cell is in equilibrium as it is (to the
+        // contacts' discretisation): test it at rest first.
+        probe_first: start.is_some_and(|s| s.cell.is_some()),
     };
     let mut st = solver.relax(&opts, progress)?;
     // The bands' tension: the volume mean of (P ê₁)·f̂₁ × the yarn's section, per family.
@@ -716,6 +758,8 @@ pub fn form_from(
         // 0.3 %.
         let first = st.clone();
         opts.hold_in_rest_test = vec![];
+        // With the ties back the patch is no longer in its own equilibrium: relax first.
+        opts.probe_first = false;
         let s0_closed = *s0;
         let mut last: [Option<(f64, f64)>; 2] = [None, None];
         let mut off = f64::INFINITY;
@@ -868,7 +912,7 @@ pub fn form_from(
             .iter()
             .copied()
             .filter(|&n| {
-                let r = m.coords[n][1] / spacing;
+                let r = (m.coords[n][1] - phase) / spacing;
                 (r - r.round()).abs() < 1e-9
             })
             .collect()
@@ -924,6 +968,13 @@ pub fn form_from(
         max_penetration_ratio: max_pen.map_or(0.0, |d| d.0),
         top_rise: rise,
         wall_seconds: t0.elapsed().as_secs_f64(),
+        start: match start {
+            None => "geometry",
+            Some(Start { cell: Some(_), .. }) => "cell",
+            Some(_) => "patch",
+        }
+        .into(),
+        cell: start.and_then(|s| s.cell).unwrap_or_default(),
     };
     Ok((out, report))
 }
@@ -934,13 +985,50 @@ pub struct Config {
     pub model: PathBuf,
     pub out: PathBuf,
     pub params: Params,
-    /// A formed smaller patch of the same weave to start from ([`tile_start`]).
+    /// A formed smaller patch of the same weave to start from ([`tile_start`]); else
+    /// `start`.
     pub start_from: Option<PathBuf>,
+    pub start: StartMode,
+}
+
+/// The start tiled from the formed periodic cell of `m` ([`cell`]).
+pub fn cell_start(m: &Model, p: &Params, progress: &mut dyn FnMut(&RelaxStats)) -> Result<Start> {
+    let spacing = spacing_of(m).ok_or_else(|| {
+        WeftError::input(
+            "the model has no node set `axis_x` with two crossings: the yarn spacing, hence the periodic cell, is unknown",
+        )
+        .hint("form a patch of at least 2 yarns per side from `weft-weave woven`, or use --start geometry")
+    })?;
+    let c = cell::extract(m, spacing)?;
+    let f = cell::form(&c, p, CELL_TENSION_TOLERANCE, progress)
+        .map_err(|e| e.context("cannot form the periodic cell".to_string()))?;
+    let u = cell::tile(m, &c, &f)?;
+    let yarn_quads = |mm: &Model| {
+        mm.elements.get(&ElementKind::Quad).map_or(0, |b| {
+            (0..b.len())
+                .filter(|&e| family(mm, b.part[e]).is_some())
+                .count()
+        })
+    };
+    Ok(Start {
+        u,
+        work: f.work * yarn_quads(m) as f64 / yarn_quads(&c.model).max(1) as f64,
+        cell: Some(CellSummary {
+            rounds: f.rounds,
+            steps: f.steps,
+            stretch: f.stretch,
+            tension: f.tension,
+        }),
+    })
 }
 
 pub fn run(c: &Config, progress: &mut dyn FnMut(&RelaxStats)) -> Result<Report> {
     let m = read_model(&c.model)?;
     let start = match &c.start_from {
+        None if c.start == StartMode::Cell => Some(
+            cell_start(&m, &c.params, progress)
+                .map_err(|e| e.context(format!("cannot form `{}`", c.model.display())))?,
+        ),
         None => None,
         Some(dir) => {
             let cell = read_model(dir)?;
@@ -952,7 +1040,11 @@ pub fn run(c: &Config, progress: &mut dyn FnMut(&RelaxStats)) -> Result<Report> 
             let quads = |mm: &Model| mm.elements.get(&ElementKind::Quad).map_or(0, |b| b.len());
             let work =
                 w.first().copied().unwrap_or(0.0) * quads(&m) as f64 / quads(&cell).max(1) as f64;
-            Some(Start { u, work })
+            Some(Start {
+                u,
+                work,
+                cell: None,
+            })
         }
     };
     let (formed, r) = form_from(&m, &c.params, start.as_ref(), progress)
@@ -995,6 +1087,13 @@ fn write_report(path: &Path, r: &Report, prov: &Provenance) -> Result<()> {
             Col::F64("max_penetration_ratio", vec![r.max_penetration_ratio]),
             Col::F64("top_rise", vec![r.top_rise]),
             Col::F64("wall_seconds", vec![r.wall_seconds]),
+            Col::Str("start", vec![r.start.clone()]),
+            Col::I64("cell_rounds", vec![r.cell.rounds as i64]),
+            Col::I64("cell_steps", vec![r.cell.steps as i64]),
+            Col::F64("cell_stretch_x", vec![r.cell.stretch[0]]),
+            Col::F64("cell_stretch_y", vec![r.cell.stretch[1]]),
+            Col::F64("cell_warp_tension", vec![r.cell.tension[0]]),
+            Col::F64("cell_weft_tension", vec![r.cell.tension[1]]),
         ]),
         prov,
     )

@@ -8,10 +8,16 @@
 //! - equilibrium: a model that starts in equilibrium and at rest stays there;
 //! - the straight yarn's axial stiffness E·A, which the tangent stiffness of a crimped
 //!   yarn approaches as it straightens, while the crossing yarns take up its crimp
-//!   (crimp interchange; Kawabata, Niwa & Kawai, J. Textile Inst. 64, 1973).
+//!   (crimp interchange; Kawabata, Niwa & Kawai, J. Textile Inst. 64, 1973);
+//! - symmetry: the periodic cell of a plain weave under equal tensions is invariant under
+//!   the two-fold rotations about its mid-span axes, which its forming does not impose.
+//!
+//! Two ways to form: from the periodic cell reflected over the patch (the default,
+//! `--start cell`) and by relaxing the generated geometry whole (`--start geometry`);
+//! both meet the same checks.
 
 mod common;
-use weft::form::{form, run, Config, Params, Report};
+use weft::form::{cell, cell_start, form, form_from, run, Config, Params, Report, StartMode};
 use weft::generate::woven::{woven, Lenticular, WovenBandParams};
 use weft::model::Model;
 use weft::solver::run_in_memory;
@@ -25,8 +31,15 @@ fn patch(yarns: usize) -> Model {
     .0
 }
 
+/// Formed by relaxing the generated geometry whole (`--start geometry`).
 fn formed(m: &Model, p: &Params) -> (Model, Report) {
     form(m, p, &mut |_| {}).unwrap()
+}
+
+/// Formed from the periodic cell (`--start cell`, the stage's default).
+fn formed_by_cell(m: &Model, p: &Params) -> (Model, Report) {
+    let start = cell_start(m, p, &mut |_| {}).unwrap();
+    form_from(m, p, Some(&start), &mut |_| {}).unwrap()
 }
 
 /// The 6 × 6 quarter formed with the defaults (once for the tests that look at it).
@@ -34,17 +47,35 @@ fn default_6x6() -> &'static (Model, Model, Report) {
     static F: std::sync::OnceLock<(Model, Model, Report)> = std::sync::OnceLock::new();
     F.get_or_init(|| {
         let m = patch(6);
-        let (f, r) = formed(&m, &Params::default());
+        let (f, r) = formed_by_cell(&m, &Params::default());
         (m, f, r)
     })
 }
 
 #[test]
 fn a_formed_weave_is_in_equilibrium_with_its_tension_and_a_string_crimp() {
-    let p = Params::default();
     let (m, f, r) = default_6x6();
+    assert_eq!(r.start, "cell");
+    // Measured 1.0 % (the contacts' discretisation: the cell's quarter crossings see
+    // one face each, the patch's crossings four, whose penalty masses differ slightly).
+    check_formed("6×6 quarter from the periodic cell", m, f, r, 0.05);
+}
+
+/// The same checks, relaxing the generated geometry whole (`--start geometry`).
+#[test]
+fn a_weave_relaxed_from_its_geometry_meets_the_same_checks() {
+    let m = patch(6);
+    let (f, r) = formed(&m, &Params::default());
+    assert_eq!(r.start, "geometry");
+    // Measured 4.4 %: a node chattering at a lens flank; the forming's own stop is 5 %
+    // (of the larger of the largest contact force and the largest nodal pull).
+    check_formed("6×6 quarter relaxed whole", &m, &f, &r, 0.05);
+}
+
+fn check_formed(what: &str, m: &Model, f: &Model, r: &Report, residual: f64) {
+    let p = Params::default();
     println!(
-        "6×6 quarter formed at T = {} N: {} steps, K/W {:.2e}, residual {:.3e} N of contact forces up to {:.3e} N ({:.2} %); tension in the bands {:.4} / {:.4} N, at the ends {:.4} / {:.4} N; crimp {:.3} % → {:.3} % / {:.3} % (string {:.3} %); deepest contact {:.2} %",
+        "{what} formed at T = {} N: {} steps, K/W {:.2e}, residual {:.3e} N of contact forces up to {:.3e} N ({:.2} %); tension in the bands {:.4} / {:.4} N, at the ends {:.4} / {:.4} N; crimp {:.3} % → {:.3} % / {:.3} % (string {:.3} %); deepest contact {:.2} %",
         p.warp_tension,
         r.steps,
         r.kinetic_over_work,
@@ -63,11 +94,9 @@ fn a_formed_weave_is_in_equilibrium_with_its_tension_and_a_string_crimp() {
     );
     // Equilibrium: the issue's criteria, which forming stops on.
     assert!(r.kinetic_over_work <= 1e-6);
-    // Measured 4.4 %: the largest residual is a node chattering at a lens flank; the
-    // forming's own stop is 5 % (of the larger of the largest contact force and the
-    // largest nodal pull).
-    assert!(r.max_residual_force <= 0.05 * r.max_contact_force);
-    // The tension at the ends: what pulls the yarn, to the residual (measured 0.06 %).
+    assert!(r.max_residual_force <= residual * r.max_contact_force);
+    // The tension at the ends: what pulls the yarn, to the residual (measured 0.06 %
+    // relaxed whole, 0.02 % from the cell).
     for t in [r.warp_end_tension, r.weft_end_tension] {
         assert!(
             (t - p.warp_tension).abs() < 0.01 * p.warp_tension,
@@ -75,7 +104,9 @@ fn a_formed_weave_is_in_equilibrium_with_its_tension_and_a_string_crimp() {
         );
     }
     // In the bands: the volume mean of the stress along the yarn times A, measured
-    // −1.0 % (the hourglass forces of the one-point quads carry the rest); 2 %.
+    // −1.0 % relaxed whole, +1.4 % from the cell (the mean over a crimped band is not its
+    // end's resultant: frictionless contact across a lenticular envelope has a component
+    // along the yarn, and the one-point quads' hourglass forces carry some); 2 %.
     for t in [r.warp_tension, r.weft_tension] {
         assert!(
             (t - p.warp_tension).abs() < 0.02 * p.warp_tension,
@@ -83,7 +114,8 @@ fn a_formed_weave_is_in_equilibrium_with_its_tension_and_a_string_crimp() {
         );
     }
     // Crimp: the generator's cosine (1.60 %) becomes straight runs between the crossings
-    // (string 1.371 %); measured 1.371 % (warp) and 1.323 % (weft, −3.5 %), asked 5 %.
+    // (string 1.371 %); measured 1.371 % / 1.323 % (warp / weft) relaxed whole, 1.386 % /
+    // 1.386 % from the cell; asked 5 %.
     for c in [r.crimp_warp_after, r.crimp_weft_after] {
         assert!(
             (c - r.crimp_target).abs() < 0.05 * r.crimp_target,
@@ -135,10 +167,13 @@ fn a_formed_weave_left_alone_stays_where_it_is() {
         100.0 * all / h,
         stats.max_balance_error_relative
     );
-    // The issue asks < 1 % of the yarn thickness over 50 µs. Measured: 1.9 % when
-    // forming stopped on kinetic energy and residual force alone, 0.96 % with the creep
-    // criterion at 10⁻³ h per 50 µs, and with its default 3·10⁻⁴ as printed above.
+    // The issue asks < 1 % of the yarn thickness over 50 µs. Measured, relaxed whole:
+    // 1.9 % when forming stopped on kinetic energy and residual force alone, 0.14 % with
+    // the rest test; from the periodic cell 0.01 % (anywhere 0.05 %), with the energy
+    // balanced to 5e-4.
     assert!(at_crossings < 0.01 * h, "moved {at_crossings} m");
+    assert!(all < 0.01 * h, "moved {all} m");
+    assert!(stats.max_balance_error_relative < 0.01);
 }
 
 #[test]
@@ -158,9 +193,16 @@ fn forming_is_thread_independent() {
             .num_threads(n)
             .build()
             .unwrap()
-            .install(|| formed(&m, &p).0.initial_displacement)
+            .install(|| {
+                (
+                    formed(&m, &p).0.initial_displacement,
+                    cell_start(&m, &Params::default(), &mut |_| {}).unwrap().u,
+                )
+            })
     };
-    assert!(go(1) == go(2), "1 and 2 threads differ");
+    let (one, two) = (go(1), go(2));
+    assert!(one.0 == two.0, "relaxed whole: 1 and 2 threads differ");
+    assert!(one.1 == two.1, "from the cell: 1 and 2 threads differ");
 }
 
 #[test]
@@ -250,7 +292,7 @@ fn pulling_the_warp_straightens_it_and_crimps_the_weft() {
 /// the tension at the ends, the crimp of straight runs between the crossings).
 #[test]
 fn a_patch_formed_from_a_smaller_formed_one_meets_the_same_checks() {
-    use weft::form::{form_from, tile_start, Start};
+    use weft::form::{tile_start, Start};
     let p = Params::default();
     let small = patch(4);
     let (fs, rs) = formed(&small, &p);
@@ -260,6 +302,7 @@ fn a_patch_formed_from_a_smaller_formed_one_meets_the_same_checks() {
     let start = Start {
         u,
         work: rs.forming_work * quads(&big) / quads(&small),
+        cell: None,
     };
     let (fb, rb) = form_from(&big, &p, Some(&start), &mut |_| {}).unwrap();
     println!(
@@ -323,6 +366,7 @@ fn forming_that_does_not_converge_is_an_error_and_writes_nothing() {
                 ..Params::default()
             },
             start_from: None,
+            start: StartMode::Cell,
         },
         &mut |_| {},
     )
@@ -341,6 +385,7 @@ fn forming_that_does_not_converge_is_an_error_and_writes_nothing() {
                 ..Params::default()
             },
             start_from: None,
+            start: StartMode::Cell,
         },
         &mut |_| {},
     )
@@ -576,6 +621,7 @@ fn relaxation_finds_the_statics_of_a_pulled_string() {
                 work_offset: 0.0,
                 contact_damping: 0.0,
                 hold_in_rest_test: vec![],
+                probe_first: false,
             },
             &mut |_| {},
         )
@@ -613,7 +659,7 @@ fn a_patch_tied_into_a_membrane_is_formed_with_the_requested_tension() {
     .unwrap()
     .0;
     let p = Params::default();
-    let (f, r) = formed(&m, &p);
+    let (f, r) = formed_by_cell(&m, &p);
     println!(
         "4×4 quarter in an 8 mm membrane formed at T = {} N: {} steps, K/W {:.2e}, residual {:.2} % of the contact forces; bands {:.4} / {:.4} N, ends {:.4} / {:.4} N; crimp {:.3} / {:.3} %",
         p.warp_tension,
@@ -679,4 +725,163 @@ fn a_patch_tied_into_a_membrane_is_formed_with_the_requested_tension() {
     // Measured 0.17 % of h, energy balance 9.1e-4.
     assert!(moved < 0.01 * h, "moved {moved} m");
     assert!(stats.max_balance_error_relative < 0.01);
+}
+
+/// The periodic cell of the default weave (four half yarns between neighbouring
+/// crossings, symmetry planes on its four sides), formed alone at T = 0.5 N per yarn.
+///
+/// ```text
+///   y = p ┌──────────────┐   warp 1 (lower half) along y = p, weft 1 (lower half)
+///         │ ╲          ╱ │   along x = p; warp 0 and weft 0 (upper halves) along the
+///         │   quarter    │   fixed planes y = 0 and x = 0; the planes x = p, y = p
+///         │   crossings  │   moved by δ until the force across them is T
+///   y = 0 └──────────────┘
+///        x = 0         x = p
+/// ```
+///
+/// Oracles: Newton's Σ F = 0 over the cell — the reactions of the fixed planes balance
+/// the force across the moved ones; symmetry — the relaxed state is invariant under the
+/// two-fold rotation about the mid-span axis (x = p/2 + δ_x/2, z = 0) along y, and
+/// likewise about (y = p/2 + δ_y/2, z = 0) along x (each maps the cell's yarns onto
+/// themselves or each other), so the node held in z on that axis needs no force; neither
+/// is imposed by the relaxation, which only moves the planes.
+#[test]
+fn the_periodic_cell_balances_its_planes_and_keeps_its_two_fold_symmetry() {
+    let m = patch(4);
+    let p = Params::default();
+    let c = cell::extract(&m, 1e-3).unwrap();
+    // 4 half bands × 5 nodes along × 2 across, 4 quads each.
+    assert_eq!(c.model.num_nodes(), 40);
+    assert_eq!(c.model.elements[&weft::model::ElementKind::Quad].len(), 16);
+    let f = cell::form(&c, &p, 1e-3, &mut |_| {}).unwrap();
+    println!(
+        "cell: {} relaxations, {} steps; planes moved {:.4e} / {:.4e} m; force across the moved planes {:.5} / {:.5} N, the fixed {:.5} / {:.5} N; z force on the axis {:.2e} N",
+        f.rounds, f.steps, f.stretch[0], f.stretch[1], f.tension[0], f.tension[1],
+        f.fixed_tension[0], f.fixed_tension[1], f.axis_reaction
+    );
+    for d in 0..2 {
+        // The stop: the tension to 1e-3.
+        assert!((f.tension[d] / 0.5 - 1.0).abs() <= 1e-3, "{:?}", f.tension);
+        // Balance, measured 2e-7 relative (the relaxation's residual, 4e-7 N).
+        assert!(
+            (f.fixed_tension[d] - f.tension[d]).abs() < 1e-5 * f.tension[d],
+            "{:?} {:?}",
+            f.fixed_tension,
+            f.tension
+        );
+        // The planes moved by the de-crimping and the stretch: positive, a few µm.
+        assert!(f.stretch[d] > 0.0 && f.stretch[d] < 1e-5, "{:?}", f.stretch);
+    }
+    // Measured 3e-7 N against contact forces of 0.04 N at the quarter crossings.
+    assert!(f.axis_reaction < 1e-5, "{}", f.axis_reaction);
+    // The two-fold rotations: node at (x, y, z) ↔ partner at (p − x, y, −z) with
+    // u' = (δ_x − u_x, u_y, −u_z), and (x, y, z) ↔ (x, p − y, −z) with
+    // u' = (u_x, δ_y − u_y, −u_z).
+    let cm = &c.model;
+    let find = |x: [f64; 3]| {
+        (0..cm.num_nodes())
+            .find(|&n| (0..3).all(|d| (cm.coords[n][d] - x[d]).abs() < 1e-9))
+            .unwrap_or_else(|| panic!("no partner at {x:?}"))
+    };
+    let amp = cm.coords.iter().map(|x| x[2].abs()).fold(0.0, f64::max);
+    let mut worst = 0.0f64;
+    for n in 0..cm.num_nodes() {
+        let (x, u) = (cm.coords[n], f.u[n]);
+        for (d, other) in [(0usize, 1usize), (1, 0)] {
+            let mut xp = x;
+            xp[d] = 1e-3 - x[d];
+            xp[2] = -x[2];
+            let k = find(xp);
+            let mut want = [0.0; 3];
+            want[d] = f.stretch[d] - u[d];
+            want[other] = u[other];
+            want[2] = -u[2];
+            for j in 0..3 {
+                worst = worst.max((f.u[k][j] - want[j]).abs());
+            }
+        }
+    }
+    println!("two-fold symmetry: largest departure {worst:.2e} m (crimp amplitude {amp:.3e} m)");
+    // Measured 2e-10 m, 2.5e-6 of the amplitude: the relaxation's tolerance.
+    assert!(worst < 1e-3 * amp, "{worst}");
+}
+
+/// What the periodic cell cannot form, named: a weave without tension (the planes are
+/// moved until the yarns carry it) and a patch too small to hold a cell.
+#[test]
+fn the_periodic_cell_refuses_what_it_cannot_form() {
+    let p = Params {
+        warp_tension: 0.0,
+        ..Params::default()
+    };
+    let e = cell_start(&patch(4), &p, &mut |_| {})
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("tensions > 0") && e.contains("--start geometry"),
+        "{e}"
+    );
+    let e = cell_start(&patch(1), &Params::default(), &mut |_| {})
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("periodic cell") && e.contains("--start geometry"),
+        "{e}"
+    );
+}
+
+/// A full patch (`--full`, no yarn on x = 0) formed from its periodic cell, whose planes
+/// lie on its yarns' centre lines (j + ½)p: the same checks, and its centre stays put —
+/// the formed state is symmetric under the patch's two-fold rotation about the z axis
+/// (x, y) → (−x, −y), which maps the weave onto itself (u_x(−x, −y) = −u_x(x, y), u_z
+/// equal).
+#[test]
+fn a_full_patch_formed_from_its_cell_keeps_its_centre() {
+    let m = woven(&WovenBandParams {
+        yarns: 6,
+        quarter: false,
+        ..WovenBandParams::default()
+    })
+    .unwrap()
+    .0;
+    let p = Params::default();
+    let (f, r) = formed_by_cell(&m, &p);
+    println!(
+        "full 6 × 6 from the cell: ends {:.4} / {:.4} N, crimp {:.3} / {:.3} % (string {:.3} %), amplitude {:.4e} / {:.4e} m, at rest moved {:.2e} m",
+        r.warp_end_tension, r.weft_end_tension, 100.0 * r.crimp_warp_after,
+        100.0 * r.crimp_weft_after, 100.0 * r.crimp_target, r.amplitude_warp_after, r.amplitude_weft_after, r.creep
+    );
+    for t in [r.warp_end_tension, r.weft_end_tension] {
+        assert!((t - p.warp_tension).abs() < 0.01 * p.warp_tension, "{t}");
+    }
+    for c in [r.crimp_warp_after, r.crimp_weft_after] {
+        assert!((c - r.crimp_target).abs() < 0.05 * r.crimp_target, "{c}");
+    }
+    assert!(r.amplitude_warp_after.is_finite() && r.amplitude_weft_after.is_finite());
+    let u = &f.initial_displacement;
+    let mut worst = 0.0f64;
+    let b = &m.elements[&weft::model::ElementKind::Quad];
+    let part_of = |n: usize| {
+        (0..b.len())
+            .find(|&e| b.nodes[4 * e..4 * e + 4].contains(&n))
+            .map(|e| b.part[e])
+    };
+    for n in 0..m.num_nodes() {
+        let c = m.coords[n];
+        let k = (0..m.num_nodes())
+            .find(|&k| {
+                (m.coords[k][0] + c[0]).abs() < 1e-12
+                    && (m.coords[k][1] + c[1]).abs() < 1e-12
+                    && (m.coords[k][2] - c[2]).abs() < 1e-12
+                    && part_of(k) == part_of(n)
+            })
+            .unwrap_or_else(|| panic!("no partner of node {n} at {c:?}"));
+        worst = worst
+            .max((u[k][0] + u[n][0]).abs())
+            .max((u[k][1] + u[n][1]).abs())
+            .max((u[k][2] - u[n][2]).abs());
+    }
+    println!("two-fold symmetry about the centre: largest departure {worst:.2e} m");
+    // The tiling is exact up to the cell's own symmetry (2e-10 m): measured as printed.
+    assert!(worst < 1e-8, "{worst}");
 }

@@ -6,7 +6,7 @@ use std::process::ExitCode;
 use anyhow::Context;
 use clap::Parser;
 use weft::cli::Progress;
-use weft::form::{run, Config, Params};
+use weft::form::{run, Config, Params, StartMode};
 
 #[derive(Parser)]
 #[command(
@@ -21,13 +21,20 @@ use weft::form::{run, Config, Params};
                   largest kinetic energy of a test window is below --kinetic-tolerance of the energy removed, the \
                   largest residual nodal force below --force-tolerance of the largest contact force, and then, left \
                   alone at rest (a free, undamped test run), no node moves more than --creep-tolerance of the yarn \
-                  thickness within --creep-time (the pretensioned patch's slow drum mode settles last; forming takes \
-                  17 s for the 6 × 6 quarter and 40 s for the 10 × 10 on 2 cores; --creep-tolerance 1000 turns the \
-                  test off). A large patch can start from a formed smaller one (--start-from).\n\n\
+                  thickness within --creep-time (the pretensioned patch's slow drum mode settles last; \
+                  --creep-tolerance 1000 turns the test off).\n\n\
+                  By default (--start cell) the patch is not relaxed whole: a plain weave is mirror-symmetric about \
+                  every yarn's centre line, so its periodic cell (four half yarns between two neighbouring crossings \
+                  each way, symmetry planes on its four sides) is formed alone, its planes moved until the force \
+                  across them is the residual tension, and reflected over the whole patch; the patch is then left \
+                  alone at rest (the same free test) and relaxed further only if it moves. Forming the 60 × 60 \
+                  quarter takes about 1 min this way (the cell in under a second, the rest of it the test run). \
+                  --start geometry relaxes the generated geometry whole instead; --start-from starts from a formed \
+                  smaller patch.\n\n\
                   A patch tied into a membrane (`weft-weave woven --membrane-length`, the paper's §3 combined model) \
                   is formed the same way as a patch alone, then its ties come back with the membrane pre-stressed \
                   (s0_11, s0_22 of its quads) and the whole model settles again, S₀ corrected until the bands carry \
-                  the requested tension (2 min for the 10 × 10 in a 29.5 mm membrane).\n\n\
+                  the requested tension (30 s for the 10 × 10 in a 29.5 mm membrane).\n\n\
                   Writes the formed model (the reference geometry unchanged, the formed positions as the nodes' initial \
                   displacement ux0, uy0, uz0 in nodes.parquet, the yarn ends held where they came to rest, contacts \
                   `keep` with their friction, the projectile raised by as much as the fabric rose) and form.parquet \
@@ -38,7 +45,7 @@ use weft::form::{run, Config, Params};
                   weft-simulate --model runs/patch-formed --out runs/impact"
 )]
 struct Cli {
-    /// Model folder (from `weft-weave woven`, edge clamped).
+    /// Model folder (from `weft-weave woven`: edge clamped, or tied into a membrane).
     #[arg(long)]
     model: PathBuf,
     /// Formed model folder to write.
@@ -89,8 +96,13 @@ struct Cli {
     /// spacings plus its mean stretch, is laid over this patch, its edges over this
     /// patch's edges, and the relaxation goes on from there (for patches whose forming
     /// from the generated geometry would take hours, like the 60 × 60 reference).
-    #[arg(long, value_name = "FORMED_MODEL")]
+    #[arg(long, value_name = "FORMED_MODEL", conflicts_with = "start")]
     start_from: Option<PathBuf>,
+    /// Where forming starts: `cell`, the formed periodic cell reflected over the patch
+    /// (then tested at rest, relaxed only if it moves), or `geometry`, the generated
+    /// geometry relaxed whole.
+    #[arg(long, value_enum, default_value = "cell")]
+    start: StartMode,
     /// Worker threads [default: all cores]. Results do not depend on it.
     #[arg(long)]
     threads: Option<usize>,
@@ -139,6 +151,7 @@ fn run_cli() -> anyhow::Result<ExitCode> {
             out: cli.out.clone(),
             params,
             start_from: cli.start_from.clone(),
+            start: cli.start,
         },
         &mut |s| {
             if progress.protocol() {
@@ -191,6 +204,12 @@ fn run_cli() -> anyhow::Result<ExitCode> {
         r.top_rise,
         r.wall_seconds
     );
+    if r.start == "cell" {
+        eprintln!(
+            "  started from the periodic cell: {} relaxations ({} steps), its planes moved {:.4e} / {:.4e} m, {:.4} / {:.4} N across them per warp / weft yarn; the patch then moved ≤ {:.3e} m at rest",
+            r.cell.rounds, r.cell.steps, r.cell.stretch[0], r.cell.stretch[1], r.cell.tension[0], r.cell.tension[1], r.creep
+        );
+    }
     eprintln!("  wrote {} (formed model, form.parquet)", cli.out.display());
     Ok(ExitCode::SUCCESS)
 }

@@ -984,6 +984,7 @@ fn relax_start(m: &mut Model, p: &WovenParams) -> Result<()> {
             work_offset: 0.0,
             contact_damping: 0.0,
             hold_in_rest_test: vec![],
+            probe_first: false,
         },
         &mut |_| {},
     )?;

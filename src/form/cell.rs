@@ -1,0 +1,562 @@
+//! The periodic cell of a plain weave: forming a patch of any size by forming one cell.
+//!
+//! A plain weave whose yarn centre lines lie at x = x₀ + ip and y = x₀ + jp is
+//! mirror-symmetric about every plane x = x₀ + ip and y = x₀ + jp: warp j follows
+//! ±(−1)^j a cos(π(x − x₀)/p), which x → 2(x₀ + ip) − x leaves unchanged, and the wefts
+//! are mapped onto wefts of the same sign. Under a uniform residual tension the formed
+//! weave keeps these symmetries about the same planes, each moved by the mean stretch:
+//! plane i by i·δ_x. The whole interior of a formed patch is therefore the fundamental
+//! cell [x₀, x₀ + p]² — four half yarns (the halves of the bands towards the cell), four
+//! quarter crossings — reflected over and over, and a yarn end at a patch edge is a cut
+//! through that periodic state, where the formed patch holds it.
+//!
+//! So the cell is formed alone, with symmetry planes on its four sides: the planes
+//! x = x₀ and y = x₀ stay, the planes x = x₀ + p and y = x₀ + p are moved by δ_x, δ_y (an
+//! initial displacement that their symmetry condition keeps), and δ is found (secant
+//! with a bracket, each family on its own) so that the force across each moved plane —
+//! the reaction Σ −(f_int + f_contact) of its nodes, the stress resultant that the cut
+//! yarns carry — equals the residual tension times the layers. Each evaluation is a
+//! dynamic relaxation of the cell ([`crate::solver::relax`]) from the last one, shifted
+//! affinely by the change of δ. One node per layer, the warp's centre line at mid-span
+//! x₀ + p/2, is held in z: the cell's rigid z translation is otherwise free, and that
+//! point lies on the cell's two-fold axis (x, z) → (2x₀ + p − x, −z) about its layer's
+//! mid-plane, so the symmetric equilibrium needs no force there.
+//!
+//! The patch's displacement is then the cell's, reflected: with k = ⌊(x − x₀)/p⌋ and
+//! r = x − x₀ − kp, a node takes the cell's node at r (k even) or p − r (k odd), the
+//! displacement along x sign-flipped for odd k, plus (K + x₀/p)·δ_x with K = k (even) or
+//! k + 1 (odd) — the planes passed counted from the patch's centre x = 0, which stays;
+//! likewise along y; u_z unchanged. Cost: the 60 × 60 quarter's 85 562 nodes take
+//! the state of a cell of 40, instead of a relaxation whose slow drum mode did not settle
+//! in 18 min on 2 cores.
+
+use crate::error::{Result, WeftError};
+use crate::model::contacts::{InitialPenetration, Slave};
+use crate::model::{ElementKind, Model, Part, SymmetryPlane};
+use crate::solver::relax::{RelaxOptions, RelaxStats};
+use crate::solver::Solver;
+
+use super::{family, Params};
+
+/// Largest number of relaxations of the cell while its planes are moved to the tension.
+const ROUNDS: usize = 40;
+
+/// The fundamental cell of a woven patch, as a model of its own.
+#[derive(Debug, Clone)]
+pub struct Cell {
+    /// The cell: the yarn quads within [x₀, x₀ + p]², symmetry planes on its four sides,
+    /// its contacts, one node per layer held in z.
+    pub model: Model,
+    /// The patch's node of each cell node.
+    pub patch_node: Vec<usize>,
+    /// The patch's part of each cell part.
+    pub patch_part: Vec<usize>,
+    /// Yarn spacing p and the first yarn centre line x₀ (0 for a quarter patch) [m].
+    pub spacing: f64,
+    pub origin: f64,
+    /// Cell nodes on the moved planes x = x₀ + p (0) and y = x₀ + p (1), and on the
+    /// fixed planes x = x₀, y = x₀.
+    pub planes: [Vec<usize>; 2],
+    pub fixed_planes: [Vec<usize>; 2],
+    /// The nodes held in z (one per layer, on the two-fold axis).
+    pub axis_nodes: Vec<usize>,
+    pub layers: usize,
+}
+
+/// A formed cell.
+#[derive(Debug, Clone)]
+pub struct CellForm {
+    /// Displacement of each cell node from its reference position [m].
+    pub u: Vec<[f64; 3]>,
+    /// The planes' displacement δ_x, δ_y [m] (the mean stretch times p).
+    pub stretch: [f64; 2],
+    /// Force across the moved planes per yarn and layer, warp and weft [N] ...
+    pub tension: [f64; 2],
+    /// ... across the fixed planes (the cell's balance: the same) ...
+    pub fixed_tension: [f64; 2],
+    /// ... and the largest force the z-held nodes on the two-fold axes need (0 by
+    /// symmetry) [N].
+    pub axis_reaction: f64,
+    /// Relaxations of the cell and their steps (summed), the energy they removed and the
+    /// last one's statistics.
+    pub rounds: usize,
+    pub steps: u64,
+    pub work: f64,
+    pub last: RelaxStats,
+}
+
+/// Whether `c` is within `tol` of a multiple of `p` from `x0` in [x0, x0 + p].
+fn in_cell(c: f64, x0: f64, p: f64, tol: f64) -> bool {
+    c >= x0 - tol && c <= x0 + p + tol
+}
+
+/// The cell of the woven patch `m` (from `weft-weave woven`, a quarter or a full patch
+/// of at least two yarns per side beyond its first centre line).
+pub fn extract(m: &Model, spacing: f64) -> Result<Cell> {
+    let p = spacing;
+    let tol = 1e-6 * p;
+    let Some(quads) = m.elements.get(&ElementKind::Quad) else {
+        return Err(
+            WeftError::input("the model has no membrane quads: no yarns to form")
+                .hint("form a model from `weft-weave woven`"),
+        );
+    };
+    let yarn_quad = |e: usize| family(m, quads.part[e]).is_some();
+    // x₀: the first warp centre line at y ≥ its smallest coordinate: a quarter patch's
+    // warp 0 lies on y = 0, a full patch's first on (−N/2 + ½)p. The crossing nodes of
+    // `axis_x` give the wefts' centre lines (x); the warps' are the same by symmetry.
+    let mut lo = f64::INFINITY;
+    let mut hi = f64::NEG_INFINITY;
+    for e in (0..quads.len()).filter(|&e| yarn_quad(e)) {
+        for &n in &quads.nodes[4 * e..4 * e + 4] {
+            lo = lo.min(m.coords[n][0]);
+            hi = hi.max(m.coords[n][0]);
+        }
+    }
+    let axis = m.node_sets.get("axis_x").cloned().unwrap_or_default();
+    let x0 = axis
+        .iter()
+        .map(|&n| m.coords[n][0])
+        .filter(|&x| x >= lo - tol)
+        .fold(f64::INFINITY, f64::min);
+    if !x0.is_finite() || hi < x0 + p - tol {
+        return Err(WeftError::input(format!(
+            "the patch's yarns reach x = {hi:e} m from their first centre line x₀ = {x0:e} m"
+        ))
+        .expected(format!(
+            "at least one spacing p = {p:e} m beyond x₀: the periodic cell [x₀, x₀ + p]² must lie inside the patch"
+        ))
+        .hint("form patches of at least 2 yarns per side with the cell, or use --start geometry"));
+    }
+    // Cell nodes: of yarn quads, within the cell.
+    let mut keep = vec![false; m.num_nodes()];
+    for e in (0..quads.len()).filter(|&e| yarn_quad(e)) {
+        for &n in &quads.nodes[4 * e..4 * e + 4] {
+            let c = m.coords[n];
+            if in_cell(c[0], x0, p, tol) && in_cell(c[1], x0, p, tol) {
+                keep[n] = true;
+            }
+        }
+    }
+    let mut cell = Model {
+        analysis: m.analysis.clone(),
+        ..Default::default()
+    };
+    cell.analysis.history_sets.clear();
+    let mut index = vec![usize::MAX; m.num_nodes()];
+    let mut patch_node = vec![];
+    for n in (0..m.num_nodes()).filter(|&n| keep[n]) {
+        index[n] = cell.add_node(m.node_id[n], m.coords[n]);
+        patch_node.push(n);
+    }
+    let mut part_index = vec![usize::MAX; m.parts.len()];
+    let mut patch_part = vec![];
+    for e in (0..quads.len()).filter(|&e| yarn_quad(e)) {
+        let ns = &quads.nodes[4 * e..4 * e + 4];
+        if !ns.iter().all(|&n| keep[n]) {
+            continue;
+        }
+        let pi = quads.part[e];
+        if part_index[pi] == usize::MAX {
+            let Part {
+                id,
+                name,
+                kind,
+                props,
+            } = m.parts[pi].clone();
+            part_index[pi] = cell.add_part(id, &name, kind, props);
+            patch_part.push(pi);
+        }
+        let local: Vec<usize> = ns.iter().map(|&n| index[n]).collect();
+        if quads.thickness.is_empty() {
+            cell.add_element(quads.id[e], part_index[pi], &local);
+        } else {
+            cell.add_element_with_thickness(
+                quads.id[e],
+                part_index[pi],
+                &local,
+                &quads.thickness[4 * e..4 * e + 4],
+            );
+        }
+    }
+    // A node within the cell that no cell quad holds (a band edge beyond a cut) would
+    // carry no mass.
+    let mut held = vec![false; cell.num_nodes()];
+    if let Some(b) = cell.elements.get(&ElementKind::Quad) {
+        for &n in &b.nodes {
+            held[n] = true;
+        }
+    }
+    if let Some(n) = (0..cell.num_nodes()).find(|&n| !held[n]) {
+        let c = cell.coords[n];
+        return Err(WeftError::input(format!(
+            "node `{}` at ({:e}, {:e}, {:e}) m lies in the periodic cell but in none of its quads",
+            cell.node_id[n], c[0], c[1], c[2]
+        ))
+        .expected("yarn bands whose quads end on the cell's planes (an even number of quads across and per spacing)")
+        .hint("generate the patch with `weft-weave woven`, or use --start geometry"));
+    }
+    for d in &m.contacts {
+        let slave = match d.slave {
+            Slave::Part(s) if part_index[s] != usize::MAX => Slave::Part(part_index[s]),
+            _ => continue,
+        };
+        if part_index[d.master] == usize::MAX {
+            continue;
+        }
+        let mut c = d.clone();
+        c.slave = slave;
+        c.master = part_index[d.master];
+        c.initial_penetration = InitialPenetration::Keep;
+        cell.contacts.push(c);
+    }
+    for normal in [0, 1] {
+        for position in [x0, x0 + p] {
+            cell.symmetry.push(SymmetryPlane {
+                normal,
+                position,
+                tolerance: tol,
+            });
+        }
+    }
+    let on = |d: usize, at: f64| {
+        (0..cell.num_nodes())
+            .filter(|&n| (cell.coords[n][d] - at).abs() <= tol)
+            .collect::<Vec<_>>()
+    };
+    let planes = [0, 1].map(|d| on(d, x0 + p));
+    let fixed_planes = [0, 1].map(|d| on(d, x0));
+    // One node per layer held in z: the warp's centre line at mid-span (on the cell's
+    // two-fold axis). Warp parts are named warp_<layer>.
+    let mut layers = 0;
+    let mut axis_nodes = vec![];
+    for (ci, &pi) in patch_part.iter().enumerate() {
+        if family(m, pi) != Some(0) {
+            continue;
+        }
+        layers += 1;
+        let b = &cell.elements[&ElementKind::Quad];
+        let pick = (0..b.len())
+            .filter(|&e| b.part[e] == ci)
+            .flat_map(|e| b.nodes[4 * e..4 * e + 4].to_vec())
+            .min_by(|&a, &b| {
+                let da =
+                    (cell.coords[a][0] - (x0 + 0.5 * p)).abs() + (cell.coords[a][1] - x0).abs();
+                let db =
+                    (cell.coords[b][0] - (x0 + 0.5 * p)).abs() + (cell.coords[b][1] - x0).abs();
+                da.total_cmp(&db).then(a.cmp(&b))
+            });
+        if let Some(n) = pick {
+            cell.constraints.push((n, [false, false, true]));
+            axis_nodes.push(n);
+        }
+    }
+    if layers == 0 || cell.contacts.is_empty() {
+        return Err(WeftError::input(
+            "the periodic cell holds no warp band or no contact between its yarns",
+        )
+        .hint("form a model from `weft-weave woven`"));
+    }
+    cell.validate()?;
+    Ok(Cell {
+        model: cell,
+        patch_node,
+        patch_part,
+        spacing: p,
+        origin: x0,
+        planes,
+        fixed_planes,
+        axis_nodes,
+        layers,
+    })
+}
+
+/// The cell's balance at the solver's state (its contacts evaluated there): the force
+/// across the moved planes and across the fixed ones, per yarn and layer — Σ −(f_int +
+/// f_contact) along the normal over the moved plane's nodes, Σ (f_int + f_contact) over
+/// the fixed plane's (the reactions its symmetry condition supplies) [N] — and the
+/// largest z force on the nodes held on the two-fold axes [N].
+fn balance(cell: &Cell, solver: &mut Solver) -> ([f64; 2], [f64; 2], f64) {
+    let fi = solver.internal_forces();
+    let fc = &solver.op.fcon;
+    let has_fc = solver.op.has_fcon();
+    let f = |n: usize, d: usize| fi[n][d] + if has_fc { fc[n][d] } else { 0.0 };
+    let per = cell.layers as f64;
+    let moved = [0, 1].map(|d| -cell.planes[d].iter().map(|&n| f(n, d)).sum::<f64>() / per);
+    let fixed = [0, 1].map(|d| cell.fixed_planes[d].iter().map(|&n| f(n, d)).sum::<f64>() / per);
+    let axis = cell
+        .axis_nodes
+        .iter()
+        .map(|&n| f(n, 2).abs())
+        .fold(0.0, f64::max);
+    (moved, fixed, axis)
+}
+
+/// Form the cell: relax it with its planes moved until the force across each is the
+/// residual tension (to `tolerance`, relative).
+pub fn form(
+    cell: &Cell,
+    p: &Params,
+    tolerance: f64,
+    progress: &mut dyn FnMut(&RelaxStats),
+) -> Result<CellForm> {
+    let tension = [p.warp_tension, p.weft_tension];
+    if tension.iter().any(|&t| !(t > 0.0)) {
+        return Err(WeftError::input(format!(
+            "a residual tension of {} / {} N per warp / weft yarn with the periodic cell",
+            tension[0], tension[1]
+        ))
+        .expected("tensions > 0: the cell's planes are moved until the yarns carry them")
+        .hint("use --start geometry for a weave without tension"));
+    }
+    let pp = cell.spacing;
+    let mut model = cell.model.clone();
+    for c in &mut model.contacts {
+        if !p.friction {
+            c.static_friction = 0.0;
+            c.dynamic_friction = 0.0;
+        }
+    }
+    let t_max = model
+        .elements
+        .get(&ElementKind::Quad)
+        .map(|b| b.thickness.iter().cloned().fold(0.0, f64::max))
+        .unwrap_or(0.0);
+    // The first guess: the cell stretched so that the warp's centre line, of the
+    // generated path length, runs straight between crossings at ±a (a the generated
+    // amplitude): δ = p (L/L_straight − 1).
+    let guess = |d: usize| -> f64 {
+        let fam_line: Vec<usize> = {
+            let mut v: Vec<usize> = (0..model.num_nodes())
+                .filter(|&n| (model.coords[n][1 - d] - cell.origin).abs() <= 1e-6 * pp)
+                .filter(|&n| {
+                    let b = &model.elements[&ElementKind::Quad];
+                    (0..b.len()).any(|e| {
+                        family(&model, b.part[e]) == Some(d)
+                            && b.nodes[4 * e..4 * e + 4].contains(&n)
+                    })
+                })
+                .collect();
+            v.sort_by(|&a, &b| model.coords[a][d].total_cmp(&model.coords[b][d]));
+            v
+        };
+        if fam_line.len() < 2 {
+            return 1e-3 * pp;
+        }
+        let x = &model.coords;
+        let len: f64 = fam_line
+            .windows(2)
+            .map(|w| {
+                let e = [0, 1, 2].map(|k| x[w[1]][k] - x[w[0]][k]);
+                (e[0] * e[0] + e[1] * e[1] + e[2] * e[2]).sqrt()
+            })
+            .sum();
+        let z: Vec<f64> = fam_line.iter().map(|&n| x[n][2]).collect();
+        let a = 0.5
+            * (z.iter().cloned().fold(f64::NEG_INFINITY, f64::max)
+                - z.iter().cloned().fold(f64::INFINITY, f64::min));
+        let straight = pp * (1.0 + (2.0 * a / pp).powi(2)).sqrt();
+        (pp * (len / straight - 1.0)).max(0.0)
+    };
+    let mut delta = [guess(0), guess(1)];
+    let mut u: Vec<[f64; 3]> = model
+        .coords
+        .iter()
+        .map(|c| {
+            [
+                delta[0] * (c[0] - cell.origin) / pp,
+                delta[1] * (c[1] - cell.origin) / pp,
+                0.0,
+            ]
+        })
+        .collect();
+    // Per family: the bracket (δ with force below, δ with force above) and the last
+    // evaluation, for the secant.
+    let mut below: [Option<(f64, f64)>; 2] = [None, None];
+    let mut above: [Option<(f64, f64)>; 2] = [None, None];
+    let mut last: [Option<(f64, f64)>; 2] = [None, None];
+    let (mut steps, mut work) = (0u64, 0.0f64);
+    let mut forces = [f64::NAN; 2];
+    for round in 1..=ROUNDS {
+        model.initial_displacement = u.clone();
+        let mut solver = Solver::new(&model)?;
+        let opts = RelaxOptions {
+            max_steps: p.max_steps,
+            min_steps: p.min_steps.min(p.max_steps),
+            check_every: p.check_every,
+            alpha: p.damping,
+            kinetic_tolerance: p.kinetic_tolerance,
+            force_tolerance: p.force_tolerance,
+            force_scale: tension[0].max(tension[1]),
+            creep_window: ((p.creep_time / (solver.stable.dt / (1.0 + p.damping).sqrt())).ceil()
+                as u64)
+                .max(1),
+            creep_tolerance: p.creep_tolerance * t_max,
+            work_offset: work,
+            contact_damping: p.contact_damping,
+            hold_in_rest_test: vec![],
+            probe_first: false,
+        };
+        let st = solver.relax(&opts, progress)?;
+        steps += st.steps;
+        work += st.removed;
+        if !st.converged {
+            return Err(WeftError::input(format!(
+                "the periodic cell did not reach equilibrium in {} steps (round {round}, planes moved {:.4e} / {:.4e} m): kinetic energy {:.2e} J, largest residual force {:.3e} N on node `{}` against contact forces up to {:.3e} N",
+                st.steps, delta[0], delta[1], st.kinetic, st.residual, model.node_id[st.residual_node], st.contact_force
+            ))
+            .hint("raise --max-steps, or loosen --kinetic-tolerance / --force-tolerance"));
+        }
+        let (moved, fixed, axis) = balance(cell, &mut solver);
+        forces = moved;
+        u = solver
+            .state
+            .x
+            .iter()
+            .zip(&model.coords)
+            .map(|(a, b)| [a[0] - b[0], a[1] - b[1], a[2] - b[2]])
+            .collect();
+        let off = (0..2)
+            .map(|f| (forces[f] / tension[f] - 1.0).abs())
+            .fold(0.0, f64::max);
+        if off <= tolerance {
+            return Ok(CellForm {
+                u,
+                stretch: delta,
+                tension: forces,
+                fixed_tension: fixed,
+                axis_reaction: axis,
+                rounds: round,
+                steps,
+                work,
+                last: st,
+            });
+        }
+        // Next δ per family: secant through the last two evaluations, kept inside the
+        // bracket once there is one (bisection when it leaves it); before a bracket,
+        // steps of p/1000 (the de-crimping compliance: 0.5 N moves a plane ~1 µm).
+        let mut next = delta;
+        for f in 0..2 {
+            let (d, r) = (delta[f], forces[f]);
+            if (r / tension[f] - 1.0).abs() <= tolerance {
+                continue;
+            }
+            if r < tension[f] {
+                below[f] = Some((d, r));
+            } else {
+                above[f] = Some((d, r));
+            }
+            let mut cand = match last[f] {
+                Some((d1, r1)) if (r - r1).abs() > 1e-12 * tension[f] && d != d1 => {
+                    d + (tension[f] - r) * (d - d1) / (r - r1)
+                }
+                _ => {
+                    if r < tension[f] {
+                        d + 1e-3 * pp
+                    } else {
+                        d - 1e-3 * pp
+                    }
+                }
+            };
+            if let (Some((dl, _)), Some((dh, _))) = (below[f], above[f]) {
+                let (a, b) = (dl.min(dh), dl.max(dh));
+                if !(cand > a && cand < b) {
+                    cand = 0.5 * (a + b);
+                }
+            }
+            last[f] = Some((d, r));
+            next[f] = cand;
+        }
+        for (n, c) in model.coords.iter().enumerate() {
+            for f in 0..2 {
+                u[n][f] += (next[f] - delta[f]) * (c[f] - cell.origin) / pp;
+            }
+        }
+        delta = next;
+    }
+    Err(WeftError::input(format!(
+        "the periodic cell's planes, moved {:.4e} / {:.4e} m, give {:.4} / {:.4} N per warp / weft yarn after {ROUNDS} relaxations",
+        delta[0], delta[1], forces[0], forces[1]
+    ))
+    .expected(format!(
+        "the residual tension {} / {} N to {:.1e}",
+        tension[0], tension[1], tolerance
+    ))
+    .hint("use --start geometry"))
+}
+
+/// The patch's displacement from the formed cell (see the module docs): the cell
+/// reflected over the patch, plus the planes' stretch. Nodes that are not in a yarn
+/// (a membrane around the patch) get none.
+pub fn tile(m: &Model, cell: &Cell, f: &CellForm) -> Result<Vec<[f64; 3]>> {
+    let p = cell.spacing;
+    let q = 1e-6 * p;
+    let key = |part: usize, x: f64, y: f64| (part, (x / q).round() as i64, (y / q).round() as i64);
+    let mut index: std::collections::HashMap<(usize, i64, i64), usize> = Default::default();
+    let cm = &cell.model;
+    if let Some(b) = cm.elements.get(&ElementKind::Quad) {
+        for e in 0..b.len() {
+            for &n in &b.nodes[4 * e..4 * e + 4] {
+                let c = cm.coords[n];
+                index.insert(key(cell.patch_part[b.part[e]], c[0], c[1]), n);
+            }
+        }
+    }
+    // Fold a coordinate into the cell: (folded, sign of the displacement, planes passed).
+    let fold = |c: f64| -> (f64, f64, f64) {
+        let s = (c - cell.origin) / p;
+        let k = (s + 1e-9).floor();
+        let r = ((s - k) * p).max(0.0);
+        if (k as i64).rem_euclid(2) == 0 {
+            (cell.origin + r, 1.0, k)
+        } else {
+            (cell.origin + p - r, -1.0, k + 1.0)
+        }
+    };
+    let mut u = vec![[0.0; 3]; m.num_nodes()];
+    let mut done = vec![false; m.num_nodes()];
+    let Some(b) = m.elements.get(&ElementKind::Quad) else {
+        return Ok(u);
+    };
+    for e in 0..b.len() {
+        if family(m, b.part[e]).is_none() {
+            continue;
+        }
+        for &n in &b.nodes[4 * e..4 * e + 4] {
+            if done[n] {
+                continue;
+            }
+            let c = m.coords[n];
+            let (x, sx, kx) = fold(c[0]);
+            let (y, sy, ky) = fold(c[1]);
+            let Some(&k) = index.get(&key(b.part[e], x, y)) else {
+                return Err(WeftError::input(format!(
+                    "node `{}` ({}, at x = {:e}, y = {:e} m) has no counterpart at x = {x:e}, y = {y:e} m in the periodic cell",
+                    m.node_id[n], m.parts[b.part[e]].name, c[0], c[1]
+                ))
+                .expected("a plain weave whose mesh repeats at every yarn (as `weft-weave woven` builds it)")
+                .hint("use --start geometry"));
+            };
+            if (cm.coords[k][2] - c[2]).abs() > 1e-6 * p {
+                return Err(WeftError::input(format!(
+                    "node `{}` ({}, at z = {:e} m) reflects onto cell node `{}` at z = {:e} m",
+                    m.node_id[n], m.parts[b.part[e]].name, c[2], cm.node_id[k], cm.coords[k][2]
+                ))
+                .expected("a plain weave symmetric about every yarn's centre line")
+                .hint("use --start geometry"));
+            }
+            // Planes passed, counted from the patch's centre x = y = 0 rather than from
+            // x₀ (the same for a quarter patch; a full patch, x₀ = −(N − 1)p/2, keeps its
+            // centre where it is).
+            let uc = f.u[k];
+            let from_centre = cell.origin / p;
+            u[n] = [
+                sx * uc[0] + (kx + from_centre) * f.stretch[0],
+                sy * uc[1] + (ky + from_centre) * f.stretch[1],
+                uc[2],
+            ];
+            done[n] = true;
+        }
+    }
+    Ok(u)
+}
