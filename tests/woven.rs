@@ -208,6 +208,15 @@ fn impossible_geometry_is_refused_with_the_parameter_named() {
         },
         "--layer-gap",
     );
+    for f in [0.0, 1.2, f64::NAN] {
+        bad(
+            WovenBandParams {
+                dt_safety: f,
+                ..d()
+            },
+            "--dt-safety",
+        );
+    }
 }
 
 /// A straight band of the default section along x on ±half, ends pinned, every node held
