@@ -781,6 +781,8 @@ pub struct PulseConfig {
     pub velocity: f64,
     /// Only nodes in this box: XMIN,XMAX,YMIN,YMAX,ZMIN,ZMAX [m].
     pub within: Option<String>,
+    /// Drop a formed model's formed state (initial displacements and stresses) first.
+    pub unformed: bool,
     pub out: PathBuf,
 }
 
@@ -806,6 +808,29 @@ pub fn run_pulse(c: &PulseConfig) -> Result<usize> {
         },
     };
     let mut m = read_model(&c.model)?;
+    let stressed = m
+        .elements
+        .values()
+        .any(|b| b.stress0.iter().any(|s| *s != [0.0; 3]));
+    if !m.initial_displacement.is_empty() || stressed {
+        if !c.unformed {
+            return Err(WeftError::input(format!(
+                "`{}` is a formed model (initial displacements or stresses)",
+                c.model.display()
+            ))
+            .expected("a model without a pre-stressed state: a region's energy would hold the pre-stress's first-order work, as large as a small pulse's energy")
+            .hint("add --unformed to start the pulse from the model's reference geometry"));
+        }
+        // As `weft-weave` built it: the geometry's small initial overlaps tracked, not
+        // pushed apart (a formed model's contacts act on its overlaps from the start).
+        m.initial_displacement.clear();
+        for b in m.elements.values_mut() {
+            b.stress0.clear();
+        }
+        for d in &mut m.contacts {
+            d.initial_penetration = crate::model::contacts::InitialPenetration::Track;
+        }
+    }
     let n = launch_pulse(&mut m, &c.parts, axis, c.from, c.to, c.velocity, within)?;
     let prov = Provenance::new("pulse", serde_json::to_value(c).expect("config serialises"));
     write_model(&m, &c.out, &prov)?;

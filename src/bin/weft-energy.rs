@@ -118,6 +118,13 @@ struct PulseArgs {
     /// [m] (inf allowed), e.g. the yarns of a reference's inner patch only.
     #[arg(long)]
     within: Option<String>,
+    /// Start the pulse from the model's reference geometry, its formed state (initial
+    /// displacements and stresses, `weft-form`) dropped. A formed model is refused
+    /// without it: the energy of a region of a pre-stressed model holds the pre-stress's
+    /// first-order work, as large as a small pulse's energy, which `measure` cannot tell
+    /// apart from the pulse's.
+    #[arg(long)]
+    unformed: bool,
     /// Output model folder.
     #[arg(long)]
     out: PathBuf,
@@ -169,6 +176,7 @@ fn run() -> anyhow::Result<ExitCode> {
                 to: a.to,
                 velocity: a.velocity,
                 within: a.within,
+                unformed: a.unformed,
                 out: a.out.clone(),
             })?;
             eprintln!(
