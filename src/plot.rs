@@ -16,6 +16,7 @@ use anyhow::Context as _;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
+use crate::analysis::interp::interpolation;
 use crate::analysis::{components, read_nodes};
 use crate::error::{Result, WeftError};
 use crate::model::io::read_model;
@@ -93,6 +94,10 @@ pub struct HistoryFigure {
     pub component: String,
     /// Position matching tolerance across models [m].
     pub tolerance: f64,
+    /// The other models read at the chosen positions through their elements' shape
+    /// functions (a coarser mesh, a membrane beyond a tied interface) instead of a node
+    /// within `tolerance` (which then bounds the distance to an element).
+    pub interpolate: bool,
 }
 
 /// Wave speeds along a line, one series per wavespeeds.parquet.
@@ -327,6 +332,28 @@ fn history(a: &HistoryFigure) -> Result<Chart> {
     let mut raw: Vec<(String, Vec<(String, Vec<(f64, f64)>)>)> = vec![];
     for (k, (m, h)) in a.model.iter().zip(&a.history).enumerate() {
         let model = read_model(m)?;
+        if k > 0 && a.interpolate {
+            // Each chosen position read through the element of this model that holds it.
+            let (read, pairs) = interpolation(&model, None, &positions, &ids, a.tolerance)
+                .map_err(|e| e.context(format!("model `{}`", m.display())))?;
+            // `pairs` index the nodes read, in the order read.
+            let s = read_nodes(&model, h, &read, "interpolated for the figure")?;
+            let lines = ids
+                .iter()
+                .zip(&pairs)
+                .map(|(id, w)| {
+                    (
+                        format!("node {id}"),
+                        s.t.iter()
+                            .zip(&s.values)
+                            .map(|(t, v)| (*t, w.iter().map(|&(j, wj)| wj * v[j][c]).sum()))
+                            .collect::<Vec<_>>(),
+                    )
+                })
+                .collect();
+            raw.push((label(&a.label, k, m), lines));
+            continue;
+        }
         // A one-off node set of the nodes nearest the chosen positions.
         let mut chosen = vec![];
         for (id, p) in ids.iter().zip(&positions) {
@@ -904,5 +931,115 @@ fn tick(v: f64) -> String {
         "0".into()
     } else {
         s.to_string()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::generate::grid::rectangle;
+    use crate::model::io::write_model;
+    use crate::model::{ElementKind, Model, PartProps};
+    use crate::table::{batch, write_table, Col, Provenance};
+
+    /// A square [0, 1]² of `n` × `n` quads, node ids from 1, and its history.parquet with
+    /// u_x(t, x, y) = t·(x + 2y) at t = 0, 1, 2 (the other components 0).
+    fn square(dir: &Path, n: usize) -> (PathBuf, PathBuf) {
+        let mut m = Model::default();
+        let (nodes, elems) = rectangle(n, n, 1.0, 1.0, ElementKind::Quad);
+        for (i, x) in nodes.iter().enumerate() {
+            m.add_node(i as i64 + 1, *x);
+        }
+        let part = m.add_part(
+            1,
+            "sheet",
+            ElementKind::Quad,
+            PartProps {
+                youngs_modulus_1: Some(1e9),
+                youngs_modulus_2: Some(1e9),
+                poisson_ratio_12: Some(0.3),
+                shear_modulus_12: Some(4e8),
+                thickness: Some(1e-3),
+                density: Some(1e3),
+                ..Default::default()
+            },
+        );
+        for (e, ns) in elems.iter().enumerate() {
+            m.add_element(e as i64 + 1, part, ns);
+        }
+        let prov = Provenance::new("test", serde_json::json!({}));
+        let folder = dir.join(format!("m{n}"));
+        write_model(&m, &folder, &prov).unwrap();
+        let (mut t, mut id, mut ux) = (vec![], vec![], vec![]);
+        for k in 0..3 {
+            for (i, x) in nodes.iter().enumerate() {
+                t.push(k as f64);
+                id.push(i as i64 + 1);
+                ux.push(k as f64 * (x[0] + 2.0 * x[1]));
+            }
+        }
+        let zero = vec![0.0; t.len()];
+        let h = dir.join(format!("h{n}.parquet"));
+        let b = batch(vec![
+            Col::F64("t", t),
+            Col::I64("node_id", id),
+            Col::F64("ux", ux),
+            Col::F64("uy", zero.clone()),
+            Col::F64("uz", zero.clone()),
+            Col::F64("vx", zero.clone()),
+            Col::F64("vy", zero.clone()),
+            Col::F64("vz", zero),
+        ]);
+        write_table(&h, &b, &prov).unwrap();
+        (folder, h)
+    }
+
+    /// `--interpolate` reads a coarser mesh at the fine nodes through its bilinear shape
+    /// functions, which reproduce a field linear in x and y exactly (the patch test of
+    /// the bilinear quad, e.g. Zienkiewicz & Taylor, *The Finite Element Method*, vol. 1,
+    /// §9.4): the coarse model's lines equal the fine model's at nodes the coarse mesh
+    /// does not have, to round-off. Without it, those positions have no coarse node.
+    #[test]
+    fn interpolated_lines_reproduce_a_linear_field() {
+        let dir = tempfile::tempdir().unwrap();
+        let (fine, hf) = square(dir.path(), 4);
+        let (coarse, hc) = square(dir.path(), 2);
+        // Fine nodes 2 (0.25, 0), 7 (0.25, 0.25) and 13 (0.5, 0.5): only the last is a
+        // coarse node; given in this order so that the coarse nodes read are not in
+        // the order of the chosen positions (the pairing indexes the nodes read).
+        let mut fig = HistoryFigure {
+            model: vec![fine, coarse],
+            history: vec![hf, hc],
+            label: vec!["fine".into(), "coarse".into()],
+            nodes: Some("13,7,2".into()),
+            set: None,
+            component: "ux".into(),
+            tolerance: 1e-9,
+            interpolate: true,
+        };
+        let chart = history(&fig).unwrap();
+        assert_eq!(chart.series.len(), 6);
+        for j in 0..3 {
+            let (f, c) = (&chart.series[j], &chart.series[3 + j]);
+            assert_eq!(f.label.split(", ").nth(1), c.label.split(", ").nth(1));
+            assert_eq!(f.points.len(), 3);
+            for (p, q) in f.points.iter().zip(&c.points) {
+                assert_eq!(p.0, q.0);
+                // Measured: 0 (the weights are exact binary fractions here).
+                assert!(
+                    (p.1 - q.1).abs() <= 1e-12 * p.1.abs().max(1.0),
+                    "{p:?} vs {q:?}"
+                );
+            }
+        }
+        // The fine lines themselves: t·(x + 2y) at t = 2 for node 7 (0.25, 0.25): 1.5,
+        // scaled by the same unit factor as the others (max |u| = 3 m: factor 1).
+        assert!((chart.series[1].points[2].1 - 1.5).abs() < 1e-12);
+        fig.interpolate = false;
+        let e = match history(&fig) {
+            Ok(_) => panic!("positions without a coarse node were read"),
+            Err(e) => e.to_string(),
+        };
+        assert!(e.contains("no node at the position of node 7"), "{e}");
     }
 }

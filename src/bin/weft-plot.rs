@@ -173,6 +173,11 @@ struct HistoryArgs {
     /// Position matching tolerance across models [m].
     #[arg(long, default_value_t = 1e-9)]
     tolerance: f64,
+    /// Read the other models at the nodes' positions through their elements' shape
+    /// functions (a membrane beyond a tied interface, a coarser mesh); --tolerance then
+    /// bounds a position's distance from the element.
+    #[arg(long)]
+    interpolate: bool,
     #[command(flatten)]
     common: Common,
 }
@@ -291,6 +296,7 @@ fn run() -> anyhow::Result<()> {
                 set: a.set,
                 component: a.component,
                 tolerance: a.tolerance,
+                interpolate: a.interpolate,
             }),
             a.common,
         ),
