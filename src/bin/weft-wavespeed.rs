@@ -17,7 +17,7 @@ use weft::analysis::wavespeed;
                   node's own peak (--relative-level, for a clean single pulse only). The incident front only: from \
                   the node reached first, arrival times must not decrease outwards along the line; the first node \
                   where one does, and every node beyond, count as not reached (a later crossing is a reflection). \
-                  Then the speed of each segment Δx/Δt, and each node's speed as the mean of its two segments. Speeds \
+                  Then the speed of each segment Δx/Δt, and each node's speed over its two segments together, (x₊ − x₋)/(t₊ − t₋) (an offset that alternates from node to node, as on a crimped yarn's crossings, cancels). Speeds \
                   are signed: positive when the wave runs in the set's order. Nodes the incident front does not \
                   reach are kept, with null times and speeds.\n\nExample:\n  weft-wavespeed --model runs/rod --history runs/rod-out/history.parquet \
                   --set axis_x --component vx --relative-level 0.5 --out runs/rod-out/wavespeeds.parquet"
