@@ -300,9 +300,9 @@ fn woven_reduced_study_fits_the_girder_to_the_yarn_level_patch() {
 /// The §3 pipeline (`pipelines/woven_membrane.toml`) made small: a 4-yarn patch in a
 /// membrane against the 10-yarn patch of the same size, 5 µs. Expectations that do not
 /// come from the code: the membrane's fit starts from ratios 2–3 × off the paper's and
-/// COBYLA keeps its best point, so the fitted T is below the start's; the fitted
-/// membrane's in-plane front runs within the paper's reported speed difference of the
-/// reference's; the combined model
+/// COBYLA keeps its best point, so the fitted T is below the start's; the in-plane fronts
+/// of the fitted membrane and of the reference run at the speeds lattice homogenisation
+/// gives (below); the combined model
 /// has fewer nodes than the reference (the point of the reduction, counted, not timed);
 /// the fitted membrane reflects less of a pulse than the start (below); every run's
 /// energy balance within 1 %; a second run does nothing.
@@ -314,14 +314,16 @@ fn woven_membrane_study_runs_small_and_the_fit_lowers_t() {
     let s = std::fs::read_to_string(&p)
         .unwrap()
         .replace("patch = 10", "patch = 4")
-        .replace("reference = 30", "reference = 10")
-        .replace("length = 0.0295", "length = 0.0095")
-        .replace("end_time = 2e-5", "end_time = 5e-6")
-        // Crossings at 1, 2, 3 mm (id 8k + 1).
-        .replace("nodes = \"33,49,65\"", "nodes = \"9,17,25\"")
+        .replace("reference = 60", "reference = 10")
+        .replace("length = 0.0595", "length = 0.0095")
+        .replace("end_time = 6e-5", "end_time = 5e-6")
+        .replace("interval = 5e-7", "interval = 5e-8")
+        .replace("field_interval = 1e-5", "field_interval = 2.5e-6")
+        // Crossings at 1, 2 | 4, 5 mm (id 8k + 1; the interface at 3.5 mm).
+        .replace("nodes = \"57,73,89,105\"", "nodes = \"9,17,33,41\"")
         .replace(
-            "--starts 4 --max-evaluations 40",
-            "--starts 2 --max-evaluations 10",
+            "--starts 4 --max-evaluations 30",
+            "--starts 2 --max-evaluations 30",
         )
         // The pulse from a 1 mm strip; its tail has passed the interface at 3.5 mm by
         // (3.5 + 1) mm / 6.8 km/s = 0.66 µs, the part reflected there is back at it from
@@ -373,21 +375,35 @@ fn woven_membrane_study_runs_small_and_the_fit_lowers_t() {
             .unwrap()[0]
     };
     assert!(nodes("combined") < nodes("reference"));
+    // The cost table gathers both impacts' summaries (one row each).
+    let cost = Table::read(&out.join("cost.parquet")).unwrap();
+    assert_eq!(cost.i64("nodes", "").unwrap().len(), 2);
     // The in-plane front beyond the interface (c = 3.5 mm) in the fitted membrane against
-    // the reference's at the same positions (the reference's node speeds interpolated
-    // linearly along the line). Left out: the first membrane node, 0.05 mm past the
-    // interface node (a segment crossed within one sample: no speed), and the last 2 mm
-    // before the clamped outer edge at 9.5 mm, which its reflection reaches first. The
-    // paper reports speed differences across its interface of up to about 20 % (§3);
-    // measured here: −33, −22, −9, +3 % at 4.1–6.8 mm, mean 17 %. (The transverse front
-    // does not get past the interface within this test's 5 µs.)
+    // the reference's at the same positions: the front's mean speed between the first and
+    // the last membrane node of 3.6–7.5 mm, Δx over the difference of the level's arrival
+    // times (the reference's arrival interpolated linearly along the line). Left out: the
+    // last 2 mm before the clamped outer edge at 9.5 mm, which its reflection reaches
+    // first. (Node by node the speeds scatter: the first membrane nodes take the patch
+    // ends' jolt. The transverse front does not get past the interface within 5 µs.)
+    //
+    // Oracles, from lattice homogenisation of the plain weave along a yarn direction: a
+    // long in-plane wave is carried by one family's stiffness E A/p per width and both
+    // families' mass 2ρA/p per area, c_L = c_y/√2 with c_y = √(E/ρ) of the yarn. A
+    // membrane that stands for the fabric runs at c_L (crimp lowers it: the straightening
+    // yarns are softer). Near the impact the reference's front runs faster, between c_L
+    // and c_y: the loaded yarns lead before their crossings' mass is dragged along. So:
+    // the reference's front within [c_L, c_y] (measured 6654 m/s = 0.89 c_y); the fitted
+    // membrane's within 15 % of c_L (measured 4799 m/s, −9 %; the full study's fit runs at
+    // √(E/ρ) = 4642 m/s, −12 %); their difference then at most 1 − 0.85/√2 = 40 %
+    // (measured −28 %; the paper's "up to about 20 %" is across its larger patch, where
+    // the full study measures ±14 % beyond 2 mm past the interface).
     let read = |m: &str| {
         let t = Table::read(&out.join(format!("wavespeed/{m}-ux.parquet"))).unwrap();
         let x = t.f64("position", "").unwrap();
-        let v = t.f64_opt("node_speed").unwrap().unwrap();
+        let a = t.f64_opt("arrival_time").unwrap().unwrap();
         x.into_iter()
-            .zip(v)
-            .filter_map(|(x, v)| v.map(|v| (x, v)))
+            .zip(a)
+            .filter_map(|(x, a)| a.map(|a| (x, a)))
             .collect::<Vec<_>>()
     };
     let (r, f) = (read("reference"), read("fitted"));
@@ -395,21 +411,34 @@ fn woven_membrane_study_runs_small_and_the_fit_lowers_t() {
         r.windows(2)
             .find(|w| w[0].0 <= x && x <= w[1].0)
             .map(|w| w[0].1 + (w[1].1 - w[0].1) * (x - w[0].0) / (w[1].0 - w[0].0))
+            .expect("the reference's front reaches the membrane's positions")
     };
-    let d: Vec<(f64, f64)> = f
+    let span: Vec<(f64, f64)> = f
         .iter()
+        .copied()
         .filter(|(x, _)| *x > 3.6e-3 && *x < 7.5e-3)
-        .filter_map(|&(x, v)| at(x).map(|vr| (x, v / vr - 1.0)))
         .collect();
-    eprintln!("in-plane front, fitted vs reference beyond the interface: {d:?}");
     assert!(
-        d.len() >= 3,
-        "the in-plane front reaches too few membrane nodes: {d:?}"
+        span.len() >= 3,
+        "the in-plane front reaches too few membrane nodes: {span:?}"
     );
-    let mean = d.iter().map(|(_, e)| e.abs()).sum::<f64>() / d.len() as f64;
+    let ((xa, ta), (xb, tb)) = (span[0], span[span.len() - 1]);
+    let (vf, vr) = ((xb - xa) / (tb - ta), (xb - xa) / (at(xb) - at(xa)));
+    let yarn = weft::generate::woven::WovenBandParams::default();
+    let c_y = (yarn.modulus / yarn.density).sqrt();
+    let c_l = c_y / 2f64.sqrt();
+    eprintln!(
+        "in-plane front over {:.2}–{:.2} mm: fitted {vf:.0} m/s, reference {vr:.0} m/s; c_L {c_l:.0}, c_y {c_y:.0}",
+        xa * 1e3,
+        xb * 1e3
+    );
     assert!(
-        mean < 0.25,
-        "mean |Δv|/v = {mean:.3} beyond the interface: {d:?}"
+        vr > c_l && vr < c_y,
+        "reference front {vr:.0} m/s outside [c_L, c_y] = [{c_l:.0}, {c_y:.0}]"
+    );
+    assert!(
+        (vf / c_l - 1.0).abs() < 0.15,
+        "fitted membrane's front {vf:.0} m/s vs the lattice's c_L = {c_l:.0} m/s"
     );
     for fig in [
         "uz_crossings.png",
