@@ -192,7 +192,7 @@ impl ElementResults {
                         d0: sub(nodes[0], nodes[1]),
                         k: [p.kx, p.ky, p.kz].map(|v| v.unwrap_or(0.0)),
                         c: [p.cx, p.cy, p.cz].map(|v| v.unwrap_or(0.0)),
-                        slider: p.slip_force.is_some(),
+                        slider: p.slip_force.is_some() || p.sliding == Some(true),
                     },
                     ElementKind::Tri => Item::Tri(Box::new(membrane_item(m, b, e, nodes)?)),
                     ElementKind::Quad => Item::Quad(Box::new(membrane_item(m, b, e, nodes)?)),

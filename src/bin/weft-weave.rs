@@ -19,6 +19,9 @@ enum LinkAxes {
     Global,
     /// The crossing's frame: warp direction, weft direction, their normal.
     Local,
+    /// The crossing's frame, its ends points of the two yarns that slide along them when
+    /// the link slips (the yarns slide across each other).
+    Sliding,
 }
 use weft::model::ProjectileShape;
 
@@ -297,8 +300,11 @@ struct WovenArgs {
     /// never pulls them together [default: two-way, as the paper's links].
     #[arg(long)]
     unilateral_links: bool,
-    /// Link axes: `global` (x, y, z, as the paper's links) or `local` (the crossing's two
-    /// yarn directions and their normal, following the fabric as it tilts).
+    /// Link axes: `global` (x, y, z, as the paper's links), `local` (the crossing's two
+    /// yarn directions and their normal, following the fabric as it tilts) or `sliding`
+    /// (local, and the link's ends are points of the yarns that move along them when the
+    /// link slips: the yarns slide across each other; give --link-friction or
+    /// --slip-force).
     #[arg(long, value_enum, default_value_t = LinkAxes::Global)]
     link_axes: LinkAxes,
     /// Membrane surround: its surface density over the woven patch's 2ρA/p [–] (the
@@ -617,6 +623,7 @@ fn run() -> anyhow::Result<ExitCode> {
                 friction: a.link_friction,
                 unilateral: a.unilateral_links,
                 local_frame: a.link_axes == LinkAxes::Local,
+                sliding: a.link_axes == LinkAxes::Sliding,
                 surround: SurroundParams {
                     density_ratio: a.membrane_density_ratio,
                     modulus_ratio: a.membrane_modulus_ratio,

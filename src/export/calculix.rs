@@ -87,6 +87,13 @@ fn check(m: &Model) -> Result<()> {
                     "CalculiX has no elastic-perfectly-plastic discrete element",
                 ));
             }
+            if p.sliding == Some(true) {
+                return Err(refuse(
+                    FORMAT,
+                    &format!("the sliding ends of link part `{}`", part.name),
+                    "a link whose ends move along its yarns has no discrete-element counterpart (it would be a contact between beams)",
+                ));
+            }
         }
     }
     if !m.projectiles.is_empty() {

@@ -54,6 +54,13 @@ fn check(m: &Model) -> Result<()> {
             {
                 return Err(refuse(FORMAT, &what("the prestrain or tension-only law"), "not mapped yet (LS-DYNA's cable, MAT_071, is a discrete beam with its own offset law)"));
             }
+            if *kind == ElementKind::Link && p.sliding == Some(true) {
+                return Err(refuse(
+                    FORMAT,
+                    &what("the sliding ends"),
+                    "a link whose ends move along its yarns has no discrete-element counterpart (it would be a contact between beams)",
+                ));
+            }
             if *kind == ElementKind::Link && p.slip_force.is_some() {
                 return Err(refuse(
                     FORMAT,

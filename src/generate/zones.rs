@@ -554,6 +554,9 @@ pub struct WovenParams {
     /// The links act in the crossing's local frame (the two yarn directions and their
     /// normal, following the fabric) instead of global x, y, z.
     pub local_frame: bool,
+    /// The links' ends slide along their yarns when the links slip
+    /// ([`crate::solver::sliding_link`]), in the frame of the yarns' tangents there.
+    pub sliding: bool,
     /// Whole model side [m], coarse membrane growth ratio, quarter symmetry.
     pub length: f64,
     pub growth: f64,
@@ -598,6 +601,7 @@ impl WovenParams {
             friction: None,
             unilateral: false,
             local_frame: false,
+            sliding: false,
             length: 0.1,
             growth: 1.25,
             quarter: true,
@@ -787,6 +791,7 @@ pub fn woven_reduced(p: &WovenParams) -> Result<Model> {
             friction: p.friction,
             unilateral: p.unilateral.then_some(true),
             local_frame: p.local_frame.then_some(true),
+            sliding: p.sliding.then_some(true),
             ..Default::default()
         },
     );
@@ -998,12 +1003,16 @@ fn relax_start(m: &mut Model, p: &WovenParams) -> Result<()> {
     }
     // A unilateral link found pulling at the equilibrium would let go at the start.
     if let Some(b) = m.block(ElementKind::Link) {
-        // The solver's two link families keep the table's order within each.
-        let (plain, framed) = (&solver.op.el.link, &solver.op.el.framed_link);
-        let (mut ip, mut ifr) = (0, 0);
+        // The solver's three link families keep the table's order within each.
+        let el = &solver.op.el;
+        let (plain, framed, sliding) = (&el.link, &el.framed_link, &el.sliding_link);
+        let (mut ip, mut ifr, mut isl) = (0, 0, 0);
         for e in 0..b.len() {
             let props = &m.parts[b.part[e]].props;
-            let f = if props.local_frame == Some(true) {
+            let f = if props.sliding == Some(true) {
+                isl += 1;
+                sliding.normal_spring_force(isl - 1, &solver.state.x)
+            } else if props.local_frame == Some(true) {
                 ifr += 1;
                 framed.normal_spring_force(ifr - 1, &solver.state.x)
             } else {

@@ -752,6 +752,7 @@ impl Model {
         }
         self.validate_nodal_thickness()?;
         self.validate_link_frames()?;
+        self.validate_sliding_links()?;
         contacts::validate(self)?;
         validate_analysis(&self.analysis)
     }
@@ -830,7 +831,144 @@ impl Model {
     }
 }
 
+/// A stretch of the yarn through a node: the chain of trusses through it, up to `half`
+/// nodes on each side (a sliding link's reach, [`crate::solver::sliding_link`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct YarnWindow {
+    /// Node indices in chain order.
+    pub nodes: Vec<usize>,
+    /// The node's position in `nodes`.
+    pub home: usize,
+    /// Whether the first and the last node of the window end the yarn (rather than the
+    /// window's reach).
+    pub ends: [bool; 2],
+}
+
 impl Model {
+    /// The truss neighbours of every node, in truss table order.
+    pub fn truss_neighbours(&self) -> Vec<Vec<usize>> {
+        let mut nb = vec![vec![]; self.coords.len()];
+        if let Some(b) = self.block(ElementKind::Truss) {
+            for e in 0..b.len() {
+                let (a, c) = (b.nodes[2 * e], b.nodes[2 * e + 1]);
+                nb[a].push(c);
+                nb[c].push(a);
+            }
+        }
+        nb
+    }
+
+    /// The window of the yarn through `node` (see [`YarnWindow`]), walking the truss
+    /// neighbours `nb` ([`Model::truss_neighbours`]); why there is none otherwise: a node
+    /// on no truss, a node where the trusses branch (more than two neighbours), a yarn
+    /// that closes on itself within the window.
+    pub fn yarn_window(
+        &self,
+        nb: &[Vec<usize>],
+        node: usize,
+        half: usize,
+    ) -> std::result::Result<YarnWindow, String> {
+        let id = |n: usize| self.node_id[n];
+        match nb[node].len() {
+            0 => return Err(format!("node `{}` is on no truss", id(node))),
+            1 | 2 => {}
+            k => {
+                return Err(format!(
+                    "node `{}` joins {k} trusses (a yarn is a chain: one or two)",
+                    id(node)
+                ))
+            }
+        }
+        let mut sides = [vec![], vec![]];
+        let mut ends = [true, true];
+        for (side, &first) in nb[node].iter().enumerate() {
+            let (mut prev, mut cur) = (node, first);
+            loop {
+                if cur == node || sides[side].contains(&cur) {
+                    return Err(format!(
+                        "the yarn through node `{}` closes on itself",
+                        id(node)
+                    ));
+                }
+                sides[side].push(cur);
+                if nb[cur].len() > 2 {
+                    return Err(format!(
+                        "node `{}` on the yarn through node `{}` joins {} trusses (a yarn is a chain: one or two)",
+                        id(cur),
+                        id(node),
+                        nb[cur].len()
+                    ));
+                }
+                let next = nb[cur].iter().copied().find(|&n| n != prev);
+                match next {
+                    Some(n) if sides[side].len() < half => (prev, cur) = (cur, n),
+                    Some(_) => {
+                        ends[side] = false;
+                        break;
+                    }
+                    None => break,
+                }
+            }
+        }
+        let [back, fwd] = sides;
+        let home = back.len();
+        let nodes: Vec<usize> = back
+            .into_iter()
+            .rev()
+            .chain(std::iter::once(node))
+            .chain(fwd)
+            .collect();
+        // A node with one neighbour ends the yarn: its side's walk never started, and
+        // its `ends` entry stays true.
+        Ok(YarnWindow { nodes, home, ends })
+    }
+
+    /// Sliding links: not in a frame of frame nodes as well, and each end on a yarn
+    /// (a chain of trusses) other than the other end's.
+    fn validate_sliding_links(&self) -> Result<()> {
+        let Some(b) = self.block(ElementKind::Link) else {
+            return Ok(());
+        };
+        let file = "elements_link.parquet";
+        let mut nb = None;
+        for e in 0..b.len() {
+            let part = &self.parts[b.part[e]];
+            if part.props.sliding != Some(true) {
+                continue;
+            }
+            let nb = nb.get_or_insert_with(|| self.truss_neighbours());
+            let (n1, n2) = (b.nodes[2 * e], b.nodes[2 * e + 1]);
+            let mut windows = vec![];
+            for (col, n) in [("n1", n1), ("n2", n2)] {
+                match self.yarn_window(nb, n, crate::solver::sliding_link::HALF) {
+                    Ok(w) => windows.push(w),
+                    Err(why) => {
+                        return Err(WeftError::input(format!(
+                            "sliding link `{}` of part `{}`: {why}",
+                            b.id[e], part.name
+                        ))
+                        .in_file(file)
+                        .in_column(col)
+                        .at_row(e)
+                        .expected("each end of a sliding link on a yarn: a chain of trusses through the node")
+                        .hint(format!("join the node to its yarn's trusses, or set `sliding` of part `{}` to null", part.name)));
+                    }
+                }
+            }
+            if windows[0].nodes.contains(&n2) {
+                return Err(WeftError::input(format!(
+                    "sliding link `{}` of part `{}` joins nodes `{}` and `{}` of the same yarn",
+                    b.id[e], part.name, self.node_id[n1], self.node_id[n2]
+                ))
+                .in_file(file)
+                .in_column("n2")
+                .at_row(e)
+                .expected("the two ends on two yarns that cross"));
+            }
+        }
+        Ok(())
+    }
+
     /// Link frame nodes: on link tables only, one set per link; every link whose part
     /// asks for `local_frame` has frame nodes that span a plane at the reference
     /// coordinates (e₁ = x_f2 − x_f1 ≠ 0, not parallel to x_f4 − x_f3).
@@ -958,6 +1096,15 @@ pub fn validate_part(p: &Part) -> Result<()> {
                     q.kz,
                     "in N/m (Coulomb friction takes its normal force N from the normal spring)",
                 )?;
+            }
+            if q.sliding == Some(true) && q.local_frame == Some(true) {
+                return Err(WeftError::input(format!(
+                    "part `{}` (link) has both sliding and local_frame",
+                    p.name
+                ))
+                .in_column("sliding")
+                .expected("one frame: a sliding link's own (its yarns' tangents where its ends are), or the frame nodes' of `local_frame`")
+                .hint("leave `local_frame` null for sliding links"));
             }
             if q.unilateral == Some(true) && q.kz.is_none() && q.cz.is_none() {
                 return Err(WeftError::input(format!(

@@ -364,6 +364,13 @@ part_properties! {
         aliases: [],
         meaning: "true: the springs, dashpots and slider act in the local frame (e₁, e₂, n) of the crossing, rebuilt every step from the frame nodes `f1`…`f4` of `elements_link.parquet` (e₁ along f2 − f1, n ⟂ e₁ and f4 − f3)",
     },
+    sliding: bool {
+        unit: "",
+        kinds: [Link: Rule::Free],
+        null: null("false", "a link joins its two nodes, as the paper's links"),
+        aliases: [],
+        meaning: "true: each end of the link is a point of a yarn (the chain of trusses through `n1`, and through `n2`) that stays put while the link sticks and moves along the yarn when its slider slips, so that the yarns slide across each other; the link acts in the frame of the two yarns' tangents at those points (e₁ along node 1's yarn, n ⟂ both towards node 2); needs `n1`, `n2` on truss chains; not with `local_frame`",
+    },
 }
 
 impl PartProps {

@@ -105,7 +105,7 @@ pub fn force_update(
 
 /// The normal spring force f_n = −k_z d_z, or −k_z min(d_z, 0) when unilateral.
 #[inline(always)]
-fn normal_spring(dz: f64, kz: f64, unilateral: bool) -> f64 {
+pub(super) fn normal_spring(dz: f64, kz: f64, unilateral: bool) -> f64 {
     if unilateral && dz >= 0.0 {
         0.0
     } else {
@@ -224,17 +224,17 @@ pub type FramedX = [Vec3; 6];
 
 /// The local frame's kinematics of a framed link at positions `x`: R (rows e₁, e₂, n),
 /// r = x₂ − x₁, u = x_f2 − x_f1, w = x_f4 − x_f3, |u|, c = u × w, |c|.
-struct FrameKin {
-    r_mat: Mat3,
-    r: Vec3,
+pub(super) struct FrameKin {
+    pub(super) r_mat: Mat3,
+    pub(super) r: Vec3,
     u: Vec3,
     w: Vec3,
-    lu: f64,
+    pub(super) lu: f64,
     lc: f64,
 }
 
 #[inline(always)]
-fn frame_kin(x: &FramedX) -> Option<FrameKin> {
+pub(super) fn frame_kin(x: &FramedX) -> Option<FrameKin> {
     let r = sub(&x[1], &x[0]);
     let u = sub(&x[3], &x[2]);
     let w = sub(&x[5], &x[4]);
@@ -277,7 +277,7 @@ pub fn framed_rel_disp(x: &FramedX, d0: &Vec3) -> Option<Vec3> {
 /// Forces sum to zero, and their moment too (W is rotation invariant). The dashpot
 /// force `fd` (in the link's axes) acts on nodes 1 and 2 only.
 #[inline(always)]
-fn framed_node_forces(k: &FrameKin, fs: &Vec3, fd: &Vec3) -> [Vec3; 6] {
+pub(super) fn framed_node_forces(k: &FrameKin, fs: &Vec3, fd: &Vec3) -> [Vec3; 6] {
     let [e1, _e2, n] = k.r_mat;
     let g = [-fs[0], -fs[1], -fs[2]];
     let ftot = [fs[0] + fd[0], fs[1] + fd[1], fs[2] + fd[2]];
@@ -379,7 +379,7 @@ use crate::model::{ElementKind, Model, PartProps};
 /// its 160 J impact at ω Δt ≈ 1.8, and 8·10⁻³ J at half that step, measured); at
 /// ω Δt ≤ 0.9 a contact lasts ≥ 3 steps.
 #[inline(always)]
-fn bound_stiffness(p: &LinkProps, law: &LinkLaw) -> [f64; 3] {
+pub(super) fn bound_stiffness(p: &LinkProps, law: &LinkLaw) -> [f64; 3] {
     if law.unilateral {
         [p.k[0], p.k[1], 4.0 * p.k[2]]
     } else {
@@ -399,7 +399,7 @@ fn law_of(law: &[LinkLaw], e: usize) -> &LinkLaw {
 }
 
 /// A part's link constants and law.
-fn link_props(p: &PartProps) -> (LinkProps, LinkLaw) {
+pub(super) fn link_props(p: &PartProps) -> (LinkProps, LinkLaw) {
     let z = |v: Option<f64>| v.unwrap_or(0.0);
     (
         LinkProps {
@@ -414,10 +414,17 @@ fn link_props(p: &PartProps) -> (LinkProps, LinkLaw) {
     )
 }
 
-/// Whether link `e` of the model's link block acts in a local frame.
+/// Whether link `e` of the model's link block acts in a local frame given by frame nodes.
 fn is_framed(m: &Model, e: usize) -> bool {
     m.block(ElementKind::Link)
         .is_some_and(|b| m.parts[b.part[e]].props.local_frame == Some(true))
+}
+
+/// Whether link `e` of the model's link block slides along its yarns
+/// ([`super::sliding_link`]).
+pub(super) fn is_sliding(m: &Model, e: usize) -> bool {
+    m.block(ElementKind::Link)
+        .is_some_and(|b| m.parts[b.part[e]].props.sliding == Some(true))
 }
 
 /// Links in global axes, struct-of-arrays.
@@ -446,7 +453,7 @@ impl Family for LinkGroup {
         let Some(b) = m.block(ElementKind::Link) else {
             return Ok(g);
         };
-        for e in (0..b.len()).filter(|&e| !is_framed(m, e)) {
+        for e in (0..b.len()).filter(|&e| !is_framed(m, e) && !is_sliding(m, e)) {
             let (a, c) = (b.nodes[2 * e], b.nodes[2 * e + 1]);
             let (props, law) = link_props(&m.parts[b.part[e]].props);
             g.id.push(b.id[e]);
@@ -650,7 +657,7 @@ impl Family for FramedLinkGroup {
         let Some(b) = m.block(ElementKind::Link) else {
             return Ok(g);
         };
-        for e in (0..b.len()).filter(|&e| is_framed(m, e)) {
+        for e in (0..b.len()).filter(|&e| is_framed(m, e) && !is_sliding(m, e)) {
             let (a, c) = (b.nodes[2 * e], b.nodes[2 * e + 1]);
             let (props, law) = link_props(&m.parts[b.part[e]].props);
             // `Model::validate` checked that the frame nodes span a plane.

@@ -35,6 +35,7 @@ pub mod operator;
 pub mod output;
 pub mod point_mass;
 pub mod relax;
+pub mod sliding_link;
 pub mod stable;
 pub mod statics;
 pub mod ties;
@@ -57,6 +58,7 @@ crate::families! {
     truss: truss::TrussGroup,
     link: link::LinkGroup,
     framed_link: link::FramedLinkGroup,
+    sliding_link: sliding_link::SlidingLinkGroup,
     point_mass: point_mass::PointMassGroup,
     tri: membrane::MembraneGroup<3>,
     quad: membrane::MembraneGroup<4>,
@@ -756,7 +758,8 @@ impl Solver {
 
     /// Current force of every link on its node 2 at the current positions: spring and
     /// slider (the slider return-mapped on a copy of its state), without the dashpot;
-    /// the links in global axes first, then those in a local frame, each in table order.
+    /// the links in global axes first, then those in a local frame, then the sliding
+    /// links (at their anchors, without slipping), each in table order.
     pub fn link_forces(&self) -> Vec<[f64; 3]> {
         let mut f = self.op.el.link.elastic_forces(&self.state.x);
         f.extend(
@@ -767,6 +770,7 @@ impl Solver {
                 .iter()
                 .map(|six| six[1]),
         );
+        f.extend(self.op.el.sliding_link.elastic_forces_on_b(&self.state.x));
         f
     }
 
@@ -775,9 +779,11 @@ impl Solver {
     pub fn internal_forces(&mut self) -> Vec<[f64; 3]> {
         let saved = self.op.el.link.state.clone();
         let saved_framed = self.op.el.framed_link.state.clone();
+        let saved_sliding = self.op.el.sliding_link.state.clone();
         self.op.element_forces(&self.state);
         self.op.el.link.state = saved;
         self.op.el.framed_link.state = saved_framed;
+        self.op.el.sliding_link.state = saved_sliding;
         (0..self.x0.len())
             .map(|i| {
                 let mut f = [0.0; 3];

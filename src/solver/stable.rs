@@ -142,6 +142,10 @@ impl Solver {
         k.most.fill(None);
         self.op.el.quad.add_stiffening(x, &mut k.extra, &mut k.most);
         self.op.el.tri.add_stiffening(x, &mut k.extra, &mut k.most);
+        self.op
+            .el
+            .sliding_link
+            .add_crowding(x, &mut k.extra, &mut k.most);
         for t in &self.op.ties.ties {
             for (a, &mn) in t.masters.iter().enumerate() {
                 k.extra[mn] += t.w[a] * k.extra[t.slave];
@@ -166,6 +170,10 @@ impl Solver {
                     .max_by(|a, b| a.0.total_cmp(&b.0))
             });
             let what = match who {
+                Some((_, ElementKind::Link, id, q)) => format!(
+                    "sliding link `{id}` (its ends slid {:.2} and {:.2} segments, {:.3e} m apart)",
+                    q[0], q[1], q[2]
+                ),
                 Some((_, kind, id, e)) => format!(
                     "{} `{id}` has stretched to a Green strain of [{:.3}, {:.3}, {:.3}] (E₁₁, E₂₂, 2E₁₂)",
                     kind.name(),

@@ -180,6 +180,23 @@ impl Solver {
             let ke = fd_stiffness(&xe, h, |x| l.reference_forces(e, x));
             add_element(&nodes, &ke);
         }
+        // Sliding links: stuck at their reference anchors, on their window nodes (a short
+        // window's padding repeats its last node, whose padding slots carry no force).
+        let l = &self.op.el.sliding_link;
+        for e in 0..l.id.len() {
+            use super::sliding_link::WIN;
+            let nodes: [usize; 2 * WIN] = l.nodes[e].map(|v| v as usize);
+            let xe: [[f64; 3]; 2 * WIN] = std::array::from_fn(|k| x0[nodes[k]]);
+            let chord = super::vec3::norm(&super::vec3::sub(&xe[1], &xe[0]));
+            let ke = fd_stiffness(&xe, 1e-6 * chord, |x| {
+                let xs = [
+                    std::array::from_fn(|k| x[k]),
+                    std::array::from_fn(|k| x[WIN + k]),
+                ];
+                l.reference_forces(e, &xs)
+            });
+            add_element(&nodes, &ke);
+        }
         fn membranes<const N: usize>(
             grp: &super::membrane::MembraneGroup<N>,
             x0: &[[f64; 3]],
