@@ -179,6 +179,8 @@ fn bad_membrane_and_link_values_are_refused_with_the_parameter_named() {
             vec!["--link-friction", "0.2", "--slip-force", "1"],
             "--slip-force",
         ),
+        (vec!["--dt-safety", "0"], "--dt-safety"),
+        (vec!["--dt-safety", "1.5"], "--dt-safety"),
     ] {
         let st = weave_bin()
             .arg("woven-reduced")

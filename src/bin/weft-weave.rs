@@ -362,6 +362,11 @@ struct WovenArgs {
     /// Output interval [s].
     #[arg(long, default_value_t = 1e-6)]
     output_interval: f64,
+    /// Safety factor on the stable time step, 0 < f ≤ 1 (written to the model's
+    /// analysis.parquet; the projectile's contact penalty κ m/Δt² stiffens with a shorter
+    /// step).
+    #[arg(long, default_value_t = 0.9)]
+    dt_safety: f64,
 }
 
 #[derive(clap::Args)]
@@ -642,6 +647,7 @@ fn run() -> anyhow::Result<ExitCode> {
                 projectile_friction: a.projectile_friction,
                 end_time: a.end_time,
                 output_interval: a.output_interval,
+                dt_safety: a.dt_safety,
             };
             let m = weave::run(&Spec::WovenReduced(p.clone()), &a.out, &mut warn)?;
             let mp = p.membrane();

@@ -574,6 +574,9 @@ pub struct WovenParams {
     pub projectile_friction: f64,
     pub end_time: f64,
     pub output_interval: f64,
+    /// Safety factor on the stable step [–], 0 < f ≤ 1 (the model's `dt_safety`; 0.9 by
+    /// default): the projectile's contact penalty is κ m*/Δt².
+    pub dt_safety: f64,
 }
 
 impl WovenParams {
@@ -614,6 +617,7 @@ impl WovenParams {
             projectile_friction: 0.0,
             end_time: 5e-5,
             output_interval: 1e-6,
+            dt_safety: 0.9,
         }
     }
 
@@ -687,6 +691,12 @@ impl WovenParams {
         if !(nu > -1.0 && nu < 1.0) {
             return Err(WeftError::input(format!("--membrane-poisson = `{nu}`"))
                 .expected("−1 < ν < 1 (an isotropic membrane, ν² < 1)"));
+        }
+        if !(self.dt_safety > 0.0 && self.dt_safety <= 1.0) {
+            return Err(
+                WeftError::input(format!("--dt-safety = `{}`", self.dt_safety))
+                    .expected("a safety factor 0 < f ≤ 1 on the stable step"),
+            );
         }
         let pf = self.projectile_friction;
         if !(pf >= 0.0 && pf.is_finite()) {
@@ -954,6 +964,7 @@ pub fn woven_reduced(p: &WovenParams) -> Result<Model> {
     m.analysis = Analysis {
         end_time: p.end_time,
         output_interval: p.output_interval,
+        dt_safety: p.dt_safety,
         ..Default::default()
     };
     m.validate()?;
