@@ -11,16 +11,25 @@
 //! κ_c = 0.1 × penalty_scale.
 //!
 //! Phases, after the DESIGN notes §11 and LS-DYNA's contact:
-//! - **broad phase** ([`Grid`]): the faces' bounding boxes, inflated by
-//!   r = t_s,max/2 + t_F,max/2 + skin, in a dense uniform grid whose cell is half the
+//! - **thickness box** of a face: the bounding box of the balls of radius t_a/2 about its
+//!   nodes, lo = min_a (x_a − t_a/2), hi = max_a (x_a + t_a/2) per component. It holds
+//!   every ball of radius t_F/2 about a point q = Σ w_a x_a of the face (w_a ≥ 0, Σ w_a =
+//!   1, t_F = Σ w_a t_a), so a slave farther than t_s/2 from it cannot penetrate the face.
+//! - **broad phase** ([`Grid`]): the faces' thickness boxes, inflated by
+//!   r = t_s,max/2 + skin, in a dense uniform grid whose cell is half the
 //!   largest inflated box (each face in ≤ 27 cells); each slave's candidates are the
-//!   faces of its cell whose box contains it (never a face it belongs to). Rebuilt only when some
-//!   node has moved more than skin/2 since the last build, so a pair that can touch is
-//!   never missed and the cost is amortised (Teschner et al., *Optimized spatial hashing
-//!   for collision detection of deformable objects*, VMV 2003).
+//!   faces of its cell whose box contains it (never a face it belongs to), in face order.
+//!   Rebuilt only when the displacements since the last build could have brought a pair
+//!   within reach that is not a candidate: some node has moved more than 2 skins, or the
+//!   displacements of the nodes near one another differ by more than the skin
+//!   ([`super::staleness`]); a region that moves as a whole (the fabric under the nose)
+//!   keeps its lists. A pair that can touch is never missed and the cost is amortised
+//!   (Teschner et al., *Optimized spatial hashing for collision detection of deformable
+//!   objects*, VMV 2003).
 //! - **narrow phase** (pure kernels [`closest_on_face`], [`pair_force`]): the faces'
-//!   bounding boxes once per step; per slave, the candidates whose box is within its reach
-//!   (a branch-free pass), then the closest point on each of those; of the faces it
+//!   thickness boxes once per step; per slave, the candidates whose thickness box is
+//!   within t_s/2 of it (a branch-free pass), then the closest point on each of those; of
+//!   the faces it
 //!   penetrates, the one of largest penetration sets g, and all of them share the rest:
 //!   the normal is their penetration-weighted mean, and the reaction −f goes to each
 //!   penetrated face F in the share λ_F = g_F/Σg (to its nodes by the foot's weights), the
@@ -48,6 +57,7 @@
 
 use rayon::prelude::*;
 
+use super::staleness::Staleness;
 use super::PENALTY_FACTOR;
 use crate::error::{Result, WeftError};
 use crate::model::contacts::{InitialPenetration, Slave};
@@ -126,18 +136,15 @@ pub fn closest_on_face(p: &[f64; 3], x: &[[f64; 3]; 4], n: usize) -> [f64; 4] {
             let w = super::closest_on_triangle(p, &x[0], &x[1], &x[2]);
             [w[0], w[1], w[2], 0.0]
         }
-        _ => {
-            let a = super::closest_on_triangle(p, &x[0], &x[1], &x[2]);
-            let b = super::closest_on_triangle(p, &x[0], &x[2], &x[3]);
-            closest_on_quad(p, x, a, b)
-        }
+        _ => closest_on_quad(p, x),
     }
 }
 
-/// [`closest_on_face`] for a quad whose split 0-2 triangles (0,1,2) and (0,2,3) have
-/// been evaluated already (`a`, `b`: their barycentric weights).
+/// [`closest_on_face`] for a quad.
 #[inline]
-pub fn closest_on_quad(p: &[f64; 3], x: &[[f64; 3]; 4], a: [f64; 3], b: [f64; 3]) -> [f64; 4] {
+pub fn closest_on_quad(p: &[f64; 3], x: &[[f64; 3]; 4]) -> [f64; 4] {
+    let a = super::closest_on_triangle(p, &x[0], &x[1], &x[2]);
+    let b = super::closest_on_triangle(p, &x[0], &x[2], &x[3]);
     let c = super::closest_on_triangle(p, &x[1], &x[2], &x[3]);
     let d = super::closest_on_triangle(p, &x[1], &x[3], &x[0]);
     // Split 0-2: triangles (0,1,2), (0,2,3); split 1-3: (1,2,3), (1,3,0). Each split
@@ -322,14 +329,17 @@ pub struct Side {
     /// 2√(k m*) (0 in impact runs; `set_normal_damping` sets it for a relaxation).
     damping: f64,
     on_initial: InitialPenetration,
-    /// Inflation of the face boxes beyond the skin: t_s,max/2 + t_F,max/2 [m].
+    /// Contact distance of the thickest slave and face, t_s,max/2 + t_F,max/2 [m].
     reach: f64,
-    /// Largest face thickness: no face farther than (t_s + this)/2 can touch [m].
-    face_t_max: f64,
+    /// Largest slave thickness: the thickness boxes are inflated by half of it and the
+    /// skin for the broad phase [m].
+    slave_t_max: f64,
+    /// Round-off allowance η of the thickness-box tests [m] (see [`BOX_MARGIN`]).
+    box_margin: f64,
     /// Candidates per slave (CSR), from the last broad phase.
     cand_ptr: Vec<u32>,
     cand: Vec<u32>,
-    /// The faces' bounding boxes at the current step (lo, hi) [m].
+    /// The faces' thickness boxes at the current step (lo, hi) [m].
     face_box: Vec<[f64; 6]>,
     pub state: Vec<SlaveState>,
     pub out: Vec<PairOut>,
@@ -492,6 +502,12 @@ impl Side {
         }
         let ts_max = slave_t.iter().cloned().fold(0.0, f64::max);
         let tf_max = face_t.iter().flatten().cloned().fold(0.0, f64::max);
+        // The largest coordinate of the side's nodes, the scale of the round-off.
+        let x_max = slaves
+            .iter()
+            .chain(faces.iter().flat_map(|f| f[..npe].iter()))
+            .flat_map(|&n| m.coords[n as usize])
+            .fold(0.0, |a: f64, c| a.max(c.abs()));
         Side {
             contact_id: d.id,
             row,
@@ -520,7 +536,8 @@ impl Side {
             damping: 0.0,
             on_initial: d.initial_penetration,
             reach: 0.5 * (ts_max + tf_max),
-            face_t_max: tf_max,
+            slave_t_max: ts_max,
+            box_margin: BOX_MARGIN * (x_max + 0.5 * (ts_max + tf_max)),
             cand_ptr: vec![],
             cand: vec![],
             face_box: vec![],
@@ -543,19 +560,19 @@ impl Side {
         s / self.faces.len() as f64
     }
 
-    /// The faces' bounding boxes at `x`, once per step, in parallel (each candidate of the
-    /// narrow phase then reads one box instead of gathering its face's nodes; measured:
+    /// The faces' thickness boxes at `x`, once per step, in parallel (each candidate of
+    /// the narrow phase then reads one box instead of gathering its face's nodes; measured:
     /// those gathers were ~40 % of the narrow phase of the woven patch).
     fn update_boxes(&mut self, x: &[[f64; 3]]) {
-        let (faces, nf) = (&self.faces, self.nf);
+        let (faces, face_t, nf) = (&self.faces, &self.face_t, self.nf);
         self.face_box.resize(faces.len(), [0.0; 6]);
         self.face_box
             .par_chunks_mut(4096)
             .enumerate()
             .for_each(|(c, bs)| {
                 for (j, b) in bs.iter_mut().enumerate() {
-                    let (lo, hi) = bbox(&faces[c * 4096 + j], nf, x);
-                    *b = [lo[0], lo[1], lo[2], hi[0], hi[1], hi[2]];
+                    let fi = c * 4096 + j;
+                    *b = thickness_box(&faces[fi], &face_t[fi], nf, x);
                 }
             });
     }
@@ -563,7 +580,9 @@ impl Side {
     /// Broad phase: candidates of every slave at the positions `x`, whose face boxes
     /// [`Side::update_boxes`] has computed.
     fn build(&mut self, x: &[[f64; 3]], skin: f64) {
-        let r = self.reach + skin;
+        // A slave within t_s/2 + η of a thickness box at some step before the next build
+        // was within this of it per component at the build (see `super::staleness`).
+        let r = 0.5 * self.slave_t_max + skin + self.box_margin;
         let nf = self.nf;
         let boxes: Vec<([f64; 3], [f64; 3])> = self
             .face_box
@@ -647,7 +666,7 @@ impl Side {
         let (cand_ptr, cand) = (&self.cand_ptr, &self.cand);
         let (fr, kappa, zeta) = (self.friction, self.kappa, self.damping);
         let keep = self.on_initial == InitialPenetration::Keep;
-        let face_t_max = self.face_t_max;
+        let eta = self.box_margin;
         let dt2 = dt * dt;
         let nchunks = self.slaves.len().div_ceil(SLAVE_CHUNK);
         self.chunk_active.resize_with(nchunks, Vec::new);
@@ -668,6 +687,10 @@ impl Side {
                 active.clear();
                 reactions.clear();
                 *sums = [0.0; 2];
+                // Scratch of the slaves (only the first n_pen, nn entries are read):
+                // declared once per chunk, not zeroed per slave.
+                let mut pen = [(0u32, [0.0f64; 4], 0.0f64); MAX_SHARED];
+                let mut near = [0u32; 32];
                 for (j, (o, st)) in outs.iter_mut().zip(sts.iter_mut()).enumerate() {
                     let si = ci * SLAVE_CHUNK + j;
                     let s = slaves[si] as usize;
@@ -687,9 +710,17 @@ impl Side {
                     // reaction jumped between faces as the node moved: measured, a formed weave
                     // tiled from its mirror-symmetric cell was out of balance by 0.10 of the
                     // crossing force at the vertex's neighbours, and drifted when left alone).
-                    let mut pen = [(0u32, [0.0f64; 4], 0.0f64); MAX_SHARED];
                     let mut n_pen = 0usize;
-                    let reach = 0.5 * (slave_t[si] + face_t_max);
+                    // A face can be penetrated only if the slave is within t_s/2 of its
+                    // thickness box: the foot q = Σ w_a x_a is a convex combination of the
+                    // nodes (each triangle's barycentric weights, averaged over a quad's
+                    // two splits), and t_F = Σ w_a t_a the same combination of their
+                    // thicknesses, so the ball of radius t_F/2 about q lies in the box, and
+                    // |x_s − q| < (t_s + t_F)/2 puts x_s within t_s/2 of it. The test in
+                    // floating point keeps η = 10⁻⁹ (|x|_max + reach) more, 10⁶ times the
+                    // round-off of the foot and the box, so that it rejects only faces
+                    // that the closest-point test below rejects too: the same bits.
+                    let reach = 0.5 * slave_t[si] + eta;
                     let r2 = reach * reach;
                     // Only faces the node penetrates (g > 0) matter: a node whose best g is
                     // ≤ 0 is open whether or not some face was evaluated, and a tracked initial
@@ -698,7 +729,6 @@ impl Side {
                     for block in list.chunks(32) {
                         // Cheap rejection, without branches: the distance to each face's
                         // bounding box at this step; the survivors are kept in order.
-                        let mut near = [0u32; 32];
                         let mut nn = 0;
                         for &fi in block {
                             let bx = &face_box[fi as usize];
@@ -1014,6 +1044,32 @@ impl Grid {
     }
 }
 
+/// Round-off allowance of the thickness-box tests relative to the largest coordinate of a
+/// side's nodes: its foot and box are computed within ~10⁻¹⁵ of that.
+const BOX_MARGIN: f64 = 1e-9;
+
+/// The thickness box of a face (`nf` nodes `f` of nodal thicknesses `t`) at `x`: the
+/// bounding box of the balls of radius t_a/2 about its nodes, (lo, hi).
+#[inline]
+fn thickness_box(f: &[u32; 4], t: &[f64; 4], nf: usize, x: &[[f64; 3]]) -> [f64; 6] {
+    let mut b = [
+        f64::INFINITY,
+        f64::INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::NEG_INFINITY,
+        f64::NEG_INFINITY,
+    ];
+    for a in 0..nf {
+        let (xa, r) = (&x[f[a] as usize], 0.5 * t[a]);
+        for d in 0..3 {
+            b[d] = b[d].min(xa[d] - r);
+            b[d + 3] = b[d + 3].max(xa[d] + r);
+        }
+    }
+    b
+}
+
 fn bbox(f: &[u32; 4], nf: usize, x: &[[f64; 3]]) -> ([f64; 3], [f64; 3]) {
     let mut lo = [f64::INFINITY; 3];
     let mut hi = [f64::NEG_INFINITY; 3];
@@ -1032,8 +1088,9 @@ pub struct SurfaceContact {
     pub sides: Vec<Side>,
     /// Nodes that take part (slaves and face nodes), sorted.
     nodes: Vec<u32>,
-    /// Their positions at the last broad phase.
-    x_ref: Vec<[f64; 3]>,
+    /// Their positions at the last broad phase, and the test of when the candidate lists
+    /// go stale.
+    motion: Staleness,
     /// Skin of the broad phase [m].
     pub skin: f64,
     /// Largest κ_c of the definitions (stable-step guard).
@@ -1085,7 +1142,7 @@ impl SurfaceContact {
         SurfaceContact {
             sides,
             nodes,
-            x_ref: vec![],
+            motion: Staleness::new(skin),
             skin,
             kappa_max,
             builds: 0,
@@ -1134,28 +1191,32 @@ impl SurfaceContact {
         best
     }
 
-    /// Broad phase for every side at `x`.
+    /// Broad phase for every side at `x` (whose thickness boxes are up to date).
     fn rebuild(&mut self, x: &[[f64; 3]]) {
         for s in &mut self.sides {
             s.build(x, self.skin);
         }
-        self.x_ref.clear();
-        self.x_ref.extend(self.nodes.iter().map(|&n| x[n as usize]));
+        // ρ + W of the staleness test: the farthest a slave can be from a thickness box
+        // that the narrow phase evaluates, and the widest box.
+        let rho_w = self
+            .sides
+            .iter()
+            .map(|s| {
+                let w = s
+                    .face_box
+                    .iter()
+                    .map(|b| (b[3] - b[0]).max(b[4] - b[1]).max(b[5] - b[2]))
+                    .fold(0.0, f64::max);
+                0.5 * s.slave_t_max + s.box_margin + w
+            })
+            .fold(0.0, f64::max);
+        self.motion.reset(&self.nodes, x, rho_w);
         self.builds += 1;
     }
 
-    /// Whether some node moved more than skin/2 since the last broad phase.
-    fn stale(&self, x: &[[f64; 3]]) -> bool {
-        let lim = 0.25 * self.skin * self.skin;
-        self.nodes
-            .par_chunks(4096)
-            .zip(self.x_ref.par_chunks(4096))
-            .any(|(ns, xr)| {
-                ns.iter().zip(xr).any(|(&n, r)| {
-                    let d = sub(&x[n as usize], r);
-                    dot(&d, &d) > lim
-                })
-            })
+    /// Whether the candidate lists may miss a pair at `x` (see [`Staleness`]).
+    fn stale(&mut self, x: &[[f64; 3]]) -> bool {
+        self.motion.stale(&self.nodes, x)
     }
 
     /// Setup at the start positions `x` (the reference plus any initial displacement):
