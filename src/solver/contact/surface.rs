@@ -16,7 +16,7 @@
 //!   every ball of radius t_F/2 about a point q = Σ w_a x_a of the face (w_a ≥ 0, Σ w_a =
 //!   1, t_F = Σ w_a t_a), so a slave farther than t_s/2 from it cannot penetrate the face.
 //! - **broad phase** ([`Grid`]): the faces' thickness boxes, inflated by
-//!   r = t_s,max/2 + skin, in a dense uniform grid whose cell is half the
+//!   r = t_s,max/2 + skin + η (η a 10⁻⁹ round-off allowance), in a dense uniform grid whose cell is half the
 //!   largest inflated box (each face in ≤ 27 cells); each slave's candidates are the
 //!   faces of its cell whose box contains it (never a face it belongs to), in face order.
 //!   Rebuilt only when the displacements since the last build could have brought a pair
@@ -28,9 +28,9 @@
 //!   objects*, VMV 2003).
 //! - **narrow phase** (pure kernels [`closest_on_face`], [`pair_force`]): the faces'
 //!   thickness boxes once per step; per slave, the candidates whose thickness box is
-//!   within t_s/2 of it (a branch-free pass), then the closest point on each of those; of
-//!   the faces it
-//!   penetrates, the one of largest penetration sets g, and all of them share the rest:
+//!   within t_s/2 + η of it (a branch-free pass), then the closest point on each of
+//!   those; of the faces it penetrates, the one of largest penetration sets g, and all of
+//!   them share the rest:
 //!   the normal is their penetration-weighted mean, and the reaction −f goes to each
 //!   penetrated face F in the share λ_F = g_F/Σg (to its nodes by the foot's weights), the
 //!   foot's mass and velocity being the λ-weighted ones, so that a node over a vertex or
