@@ -7,3 +7,14 @@ pub mod surface;
 
 pub use projectile::*;
 pub use surface::{ContactReport, SurfaceContact};
+
+/// A small deterministic generator (SplitMix64) for the contact tests, so that they need
+/// no crate: uniform in [0, 1).
+#[cfg(test)]
+fn uniform(state: &mut u64) -> f64 {
+    *state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+    let mut z = *state;
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+}

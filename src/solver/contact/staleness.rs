@@ -51,7 +51,7 @@ pub struct Staleness {
     skin: f64,
     u_max: f64,
     /// Positions of the nodes (in the order of the caller's node list) at the build.
-    pub x_ref: Vec<[f64; 3]>,
+    x_ref: Vec<[f64; 3]>,
     /// Cells: origin, size h, counts per axis.
     origin: [f64; 3],
     h: f64,
@@ -224,16 +224,8 @@ impl Staleness {
 
 #[cfg(test)]
 mod tests {
+    use super::super::uniform;
     use super::{Staleness, ABSOLUTE_PER_SKIN};
-
-    /// A small deterministic generator (SplitMix64).
-    fn uniform(state: &mut u64) -> f64 {
-        *state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = *state;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-    }
 
     /// What "not stale" promises, checked by brute force over every pair of nodes (the
     /// oracle): any two nodes now within ρ + W + 2U of each other in every component

@@ -16,9 +16,10 @@
 //!   every ball of radius t_F/2 about a point q = Σ w_a x_a of the face (w_a ≥ 0, Σ w_a =
 //!   1, t_F = Σ w_a t_a), so a slave farther than t_s/2 from it cannot penetrate the face.
 //! - **broad phase** ([`Grid`]): the faces' thickness boxes, inflated by
-//!   r = t_s,max/2 + skin + η (η a 10⁻⁹ round-off allowance), in a dense uniform grid whose cell is half the
-//!   largest inflated box (each face in ≤ 27 cells); each slave's candidates are the
-//!   faces of its cell whose box contains it (never a face it belongs to), in face order.
+//!   r = t_s,max/2 + skin + η (η a 10⁻⁹ round-off allowance), in a dense uniform grid
+//!   whose cell is half the largest inflated box (each face in ≤ 27 cells); each slave's
+//!   candidates are the faces of its cell whose box contains it (never a face it belongs
+//!   to), in face order.
 //!   Rebuilt only when the displacements since the last build could have brought a pair
 //!   within reach that is not a candidate: some node has moved more than 2 skins, or the
 //!   displacements of the nodes near one another differ by more than the skin
@@ -1383,16 +1384,8 @@ impl SurfaceContact {
 
 #[cfg(test)]
 mod tests {
+    use super::super::uniform;
     use super::Grid;
-
-    /// A small deterministic generator (SplitMix64), so that the test needs no crate.
-    fn uniform(state: &mut u64) -> f64 {
-        *state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = *state;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-    }
 
     /// The grid's candidates of a point, filtered by box containment, are exactly the
     /// boxes that contain it by brute force (the oracle), in box order; points outside
