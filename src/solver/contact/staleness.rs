@@ -50,13 +50,13 @@ pub struct Staleness {
     /// Skin of the broad phase and the absolute bound U [m].
     skin: f64,
     u_max: f64,
-    /// Positions of the nodes (in the order of the caller's node list) at the build.
+    /// Positions at the build of the nodes in `cell_nodes`, in the same (cell) order.
     x_ref: Vec<[f64; 3]>,
     /// Cells: origin, size h, counts per axis.
     origin: [f64; 3],
     h: f64,
     dims: [usize; 3],
-    /// Nodes (positions in the caller's list) per cell (CSR).
+    /// Nodes (indices into the positions) per cell (CSR).
     cell_ptr: Vec<u32>,
     cell_nodes: Vec<u32>,
     /// Per cell: min u (3), max u (3); then the same over its neighbourhood.
@@ -75,16 +75,22 @@ impl Staleness {
 
     /// A build at the positions `x` of `nodes`; `rho_w` = ρ + W (see the module docs).
     pub fn reset(&mut self, nodes: &[u32], x: &[[f64; 3]], rho_w: f64) {
-        self.x_ref.clear();
-        self.x_ref.extend(nodes.iter().map(|&n| x[n as usize]));
-        let mut lo = [f64::INFINITY; 3];
-        let mut hi = [f64::NEG_INFINITY; 3];
-        for p in &self.x_ref {
-            for d in 0..3 {
-                lo[d] = lo[d].min(p[d]);
-                hi[d] = hi[d].max(p[d]);
-            }
-        }
+        // Bounds: minima and maxima, exact in any order.
+        type Bounds = ([f64; 3], [f64; 3]);
+        let none: Bounds = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+        let merge = |p: Bounds, q: Bounds| -> Bounds {
+            (
+                std::array::from_fn(|d| p.0[d].min(q.0[d])),
+                std::array::from_fn(|d| p.1[d].max(q.1[d])),
+            )
+        };
+        let (mut lo, hi) = nodes
+            .par_iter()
+            .fold(
+                || none,
+                |acc, &n| merge(acc, (x[n as usize], x[n as usize])),
+            )
+            .reduce(|| none, merge);
         let mut h = rho_w + 4.0 * self.u_max;
         if nodes.is_empty() || !(h > 0.0) || !(0..3).all(|d| lo[d].is_finite() && hi[d].is_finite())
         {
@@ -108,12 +114,16 @@ impl Staleness {
         }
         let ncell = dims[0] * dims[1] * dims[2];
         (self.origin, self.h, self.dims) = (lo, h, dims);
-        // Nodes by cell: a counting sort.
-        let cells: Vec<usize> = self.x_ref.iter().map(|p| self.cell(p)).collect();
+        // Nodes by cell: a counting sort; the nodes' indices and build positions are kept
+        // in cell order, so that the test reads them in sequence.
+        let cells: Vec<u32> = nodes
+            .par_iter()
+            .map(|&n| self.cell(&x[n as usize]) as u32)
+            .collect();
         self.cell_ptr.clear();
         self.cell_ptr.resize(ncell + 1, 0);
         for &c in &cells {
-            self.cell_ptr[c + 1] += 1;
+            self.cell_ptr[c as usize + 1] += 1;
         }
         for c in 0..ncell {
             self.cell_ptr[c + 1] += self.cell_ptr[c];
@@ -121,10 +131,13 @@ impl Staleness {
         let mut fill = self.cell_ptr.clone();
         self.cell_nodes.clear();
         self.cell_nodes.resize(nodes.len(), 0);
-        for (i, &c) in cells.iter().enumerate() {
-            self.cell_nodes[fill[c] as usize] = i as u32;
-            fill[c] += 1;
+        for (&n, &c) in nodes.iter().zip(&cells) {
+            self.cell_nodes[fill[c as usize] as usize] = n;
+            fill[c as usize] += 1;
         }
+        self.x_ref.clear();
+        self.x_ref
+            .par_extend(self.cell_nodes.par_iter().map(|&n| x[n as usize]));
         self.range.resize(ncell, [0.0; 6]);
         self.scratch.resize(ncell, [0.0; 6]);
     }
@@ -140,10 +153,11 @@ impl Staleness {
         (c[2] * self.dims[1] + c[1]) * self.dims[0] + c[0]
     }
 
-    /// Whether the lists built at `reset` may miss a pair at the positions `x`: some node
-    /// has moved more than U in a component, or the displacements within some cell's
-    /// neighbourhood spread more than the skin in a component.
-    pub fn stale(&mut self, nodes: &[u32], x: &[[f64; 3]]) -> bool {
+    /// Whether the lists built at `reset` may miss a pair at the positions `x` (of every
+    /// node, indexed as in `reset`): some node has moved more than U in a component, or
+    /// the displacements within some cell's neighbourhood spread more than the skin in a
+    /// component.
+    pub fn stale(&mut self, x: &[[f64; 3]]) -> bool {
         let (x_ref, cell_ptr, cell_nodes, u_max) =
             (&self.x_ref, &self.cell_ptr, &self.cell_nodes, self.u_max);
         // Per cell, the range of the displacements of its nodes, and whether one of them
@@ -164,9 +178,8 @@ impl Staleness {
                         f64::NEG_INFINITY,
                         f64::NEG_INFINITY,
                     ];
-                    for &i in &cell_nodes[cell_ptr[c] as usize..cell_ptr[c + 1] as usize] {
-                        let i = i as usize;
-                        let (p, q) = (&x[nodes[i] as usize], &x_ref[i]);
+                    for i in cell_ptr[c] as usize..cell_ptr[c + 1] as usize {
+                        let (p, q) = (&x[cell_nodes[i] as usize], &x_ref[i]);
                         for d in 0..3 {
                             let u = p[d] - q[d];
                             r[d] = r[d].min(u);
@@ -267,12 +280,12 @@ mod tests {
         // Rigid translation by 1.5 skins (more than the old limit of skin/2).
         let x = moved(&|_| [1.5 * skin, -1.0 * skin, 0.5 * skin]);
         assert!(
-            !fresh().stale(&nodes, &x),
+            !fresh().stale(&x),
             "a rigid translation within U is not stale"
         );
         // Past U.
         let x = moved(&|_| [1.01 * u_max, 0.0, 0.0]);
-        assert!(fresh().stale(&nodes, &x), "a translation past U is stale");
+        assert!(fresh().stale(&x), "a translation past U is stale");
         // Two nodes close together moving apart by 1.2 skins.
         let (i, j) = (0..n)
             .flat_map(|i| (i + 1..n).map(move |j| (i, j)))
@@ -281,10 +294,7 @@ mod tests {
         let mut x = x0.clone();
         x[i][2] += 0.6 * skin;
         x[j][2] -= 0.6 * skin;
-        assert!(
-            fresh().stale(&nodes, &x),
-            "neighbours moving apart past the skin"
-        );
+        assert!(fresh().stale(&x), "neighbours moving apart past the skin");
         // Smooth bends of growing amplitude: whenever not stale, the promise holds.
         let reach = rho_w + 2.0 * u_max;
         let (mut kept, mut checked) = (0, 0);
@@ -294,7 +304,7 @@ mod tests {
                 let r = (p[0] * p[0] + p[1] * p[1]).sqrt();
                 [0.3 * a, 0.0, a * (-r / 5e-3).exp() + 0.5 * a]
             });
-            if fresh().stale(&nodes, &x) {
+            if fresh().stale(&x) {
                 continue;
             }
             kept += 1;

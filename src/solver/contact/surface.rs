@@ -933,6 +933,10 @@ impl Side {
 /// Most cells a broad-phase grid may have per face box (past it, the cells grow).
 const GRID_CELLS_PER_BOX: usize = 8;
 
+/// Blocks of rows the broad-phase grid is filled by, in parallel (the grid is the same for
+/// any number).
+const GRID_BLOCKS: usize = 32;
+
 /// Cell size of the broad-phase grid as a fraction of the largest inflated face box:
 /// smaller cells list fewer boxes per lookup, but each box is entered in more cells
 /// (≤ 27 at ½). Measured on the 30 × 30 woven quarter (1 thread, 1141 steps): broad
@@ -942,7 +946,7 @@ const GRID_CELL_FRACTION: f64 = 0.5;
 /// Uniform grid over the inflated face boxes, as a dense array of cells (CSR): a cell is
 /// [`GRID_CELL_FRACTION`] of the largest box, so each box lies in ≤ 27 cells, and a
 /// point's candidates are the boxes listed in its own cell, in face order (a counting
-/// sort: O(n), no sort, and no search per point).
+/// sort: O(n), no sort, and no search per point; filled in parallel by blocks of rows).
 struct Grid {
     origin: [f64; 3],
     h: f64,
@@ -953,16 +957,28 @@ struct Grid {
 
 impl Grid {
     fn new(boxes: &[([f64; 3], [f64; 3])]) -> Grid {
-        let mut lo = [f64::INFINITY; 3];
-        let mut hi = [f64::NEG_INFINITY; 3];
-        let mut h: f64 = 1e-12;
-        for (a, b) in boxes {
-            for d in 0..3 {
-                lo[d] = lo[d].min(a[d]);
-                hi[d] = hi[d].max(b[d]);
-                h = h.max(b[d] - a[d]);
-            }
-        }
+        // Bounds and the largest box: minima and maxima, exact in any order.
+        type Bounds = ([f64; 3], [f64; 3], f64);
+        let merge = |p: Bounds, q: Bounds| -> Bounds {
+            (
+                std::array::from_fn(|d| p.0[d].min(q.0[d])),
+                std::array::from_fn(|d| p.1[d].max(q.1[d])),
+                p.2.max(q.2),
+            )
+        };
+        let none: Bounds = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3], 1e-12);
+        let (lo, hi, mut h) = boxes
+            .par_iter()
+            .fold(
+                || none,
+                |acc, (a, b)| {
+                    let w = (0..3)
+                        .map(|d| b[d] - a[d])
+                        .fold(f64::NEG_INFINITY, f64::max);
+                    merge(acc, (*a, *b, w))
+                },
+            )
+            .reduce(|| none, merge);
         h *= GRID_CELL_FRACTION;
         if boxes.is_empty() || !(0..3).all(|d| lo[d].is_finite() && hi[d].is_finite()) {
             return Grid {
@@ -987,39 +1003,100 @@ impl Grid {
             h *= 1.5;
         }
         let ncell = dims[0] * dims[1] * dims[2];
-        let index = |c: [usize; 3]| (c[2] * dims[1] + c[1]) * dims[0] + c[0];
         // Truncation is the floor here: every coordinate is ≥ the origin.
-        let cell = |p: &[f64; 3]| -> [usize; 3] {
-            std::array::from_fn(|d| (((p[d] - lo[d]) / h).max(0.0) as usize).min(dims[d] - 1))
+        let cell = |p: &[f64; 3]| -> [u32; 3] {
+            std::array::from_fn(|d| {
+                (((p[d] - lo[d]) / h).max(0.0) as usize).min(dims[d] - 1) as u32
+            })
         };
+        // Each box's cell range (first, last per axis).
+        let span: Vec<[[u32; 3]; 2]> = boxes.par_iter().map(|(a, b)| [cell(a), cell(b)]).collect();
+        // The cells are filled by blocks of whole rows (a row: the cells of one (j, k)),
+        // in parallel: each block takes the boxes that reach its rows, in box order, so a
+        // cell lists its boxes in box order whatever the blocks (a counting sort).
+        let nrows = dims[1] * dims[2];
+        let rows_per = nrows.div_ceil(GRID_BLOCKS).max(1);
+        let nblocks = nrows.div_ceil(rows_per);
+        let row_of = |j: u32, k: u32| k as usize * dims[1] + j as usize;
+        let mut members: Vec<Vec<u32>> = vec![Vec::new(); nblocks];
+        for (fi, [ca, cb]) in span.iter().enumerate() {
+            let mut last = usize::MAX;
+            for k in ca[2]..=cb[2] {
+                let (b0, b1) = (row_of(ca[1], k) / rows_per, row_of(cb[1], k) / rows_per);
+                for b in b0.max(last.wrapping_add(1))..=b1 {
+                    members[b].push(fi as u32);
+                    last = b;
+                }
+            }
+        }
+        // Visit the cells of block `b` that box `fi` covers.
+        let visit = |b: usize, fi: u32, f: &mut dyn FnMut(usize)| {
+            let [ca, cb] = span[fi as usize];
+            let (r0, r1) = (b * rows_per, ((b + 1) * rows_per).min(nrows));
+            for k in ca[2]..=cb[2] {
+                for j in ca[1]..=cb[1] {
+                    let r = row_of(j, k);
+                    if r < r0 || r >= r1 {
+                        continue;
+                    }
+                    for i in ca[0]..=cb[0] {
+                        f((r - r0) * dims[0] + i as usize);
+                    }
+                }
+            }
+        };
+        // Counts, then each block's running sums, then the blocks' offsets.
+        let block_cells = rows_per * dims[0];
         let mut count = vec![0u32; ncell + 1];
-        for (a, b) in boxes {
-            let (ca, cb) = (cell(a), cell(b));
-            for k in ca[2]..=cb[2] {
-                for j in ca[1]..=cb[1] {
-                    for i in ca[0]..=cb[0] {
-                        count[index([i, j, k]) + 1] += 1;
-                    }
+        let totals: Vec<u32> = count[1..]
+            .par_chunks_mut(block_cells)
+            .enumerate()
+            .map(|(b, cnt)| {
+                for &fi in &members[b] {
+                    visit(b, fi, &mut |c| cnt[c] += 1);
                 }
-            }
-        }
-        for c in 0..ncell {
-            count[c + 1] += count[c];
-        }
-        let mut fill = count.clone();
-        let mut items = vec![0u32; count[ncell] as usize];
-        for (fi, (a, b)) in boxes.iter().enumerate() {
-            let (ca, cb) = (cell(a), cell(b));
-            for k in ca[2]..=cb[2] {
-                for j in ca[1]..=cb[1] {
-                    for i in ca[0]..=cb[0] {
-                        let c = index([i, j, k]);
-                        items[fill[c] as usize] = fi as u32;
-                        fill[c] += 1;
-                    }
+                let mut run = 0u32;
+                for c in cnt.iter_mut() {
+                    run += *c;
+                    *c = run;
                 }
-            }
+                run
+            })
+            .collect();
+        let mut offsets = Vec::with_capacity(nblocks);
+        let mut run = 0u32;
+        for t in &totals {
+            offsets.push(run);
+            run += t;
         }
+        count[1..]
+            .par_chunks_mut(block_cells)
+            .zip(&offsets)
+            .for_each(|(cnt, &o)| cnt.iter_mut().for_each(|c| *c += o));
+        // Fill: each block writes its own slice of the items.
+        let mut items = vec![0u32; run as usize];
+        let mut slices: Vec<&mut [u32]> = Vec::with_capacity(nblocks);
+        let mut rest: &mut [u32] = &mut items;
+        for t in &totals {
+            let (head, tail) = rest.split_at_mut(*t as usize);
+            slices.push(head);
+            rest = tail;
+        }
+        let ptr = &count;
+        slices.into_par_iter().enumerate().for_each(|(b, out)| {
+            let c0 = b * block_cells;
+            let base = offsets[b];
+            let mut fill: Vec<u32> = ptr[c0..(c0 + block_cells).min(ncell)]
+                .iter()
+                .map(|&p| p - base)
+                .collect();
+            for &fi in &members[b] {
+                visit(b, fi, &mut |c| {
+                    out[fill[c] as usize] = fi;
+                    fill[c] += 1;
+                });
+            }
+        });
         Grid {
             origin: lo,
             h,
@@ -1217,7 +1294,7 @@ impl SurfaceContact {
 
     /// Whether the candidate lists may miss a pair at `x` (see [`Staleness`]).
     fn stale(&mut self, x: &[[f64; 3]]) -> bool {
-        self.motion.stale(&self.nodes, x)
+        self.motion.stale(x)
     }
 
     /// Setup at the start positions `x` (the reference plus any initial displacement):
@@ -1413,6 +1490,12 @@ mod tests {
             })
             .collect();
         let grid = Grid::new(&boxes);
+        // Boxes spanning several blocks of rows of the parallel fill.
+        assert!(
+            grid.dims[1] * grid.dims[2] > 4 * super::GRID_BLOCKS,
+            "{:?}",
+            grid.dims
+        );
         let inside = |p: &[f64; 3], b: &([f64; 3], [f64; 3])| {
             (0..3).all(|d| p[d] >= b.0[d] && p[d] <= b.1[d])
         };
