@@ -186,6 +186,10 @@ pub fn closest_on_triangle(p: &[f64; 3], a: &[f64; 3], b: &[f64; 3], c: &[f64; 3
     }
     let vc = d1 * d4 - d3 * d2;
     if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        // d1 − d3 = |ab|² is 0 only for a = b: the triangle is a segment (0/0 otherwise).
+        if !(d1 - d3 > 0.0) {
+            return closest_on_edges(p, a, b, c);
+        }
         let v = d1 / (d1 - d3);
         return [1.0 - v, v, 0.0];
     }
@@ -196,17 +200,62 @@ pub fn closest_on_triangle(p: &[f64; 3], a: &[f64; 3], b: &[f64; 3], c: &[f64; 3
     }
     let vb = d5 * d2 - d1 * d6;
     if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        if !(d2 - d6 > 0.0) {
+            return closest_on_edges(p, a, b, c);
+        }
         let w = d2 / (d2 - d6);
         return [1.0 - w, 0.0, w];
     }
     let va = d3 * d6 - d5 * d4;
     if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+        if !((d4 - d3) + (d5 - d6) > 0.0) {
+            return closest_on_edges(p, a, b, c);
+        }
         let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
         return [0.0, 1.0 - w, w];
     }
-    let denom = 1.0 / (va + vb + vc);
+    // va + vb + vc = |ab × ac|² = |ab|²|ac|² sin²θ. Each carries a round-off of order
+    // ε|ab|²|ac|², so the weights of a sliver (sin²θ ≤ 10⁻¹⁰) are noise (measured: a
+    // collinear triangle gave a point 0.09 of its length off): its edges' nearest point
+    // instead, within its height (≤ 10⁻⁵ of its size) of the true one.
+    let area2 = va + vb + vc;
+    if !(area2 > SLIVER * dot(&ab, &ab) * dot(&ac, &ac)) {
+        return closest_on_edges(p, a, b, c);
+    }
+    let denom = 1.0 / area2;
     let (v, w) = (vb * denom, vc * denom);
     [1.0 - v - w, v, w]
+}
+
+/// sin²θ below which [`closest_on_triangle`] treats a triangle as a sliver.
+const SLIVER: f64 = 1e-10;
+
+/// Closest point of the three edges of a triangle (a, b, c) to p, as weights: the
+/// fallback of [`closest_on_triangle`] for a triangle of no area.
+#[cold]
+fn closest_on_edges(p: &[f64; 3], a: &[f64; 3], b: &[f64; 3], c: &[f64; 3]) -> [f64; 3] {
+    let seg = |x: &[f64; 3], y: &[f64; 3]| -> (f64, f64) {
+        let e = [y[0] - x[0], y[1] - x[1], y[2] - x[2]];
+        let ee = e[0] * e[0] + e[1] * e[1] + e[2] * e[2];
+        let t = if ee > 0.0 {
+            (((p[0] - x[0]) * e[0] + (p[1] - x[1]) * e[1] + (p[2] - x[2]) * e[2]) / ee)
+                .clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        let r: [f64; 3] = std::array::from_fn(|d| p[d] - (x[d] + t * e[d]));
+        (t, r[0] * r[0] + r[1] * r[1] + r[2] * r[2])
+    };
+    let (tab, dab) = seg(a, b);
+    let (tbc, dbc) = seg(b, c);
+    let (tca, dca) = seg(c, a);
+    if dab <= dbc && dab <= dca {
+        [1.0 - tab, tab, 0.0]
+    } else if dbc <= dca {
+        [0.0, 1.0 - tbc, tbc]
+    } else {
+        [tca, 0.0, 1.0 - tca]
+    }
 }
 
 // ---------------------------------------------------------------------------------------

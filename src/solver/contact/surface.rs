@@ -1464,6 +1464,84 @@ mod tests {
     use super::super::uniform;
     use super::Grid;
 
+    /// The triangle kernel's closest point is the projection onto the triangle: by the
+    /// projection theorem for a convex set, q is the closest point of the triangle to p iff
+    /// (p − q)·(y − q) ≤ 0 for each of its vertices y (the oracle, independent of the
+    /// kernel's Voronoi regions), and its weights are barycentric (≥ 0, summing to 1).
+    /// The four triangles of random quads' two splits, warped and flat, with points near
+    /// and far; degenerate ones (coincident, collinear nodes) must give finite weights and
+    /// a point no farther than any vertex.
+    #[test]
+    fn triangle_projection_satisfies_the_projection_theorem() {
+        use super::super::closest_on_triangle;
+        let mut st = 11u64;
+        let tris = [[0, 1, 2], [0, 2, 3], [1, 2, 3], [1, 3, 0]];
+        let (mut n_checked, mut worst) = (0usize, 0.0f64);
+        for case in 0..40_000 {
+            let mut x: [[f64; 3]; 4] = [
+                [0.0, 0.0, 0.0],
+                [1.0, 0.0, 0.0],
+                [1.0, 1.0, 0.0],
+                [0.0, 1.0, 0.0],
+            ];
+            for a in &mut x {
+                for c in a.iter_mut() {
+                    *c += 0.4 * (uniform(&mut st) - 0.5);
+                }
+            }
+            match case % 8 {
+                // Coincident nodes, a collinear quad, a flat one.
+                5 => x[2] = x[1],
+                6 => {
+                    for a in 0..4 {
+                        x[a] = [a as f64 * 0.3, 0.0, 0.0];
+                    }
+                }
+                7 => x.iter_mut().for_each(|a| a[2] = 0.0),
+                _ => {}
+            }
+            let mut p: [f64; 3] = std::array::from_fn(|_| 3.0 * (uniform(&mut st) - 0.5) + 0.5);
+            match case % 11 {
+                // On a vertex, on an edge.
+                9 => p = x[(case / 11) % 4],
+                10 => p = std::array::from_fn(|d| 0.5 * (x[0][d] + x[1][d])),
+                _ => {}
+            }
+            for t in &tris {
+                let w = closest_on_triangle(&p, &x[t[0]], &x[t[1]], &x[t[2]]);
+                assert!(
+                    w.iter().all(|c| c.is_finite() && *c >= 0.0),
+                    "case {case}: {w:?}"
+                );
+                assert!(
+                    (w[0] + w[1] + w[2] - 1.0).abs() < 1e-15,
+                    "case {case}: {w:?}"
+                );
+                let q: [f64; 3] = std::array::from_fn(|d| (0..3).map(|k| w[k] * x[t[k]][d]).sum());
+                let r: [f64; 3] = std::array::from_fn(|d| p[d] - q[d]);
+                let rr: f64 = r.iter().map(|c| c * c).sum();
+                for &y in t {
+                    let py: f64 = (0..3).map(|d| (p[d] - x[y][d]).powi(2)).sum();
+                    assert!(
+                        rr <= py * (1.0 + 1e-14),
+                        "case {case}: farther than vertex {y}: {w:?}"
+                    );
+                }
+                if case % 8 >= 5 {
+                    continue; // degenerate: the projection theorem needs a true triangle
+                }
+                for &y in t {
+                    let e: f64 = (0..3).map(|d| r[d] * (x[y][d] - q[d])).sum();
+                    worst = worst.max(e);
+                }
+                n_checked += 1;
+            }
+        }
+        // Measured: worst (p − q)·(y − q) 7.6e-16 (round-off on unit-size triangles).
+        assert!(n_checked >= 100_000, "{n_checked}");
+        assert!(worst < 4e-15, "projection theorem violated by {worst}");
+    }
+
     /// The grid's candidates of a point, filtered by box containment, are exactly the
     /// boxes that contain it by brute force (the oracle), in box order; points outside
     /// every box, on box faces and beyond the grid included.
