@@ -88,6 +88,7 @@ pub struct Reference<const N: usize> {
 }
 
 use super::vec3::{cross, dot, sub, unit};
+use rayon::prelude::*;
 
 impl<const N: usize> Reference<N> {
     /// Set up from the reference positions; `angle` turns material direction 1 from the
@@ -465,9 +466,18 @@ impl<const N: usize> MembraneGroup<N> {
         extra: &mut [f64],
         most: &mut [Option<(f64, ElementKind, i64, [f64; 3])>],
     ) {
-        for (e, ns) in self.nodes.iter().enumerate() {
-            let xe: [[f64; 3]; N] = std::array::from_fn(|a| x[ns[a] as usize]);
-            let (r, strain) = stiffening(&xe, &self.reference[e], &self.material[e]);
+        // The elements' ratios in parallel, added to their nodes in element order (the
+        // same sums whatever the threads).
+        let ratios: Vec<(f64, [f64; 3])> = (0..self.nodes.len())
+            .into_par_iter()
+            .with_min_len(1024)
+            .map(|e| {
+                let ns = &self.nodes[e];
+                let xe: [[f64; 3]; N] = std::array::from_fn(|a| x[ns[a] as usize]);
+                stiffening(&xe, &self.reference[e], &self.material[e])
+            })
+            .collect();
+        for (e, (ns, &(r, strain))) in self.nodes.iter().zip(&ratios).enumerate() {
             if r <= 1.0 {
                 continue;
             }

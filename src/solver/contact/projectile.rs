@@ -218,8 +218,9 @@ pub fn closest_on_triangle(p: &[f64; 3], a: &[f64; 3], b: &[f64; 3], c: &[f64; 3
     // ε|ab|²|ac|², so the weights of a sliver (sin²θ ≤ 10⁻¹⁰) are noise (measured: a
     // collinear triangle gave a point 0.09 of its length off): its edges' nearest point
     // instead, within its height (≤ 10⁻⁵ of its size) of the true one.
+    // (d1 − d3 = |ab|², d2 − d6 = |ac|².)
     let area2 = va + vb + vc;
-    if !(area2 > SLIVER * dot(&ab, &ab) * dot(&ac, &ac)) {
+    if !(area2 > SLIVER * (d1 - d3) * (d2 - d6)) {
         return closest_on_edges(p, a, b, c);
     }
     let denom = 1.0 / area2;
@@ -491,12 +492,22 @@ impl ProjectileContact {
             if p.segments && p.nose_centre().is_some() {
                 // Exact: the sphere against the closest point of every face triangle.
                 let c = p.nose_centre().expect("spherical nose");
-                // Only the listed triangles: the others are farther than the radius.
-                for &ti in &self.near[k] {
+                // Only the listed triangles: the others are farther than the radius. The
+                // contacts are found in parallel and applied in list order (the same sums
+                // whatever the threads; measured, this loop alone was ~3 % of a woven
+                // impact's CPU time and ran on one thread).
+                let pp = &*p;
+                let tris = &self.face_tris;
+                let hits: Vec<(u32, [f64; 3], [f64; 3], f64, f64)> = self.near[k]
+                    .par_iter()
+                    .with_min_len(256)
+                    .filter_map(|&ti| {
+                        sphere_face(pp, &c, &tris[ti as usize], x, dt2)
+                            .map(|(w, n, g, kp)| (ti, w, n, g, kp))
+                    })
+                    .collect();
+                for (ti, w, n, g, kp) in hits {
                     let t = &self.face_tris[ti as usize];
-                    let Some((w, n, g, kp)) = sphere_face(p, &c, t, x, dt2) else {
-                        continue;
-                    };
                     let fnorm = kp * g;
                     let mut f = [n[0] * fnorm, n[1] * fnorm, n[2] * fnorm];
                     if p.friction > 0.0 {
