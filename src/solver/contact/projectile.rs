@@ -638,16 +638,25 @@ impl ProjectileContact {
             .collect();
     }
 
-    /// Stored penalty energy ½ Σ k g² at the positions `x`.
+    /// Stored penalty energy ½ Σ k g² at the positions `x`. The terms are found in
+    /// parallel and summed in triangle and node order (the same sum whatever the threads;
+    /// measured, the serial loops over every face triangle were ~1 % of a woven impact's
+    /// CPU time, on one thread while the other waited).
     pub fn energy(&self, x: &[[f64; 3]], mass: &[f64], dt: f64) -> f64 {
         let dt2 = dt * dt;
         let mut e = 0.0;
         for p in self.projectiles.iter().filter(|p| p.segments) {
             if let Some(c) = p.nose_centre() {
-                for t in &self.face_tris {
-                    if let Some((_, _, g, kp)) = sphere_face(p, &c, t, x, dt2) {
-                        e += 0.5 * kp * g.powi(2);
-                    }
+                let terms: Vec<f64> = self
+                    .face_tris
+                    .par_iter()
+                    .with_min_len(4096)
+                    .filter_map(|t| {
+                        sphere_face(p, &c, t, x, dt2).map(|(_, _, g, kp)| 0.5 * kp * g.powi(2))
+                    })
+                    .collect();
+                for t in terms {
+                    e += t;
                 }
                 continue;
             }
@@ -662,13 +671,19 @@ impl ProjectileContact {
             }
         }
         for p in &self.projectiles {
-            for i in 0..x.len() {
-                if mass[i] <= 0.0 {
-                    continue;
-                }
-                if let Some((g, _)) = p.penetration(&x[i]) {
-                    e += 0.5 * p.stiffness.unwrap_or(self.k_node[i]) * g * g;
-                }
+            let terms: Vec<f64> = (0..x.len())
+                .into_par_iter()
+                .with_min_len(4096)
+                .filter_map(|i| {
+                    if mass[i] <= 0.0 {
+                        return None;
+                    }
+                    p.penetration(&x[i])
+                        .map(|(g, _)| 0.5 * p.stiffness.unwrap_or(self.k_node[i]) * g * g)
+                })
+                .collect();
+            for t in terms {
+                e += t;
             }
         }
         e

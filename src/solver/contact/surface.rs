@@ -68,6 +68,9 @@ use crate::solver::vec3::{add, cross, dot, sub};
 /// Slaves per parallel chunk of the narrow phase.
 const SLAVE_CHUNK: usize = 256;
 
+/// Most slave chunks of one narrow-phase task (see [`Side::narrow`]).
+const NARROW_TASK_CHUNKS: usize = 4;
+
 /// Gradient in the face's plane of its interpolated nodal thickness, at the face centre
 /// (exact for a thickness linear over the face, as across a lenticular band's quads); zero
 /// for a uniform thickness or a segment.
@@ -925,6 +928,11 @@ impl Side {
                 .zip(self.chunk_reactions.par_iter_mut())
                 .zip(self.chunk_sums.par_iter_mut())
                 .enumerate()
+                // A task per few chunks: the slaves in contact cluster under the nose, and
+                // rayon's default split leaves quarters of the range that a second thread
+                // cannot steal from (measured by thread in perf: the narrow phase's
+                // samples 14.8 % against 13.2 %, the second thread idle meanwhile).
+                .with_max_len(NARROW_TASK_CHUNKS)
                 .for_each(body);
         }
     }
