@@ -631,16 +631,32 @@ impl Side {
                 (counts, list)
             })
             .collect();
-        let mut ptr = Vec::with_capacity(ns + 1);
-        ptr.push(0u32);
-        let mut cand = Vec::with_capacity(chunks.iter().map(|c| c.1.len()).sum());
-        for (counts, list) in chunks {
-            for c in counts {
-                let last = *ptr.last().unwrap();
-                ptr.push(last + c);
-            }
-            cand.extend_from_slice(&list);
+        // The chunks' offsets, then each chunk writes its own slices of the lists and of
+        // the pointers, in parallel.
+        let mut offsets = Vec::with_capacity(chunks.len());
+        let mut total = 0u32;
+        for (_, list) in &chunks {
+            offsets.push(total);
+            total += list.len() as u32;
         }
+        let mut ptr = vec![0u32; ns + 1];
+        let mut cand = vec![0u32; total as usize];
+        let (mut ptr_rest, mut cand_rest) = (&mut ptr[1..], &mut cand[..]);
+        let mut jobs = Vec::with_capacity(chunks.len());
+        for ((counts, list), &o) in chunks.iter().zip(&offsets) {
+            let (p, pt) = std::mem::take(&mut ptr_rest).split_at_mut(counts.len());
+            let (c, ct) = std::mem::take(&mut cand_rest).split_at_mut(list.len());
+            (ptr_rest, cand_rest) = (pt, ct);
+            jobs.push((counts, list, o, p, c));
+        }
+        jobs.into_par_iter().for_each(|(counts, list, o, p, c)| {
+            c.copy_from_slice(list);
+            let mut run = o;
+            for (q, &n) in p.iter_mut().zip(counts) {
+                run += n;
+                *q = run;
+            }
+        });
         self.cand_ptr = ptr;
         self.cand = cand;
     }
@@ -1026,17 +1042,35 @@ impl Grid {
         let rows_per = nrows.div_ceil(GRID_BLOCKS).max(1);
         let nblocks = nrows.div_ceil(rows_per);
         let row_of = |j: u32, k: u32| k as usize * dims[1] + j as usize;
-        let mut members: Vec<Vec<u32>> = vec![Vec::new(); nblocks];
-        for (fi, [ca, cb]) in span.iter().enumerate() {
-            let mut last = usize::MAX;
-            for k in ca[2]..=cb[2] {
-                let (b0, b1) = (row_of(ca[1], k) / rows_per, row_of(cb[1], k) / rows_per);
-                for b in b0.max(last.wrapping_add(1))..=b1 {
-                    members[b].push(fi as u32);
-                    last = b;
+        // The boxes that reach each block, in box order: found in parallel over fixed
+        // ranges of boxes (`members[r][b]`, read range after range; the same lists for
+        // any number of threads), each row's block looked up rather than divided for
+        // (measured: this loop was most of the rebuild's serial time).
+        let block_of: Vec<u32> = (0..nrows).map(|r| (r / rows_per) as u32).collect();
+        let per_range = span.len().div_ceil(GRID_BLOCKS).max(1);
+        let members: Vec<Vec<Vec<u32>>> = span
+            .par_chunks(per_range)
+            .enumerate()
+            .map(|(ri, range)| {
+                let f0 = ri * per_range;
+                let mut m: Vec<Vec<u32>> = vec![Vec::new(); nblocks];
+                for (j, [ca, cb]) in range.iter().enumerate() {
+                    let mut last = usize::MAX;
+                    for k in ca[2]..=cb[2] {
+                        let (b0, b1) = (
+                            block_of[row_of(ca[1], k)] as usize,
+                            block_of[row_of(cb[1], k)] as usize,
+                        );
+                        for b in b0.max(last.wrapping_add(1))..=b1 {
+                            m[b].push((f0 + j) as u32);
+                            last = b;
+                        }
+                    }
                 }
-            }
-        }
+                m
+            })
+            .collect();
+        let block_members = |b: usize| members.iter().flat_map(move |m| m[b].iter().copied());
         // Visit the cells of block `b` that box `fi` covers.
         let visit = |b: usize, fi: u32, f: &mut dyn FnMut(usize)| {
             let [ca, cb] = span[fi as usize];
@@ -1060,7 +1094,7 @@ impl Grid {
             .par_chunks_mut(block_cells)
             .enumerate()
             .map(|(b, cnt)| {
-                for &fi in &members[b] {
+                for fi in block_members(b) {
                     visit(b, fi, &mut |c| cnt[c] += 1);
                 }
                 let mut run = 0u32;
@@ -1098,7 +1132,7 @@ impl Grid {
                 .iter()
                 .map(|&p| p - base)
                 .collect();
-            for &fi in &members[b] {
+            for fi in block_members(b) {
                 visit(b, fi, &mut |c| {
                     out[fill[c] as usize] = fi;
                     fill[c] += 1;
@@ -1288,11 +1322,13 @@ impl SurfaceContact {
             .sides
             .iter()
             .map(|s| {
+                // (A maximum: exact in any order.)
                 let w = s
                     .face_box
-                    .iter()
+                    .par_iter()
+                    .with_min_len(4096)
                     .map(|b| (b[3] - b[0]).max(b[4] - b[1]).max(b[5] - b[2]))
-                    .fold(0.0, f64::max);
+                    .reduce(|| 0.0, f64::max);
                 0.5 * s.slave_t_max + s.box_margin + w
             })
             .fold(0.0, f64::max);
