@@ -1571,7 +1571,7 @@ mod tests {
                         "case {case}: farther than vertex {y}: {w:?}"
                     );
                 }
-                if case % 8 >= 5 {
+                if case % 8 == 5 || case % 8 == 6 {
                     continue; // degenerate: the projection theorem needs a true triangle
                 }
                 for &y in t {
@@ -1582,7 +1582,7 @@ mod tests {
             }
         }
         // Measured: worst (p − q)·(y − q) 7.6e-16 (round-off on unit-size triangles).
-        assert!(n_checked >= 100_000, "{n_checked}");
+        assert!(n_checked >= 120_000, "{n_checked}");
         assert!(worst < 4e-15, "projection theorem violated by {worst}");
     }
 
