@@ -231,21 +231,27 @@ pub fn closest_on_triangle(p: &[f64; 3], a: &[f64; 3], b: &[f64; 3], c: &[f64; 3
 /// sin²θ below which [`closest_on_triangle`] treats a triangle as a sliver.
 const SLIVER: f64 = 1e-10;
 
+/// Closest point of the segment (a, b) to p, as the parameter t ∈ [0, 1] of a + t(b − a)
+/// (0 for a segment of no length).
+#[inline]
+pub fn closest_on_segment(p: &[f64; 3], a: &[f64; 3], b: &[f64; 3]) -> f64 {
+    let e = sub(b, a);
+    let ee = dot(&e, &e);
+    if ee > 0.0 {
+        (dot(&sub(p, a), &e) / ee).clamp(0.0, 1.0)
+    } else {
+        0.0
+    }
+}
+
 /// Closest point of the three edges of a triangle (a, b, c) to p, as weights: the
 /// fallback of [`closest_on_triangle`] for a triangle of no area.
 #[cold]
 fn closest_on_edges(p: &[f64; 3], a: &[f64; 3], b: &[f64; 3], c: &[f64; 3]) -> [f64; 3] {
     let seg = |x: &[f64; 3], y: &[f64; 3]| -> (f64, f64) {
-        let e = [y[0] - x[0], y[1] - x[1], y[2] - x[2]];
-        let ee = e[0] * e[0] + e[1] * e[1] + e[2] * e[2];
-        let t = if ee > 0.0 {
-            (((p[0] - x[0]) * e[0] + (p[1] - x[1]) * e[1] + (p[2] - x[2]) * e[2]) / ee)
-                .clamp(0.0, 1.0)
-        } else {
-            0.0
-        };
-        let r: [f64; 3] = std::array::from_fn(|d| p[d] - (x[d] + t * e[d]));
-        (t, r[0] * r[0] + r[1] * r[1] + r[2] * r[2])
+        let t = closest_on_segment(p, x, y);
+        let r: [f64; 3] = std::array::from_fn(|d| p[d] - (x[d] + t * (y[d] - x[d])));
+        (t, dot(&r, &r))
     };
     let (tab, dab) = seg(a, b);
     let (tbc, dbc) = seg(b, c);
@@ -266,7 +272,7 @@ fn closest_on_edges(p: &[f64; 3], a: &[f64; 3], b: &[f64; 3], c: &[f64; 3]) -> [
 use rayon::prelude::*;
 
 use crate::model::Model;
-use crate::solver::vec3::{add, dot};
+use crate::solver::vec3::{add, dot, sub};
 
 /// Skin of the projectile's list of nearby face triangles, as a fraction of its radius:
 /// the list holds every triangle that could come within the radius before the nose

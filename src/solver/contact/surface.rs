@@ -127,13 +127,7 @@ pub const MAX_THICKNESS_GRADIENT: f64 = 2.0;
 pub fn closest_on_face(p: &[f64; 3], x: &[[f64; 3]; 4], n: usize) -> [f64; 4] {
     match n {
         2 => {
-            let e = sub(&x[1], &x[0]);
-            let ee = dot(&e, &e);
-            let t = if ee > 0.0 {
-                (dot(&sub(p, &x[0]), &e) / ee).clamp(0.0, 1.0)
-            } else {
-                0.0
-            };
+            let t = super::closest_on_segment(p, &x[0], &x[1]);
             [1.0 - t, t, 0.0, 0.0]
         }
         3 => {
