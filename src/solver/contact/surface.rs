@@ -804,7 +804,7 @@ impl Side {
                         // foot q = Σ w_a x_a has the support m·q + t_F/2 = Σ w_a (m·x_a +
                         // t_a/2) ≤ max_a (m·x_a + t_a/2) = h along a unit m, so a slave with
                         // m·x_s ≥ h + t_s/2 is at least (t_s + t_F)/2 from q (η as above:
-                        // the same bits). Measured on the 60 × 60 to 20 µs: 65 % of the
+                        // the same bits). Measured on the 60 × 60 to 20 µs: 60 % of the
                         // faces that pass the box test fail this one, none penetrated.
                         if NF >= 3 {
                             let mut kept = 0;
