@@ -518,6 +518,7 @@ impl Side {
             .chain(faces.iter().flat_map(|f| f[..npe].iter()))
             .flat_map(|&n| m.coords[n as usize])
             .fold(0.0, |a: f64, c| a.max(c.abs()));
+        let n_faces = faces.len();
         Side {
             contact_id: d.id,
             row,
@@ -550,8 +551,10 @@ impl Side {
             box_margin: BOX_MARGIN * (x_max + 0.5 * (ts_max + tf_max)),
             cand_ptr: vec![],
             cand: vec![],
-            face_box: vec![],
-            face_dir: vec![],
+            // Before the first broad phase there are no directions yet: zero ones never
+            // reject.
+            face_box: vec![[0.0; 8]; n_faces],
+            face_dir: vec![[0.0; 6]; n_faces],
             chunk_active: vec![],
             chunk_reactions: vec![],
             chunk_sums: vec![],
@@ -576,10 +579,7 @@ impl Side {
     /// those gathers were ~40 % of the narrow phase of the woven patch).
     fn update_boxes(&mut self, x: &[[f64; 3]]) {
         let (faces, face_t, nf) = (&self.faces, &self.face_t, self.nf);
-        // Before the first broad phase there are no directions yet: zero ones never reject.
-        self.face_dir.resize(faces.len(), [0.0; 6]);
         let dirs = &self.face_dir;
-        self.face_box.resize(faces.len(), [0.0; 8]);
         self.face_box
             .par_chunks_mut(4096)
             .enumerate()
@@ -604,8 +604,6 @@ impl Side {
             return;
         }
         // (The boxes are up to date: only the bounds along the new directions change.)
-        self.face_dir.resize(faces.len(), [0.0; 6]);
-        self.face_box.resize(faces.len(), [0.0; 8]);
         self.face_dir
             .par_chunks_mut(4096)
             .zip(self.face_box.par_chunks_mut(4096))
@@ -1610,6 +1608,23 @@ mod tests {
     use super::super::uniform;
     use super::Grid;
 
+    /// The rectangle 1 × `width` in the xy plane (nodes counter-clockwise from the origin),
+    /// each coordinate moved by up to ±`amp`/2 at random: a warped quad.
+    fn jittered_rectangle(width: f64, amp: f64, st: &mut u64) -> [[f64; 3]; 4] {
+        let mut x = [
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [1.0, width, 0.0],
+            [0.0, width, 0.0],
+        ];
+        for a in &mut x {
+            for c in a.iter_mut() {
+                *c += amp * (uniform(st) - 0.5);
+            }
+        }
+        x
+    }
+
     /// The triangle kernel's closest point is the projection onto the triangle: by the
     /// projection theorem for a convex set, q is the closest point of the triangle to p iff
     /// (p − q)·(y − q) ≤ 0 for each of its vertices y (the oracle, independent of the
@@ -1624,17 +1639,7 @@ mod tests {
         let tris = [[0, 1, 2], [0, 2, 3], [1, 2, 3], [1, 3, 0]];
         let (mut n_checked, mut worst) = (0usize, 0.0f64);
         for case in 0..40_000 {
-            let mut x: [[f64; 3]; 4] = [
-                [0.0, 0.0, 0.0],
-                [1.0, 0.0, 0.0],
-                [1.0, 1.0, 0.0],
-                [0.0, 1.0, 0.0],
-            ];
-            for a in &mut x {
-                for c in a.iter_mut() {
-                    *c += 0.4 * (uniform(&mut st) - 0.5);
-                }
-            }
+            let mut x = jittered_rectangle(1.0, 0.4, &mut st);
             match case % 8 {
                 // Coincident nodes, a collinear quad, a flat one.
                 5 => x[2] = x[1],
@@ -1704,17 +1709,7 @@ mod tests {
         let (mut penetrating, mut rejected, mut worst) = (0usize, 0usize, f64::NEG_INFINITY);
         for case in 0..60_000 {
             let nf = if case % 5 == 4 { 3 } else { 4 };
-            let mut x: Vec<[f64; 3]> = vec![
-                [0.0, 0.0, 0.0],
-                [1.0, 0.0, 0.0],
-                [1.0, 0.4, 0.0],
-                [0.0, 0.4, 0.0],
-            ];
-            for a in &mut x {
-                for c in a.iter_mut() {
-                    *c += 0.3 * (uniform(&mut st) - 0.5);
-                }
-            }
+            let x = jittered_rectangle(0.4, 0.3, &mut st);
             let t: [f64; 4] = match case % 3 {
                 0 => [0.2, 0.0, 0.0, 0.2],
                 1 => std::array::from_fn(|_| 0.3 * uniform(&mut st)),
