@@ -116,7 +116,14 @@ impl Projectile {
             (rr < r && rr > 0.0).then(|| (r - rr, [dc[0] / rr, dc[1] / rr, dc[2] / rr]))
         };
         let radial = [d[0] - s * a[0], d[1] - s * a[1], d[2] - s * a[2]];
-        let rho = (radial[0] * radial[0] + radial[1] * radial[1] + radial[2] * radial[2]).sqrt();
+        let rho2 = radial[0] * radial[0] + radial[1] * radial[1] + radial[2] * radial[2];
+        // Every shape lies within the radius of the axis: a point farther out is not
+        // inside (most of a fabric's nodes, each step). The margin keeps the points whose
+        // distance to the nose centre might still round below the radius.
+        if rho2 > r * r * (1.0 + 1e-9) {
+            return None;
+        }
+        let rho = rho2.sqrt();
         let side_n = || {
             if rho > 0.0 {
                 [radial[0] / rho, radial[1] / rho, radial[2] / rho]
