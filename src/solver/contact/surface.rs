@@ -788,26 +788,17 @@ impl Side {
                             p[0], p[1], p[2], reach, r2, block, face_box, face_dir, &mut near,
                         );
                         for &fi in &near[..nn] {
-                            let f = &faces[fi as usize];
-                            let xf: [[f64; 3]; 4] = std::array::from_fn(|a| {
-                                if a < nf {
-                                    x[f[a] as usize]
-                                } else {
-                                    [0.0; 3]
-                                }
-                            });
-                            let w = closest_on_face(&p, &xf, nf);
-                            let q: [f64; 3] =
-                                std::array::from_fn(|d| (0..nf).map(|a| w[a] * xf[a][d]).sum());
-                            let tf: f64 = (0..nf).map(|a| w[a] * face_t[fi as usize][a]).sum();
-                            let r = sub(&p, &q);
-                            let c = 0.5 * (slave_t[si] + tf);
-                            let d2 = dot(&r, &r);
-                            if d2 >= c * c {
+                            let Some(Hit { w, g, dist, r, tg, flat }) = evaluate_face::<NF>(
+                                p[0],
+                                p[1],
+                                p[2],
+                                slave_t[si],
+                                &faces[fi as usize],
+                                &face_t[fi as usize],
+                                x,
+                            ) else {
                                 continue;
-                            }
-                            let dist = d2.sqrt();
-                            let g = c - dist;
+                            };
                             if n_pen < MAX_SHARED {
                                 pen[n_pen] = (fi, w, g);
                                 n_pen += 1;
@@ -824,7 +815,6 @@ impl Side {
                                 }
                             }
                             if dist > 0.0 {
-                                let tg = thickness_gradient(&face_t[fi as usize], &xf, nf);
                                 for d in 0..3 {
                                     n_sum[d] += g * r[d] / dist;
                                     tg_sum[d] += g * tg[d];
@@ -836,13 +826,7 @@ impl Side {
                                 let n = if dist > 0.0 {
                                     [r[0] / dist, r[1] / dist, r[2] / dist]
                                 } else {
-                                    let c = cross(&sub(&xf[1], &xf[0]), &sub(&xf[nf - 1], &xf[0]));
-                                    let cn = dot(&c, &c).sqrt();
-                                    if cn > 0.0 {
-                                        [c[0] / cn, c[1] / cn, c[2] / cn]
-                                    } else {
-                                        [0.0, 0.0, 1.0]
-                                    }
+                                    flat
                                 };
                                 best = Some((fi, g, n));
                             }
@@ -979,6 +963,74 @@ impl Side {
                 .for_each(body);
         }
     }
+}
+
+/// A face a slave penetrates: the weights `w` of its foot q, the penetration `g` = c − |r|
+/// (c = (t_s + t_F)/2), |r| and r = x_s − q, the face's in-plane thickness gradient (when
+/// |r| > 0) and, for a slave on the mid-surface (|r| = 0), the face's unit normal.
+struct Hit {
+    w: [f64; 4],
+    g: f64,
+    dist: f64,
+    r: [f64; 3],
+    tg: [f64; 3],
+    flat: [f64; 3],
+}
+
+/// The closest point of face `f` (thicknesses `ft`) to a slave at (px, py, pz) of
+/// thickness `ts`, and whether the slave penetrates it. (A function of its own, its loads
+/// first: inlined in the slave loop, the gathers of the face's nodes and thicknesses went
+/// through the stack and the thicknesses were read only after the projection.)
+#[inline(never)]
+#[allow(clippy::too_many_arguments)]
+fn evaluate_face<const NF: usize>(
+    px: f64,
+    py: f64,
+    pz: f64,
+    ts: f64,
+    f: &[u32; 4],
+    ft: &[f64; 4],
+    x: &[[f64; 3]],
+) -> Option<Hit> {
+    let (f, t) = (*f, *ft);
+    let p = [px, py, pz];
+    let xf: [[f64; 3]; 4] = [
+        x[f[0] as usize],
+        x[f[1] as usize],
+        if NF > 2 { x[f[2] as usize] } else { [0.0; 3] },
+        if NF > 3 { x[f[3] as usize] } else { [0.0; 3] },
+    ];
+    let nf = NF;
+    let w = closest_on_face(&p, &xf, nf);
+    let q: [f64; 3] = std::array::from_fn(|d| (0..nf).map(|a| w[a] * xf[a][d]).sum());
+    let tf: f64 = (0..nf).map(|a| w[a] * t[a]).sum();
+    let r = sub(&p, &q);
+    let c = 0.5 * (ts + tf);
+    let d2 = dot(&r, &r);
+    if d2 >= c * c {
+        return None;
+    }
+    let dist = d2.sqrt();
+    let (tg, flat) = if dist > 0.0 {
+        (thickness_gradient(&t, &xf, nf), [0.0; 3])
+    } else {
+        let c = cross(&sub(&xf[1], &xf[0]), &sub(&xf[nf - 1], &xf[0]));
+        let cn = dot(&c, &c).sqrt();
+        let n = if cn > 0.0 {
+            [c[0] / cn, c[1] / cn, c[2] / cn]
+        } else {
+            [0.0, 0.0, 1.0]
+        };
+        ([0.0; 3], n)
+    };
+    Some(Hit {
+        w,
+        g: c - dist,
+        dist,
+        r,
+        tg,
+        flat,
+    })
 }
 
 /// The candidates of `block` a slave at (px, py, pz) may penetrate, in order, into `near`;
