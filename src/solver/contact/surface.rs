@@ -978,9 +978,10 @@ struct Hit {
 }
 
 /// The closest point of face `f` (thicknesses `ft`) to a slave at (px, py, pz) of
-/// thickness `ts`, and whether the slave penetrates it. (A function of its own, its loads
-/// first: inlined in the slave loop, the gathers of the face's nodes and thicknesses went
-/// through the stack and the thicknesses were read only after the projection.)
+/// thickness `ts`, and whether the slave penetrates it. (A function of its own: inlined in
+/// the slave loop, the gathers of the face's nodes went through the stack and were
+/// reloaded as pairs spanning two stores; the compiler still reads the thicknesses only
+/// after the projection, where perf puts most of this function's own samples.)
 #[inline(never)]
 #[allow(clippy::too_many_arguments)]
 fn evaluate_face<const NF: usize>(
