@@ -739,205 +739,212 @@ impl Side {
                 &'c mut [f64; 2],
             ),
         );
-        let body =
-            |(ci, ((((outs, sts), active), reactions), sums)): Chunk| {
-                active.clear();
-                reactions.clear();
-                *sums = [0.0; 2];
-                // Scratch of the slaves (only the first n_pen, nn entries are read):
-                // declared once per chunk, not zeroed per slave.
-                let mut pen = [(0u32, [0.0f64; 4], 0.0f64); MAX_SHARED];
-                let mut near = [0u32; 32];
-                for (j, (o, st)) in outs.iter_mut().zip(sts.iter_mut()).enumerate() {
-                    let si = ci * SLAVE_CHUNK + j;
-                    let s = slaves[si] as usize;
-                    let p = x[s];
-                    // The candidate of largest raw penetration.
-                    let mut best: Option<(u32, f64, [f64; 3])> = None;
-                    // Σ g n over the faces the node penetrates, and how many: in a concave
-                    // crease (a node under a tent of two faces) both feet are valid and the
-                    // nearer one's normal flips as the node crosses the bisector; the
-                    // penetration-weighted normal turns continuously instead.
-                    let (mut n_sum, mut n_count) = ([0.0f64; 3], 0u32);
-                    let (mut tg_sum, mut g_sum) = ([0.0f64; 3], 0.0f64);
-                    // The faces it penetrates (face, weights, g), the deepest MAX_SHARED: the
-                    // reaction is shared over them as the normal is, so that a node over a
-                    // vertex or a ridge, whose faces tie, pushes them all alike (the deepest
-                    // alone, ties to the first in face order, pushed one side only, and the
-                    // reaction jumped between faces as the node moved: measured, a formed weave
-                    // tiled from its mirror-symmetric cell was out of balance by 0.10 of the
-                    // crossing force at the vertex's neighbours, and drifted when left alone).
-                    let mut n_pen = 0usize;
-                    // A face can be penetrated only if the slave is within t_s/2 of its
-                    // thickness box: the foot q = Σ w_a x_a is a convex combination of the
-                    // nodes (each triangle's barycentric weights, averaged over a quad's
-                    // two splits), and t_F = Σ w_a t_a the same combination of their
-                    // thicknesses, so the ball of radius t_F/2 about q lies in the box, and
-                    // |x_s − q| < (t_s + t_F)/2 puts x_s within t_s/2 of it. The test in
-                    // floating point keeps η = 10⁻⁹ (|x|_max + reach) more, 10⁶ times the
-                    // round-off of the foot and the box, so that it rejects only faces
-                    // that the closest-point test below rejects too: the same bits.
-                    let reach = 0.5 * slave_t[si] + eta;
-                    let r2 = reach * reach;
-                    // Only faces the node penetrates (g > 0) matter: a node whose best g is
-                    // ≤ 0 is open whether or not some face was evaluated, and a tracked initial
-                    // penetration g₀ then drops to 0 either way.
-                    let list = &cand[cand_ptr[si] as usize..cand_ptr[si + 1] as usize];
-                    for block in list.chunks(32) {
-                        let nn = filter_block::<NF>(
-                            p[0], p[1], p[2], reach, r2, block, face_box, face_dir, &mut near,
-                        );
-                        for &fi in &near[..nn] {
-                            let Some(Hit { w, g, dist, r, tg, flat }) = evaluate_face::<NF>(
-                                p[0],
-                                p[1],
-                                p[2],
-                                slave_t[si],
-                                &faces[fi as usize],
-                                &face_t[fi as usize],
-                                x,
-                            ) else {
-                                continue;
-                            };
-                            if n_pen < MAX_SHARED {
-                                pen[n_pen] = (fi, w, g);
-                                n_pen += 1;
+        let body = |(ci, ((((outs, sts), active), reactions), sums)): Chunk| {
+            active.clear();
+            reactions.clear();
+            *sums = [0.0; 2];
+            // Scratch of the slaves (only the first n_pen, nn entries are read):
+            // declared once per chunk, not zeroed per slave.
+            let mut pen = [(0u32, [0.0f64; 4], 0.0f64); MAX_SHARED];
+            let mut near = [0u32; 32];
+            for (j, (o, st)) in outs.iter_mut().zip(sts.iter_mut()).enumerate() {
+                let si = ci * SLAVE_CHUNK + j;
+                let s = slaves[si] as usize;
+                let p = x[s];
+                // The candidate of largest raw penetration.
+                let mut best: Option<(u32, f64, [f64; 3])> = None;
+                // Σ g n over the faces the node penetrates, and how many: in a concave
+                // crease (a node under a tent of two faces) both feet are valid and the
+                // nearer one's normal flips as the node crosses the bisector; the
+                // penetration-weighted normal turns continuously instead.
+                let (mut n_sum, mut n_count) = ([0.0f64; 3], 0u32);
+                let (mut tg_sum, mut g_sum) = ([0.0f64; 3], 0.0f64);
+                // The faces it penetrates (face, weights, g), the deepest MAX_SHARED: the
+                // reaction is shared over them as the normal is, so that a node over a
+                // vertex or a ridge, whose faces tie, pushes them all alike (the deepest
+                // alone, ties to the first in face order, pushed one side only, and the
+                // reaction jumped between faces as the node moved: measured, a formed weave
+                // tiled from its mirror-symmetric cell was out of balance by 0.10 of the
+                // crossing force at the vertex's neighbours, and drifted when left alone).
+                let mut n_pen = 0usize;
+                // A face can be penetrated only if the slave is within t_s/2 of its
+                // thickness box: the foot q = Σ w_a x_a is a convex combination of the
+                // nodes (each triangle's barycentric weights, averaged over a quad's
+                // two splits), and t_F = Σ w_a t_a the same combination of their
+                // thicknesses, so the ball of radius t_F/2 about q lies in the box, and
+                // |x_s − q| < (t_s + t_F)/2 puts x_s within t_s/2 of it. The test in
+                // floating point keeps η = 10⁻⁹ (|x|_max + reach) more, 10⁶ times the
+                // round-off of the foot and the box, so that it rejects only faces
+                // that the closest-point test below rejects too: the same bits.
+                let reach = 0.5 * slave_t[si] + eta;
+                let r2 = reach * reach;
+                // Only faces the node penetrates (g > 0) matter: a node whose best g is
+                // ≤ 0 is open whether or not some face was evaluated, and a tracked initial
+                // penetration g₀ then drops to 0 either way.
+                let list = &cand[cand_ptr[si] as usize..cand_ptr[si + 1] as usize];
+                for block in list.chunks(32) {
+                    let nn = filter_block::<NF>(
+                        p[0], p[1], p[2], reach, r2, block, face_box, face_dir, &mut near,
+                    );
+                    for &fi in &near[..nn] {
+                        let Some(Hit {
+                            w,
+                            g,
+                            dist,
+                            r,
+                            tg,
+                            flat,
+                        }) = evaluate_face::<NF>(
+                            p[0],
+                            p[1],
+                            p[2],
+                            slave_t[si],
+                            &faces[fi as usize],
+                            &face_t[fi as usize],
+                            x,
+                        )
+                        else {
+                            continue;
+                        };
+                        if n_pen < MAX_SHARED {
+                            pen[n_pen] = (fi, w, g);
+                            n_pen += 1;
+                        } else {
+                            // Full: replace the shallowest (the first of equals).
+                            let mut k = 0;
+                            for j in 1..MAX_SHARED {
+                                if pen[j].2 < pen[k].2 {
+                                    k = j;
+                                }
+                            }
+                            if g > pen[k].2 {
+                                pen[k] = (fi, w, g);
+                            }
+                        }
+                        if dist > 0.0 {
+                            for d in 0..3 {
+                                n_sum[d] += g * r[d] / dist;
+                                tg_sum[d] += g * tg[d];
+                            }
+                            g_sum += g;
+                            n_count += 1;
+                        }
+                        if best.as_ref().is_none_or(|b| g > b.1) {
+                            let n = if dist > 0.0 {
+                                [r[0] / dist, r[1] / dist, r[2] / dist]
                             } else {
-                                // Full: replace the shallowest (the first of equals).
-                                let mut k = 0;
-                                for j in 1..MAX_SHARED {
-                                    if pen[j].2 < pen[k].2 {
-                                        k = j;
-                                    }
-                                }
-                                if g > pen[k].2 {
-                                    pen[k] = (fi, w, g);
-                                }
-                            }
-                            if dist > 0.0 {
-                                for d in 0..3 {
-                                    n_sum[d] += g * r[d] / dist;
-                                    tg_sum[d] += g * tg[d];
-                                }
-                                g_sum += g;
-                                n_count += 1;
-                            }
-                            if best.as_ref().is_none_or(|b| g > b.1) {
-                                let n = if dist > 0.0 {
-                                    [r[0] / dist, r[1] / dist, r[2] / dist]
-                                } else {
-                                    flat
-                                };
-                                best = Some((fi, g, n));
-                            }
-                        }
-                    }
-                    let mut out = PairOut {
-                        face: u32::MAX,
-                        ..Default::default()
-                    };
-                    let g_raw = best.as_ref().map_or(f64::NEG_INFINITY, |b| b.1);
-                    if initial {
-                        st.g0 = if keep { 0.0 } else { g_raw.max(0.0) };
-                        if let Some(b) = &best {
-                            out.face = if g_raw > 0.0 { b.0 } else { u32::MAX };
-                        }
-                        *o = out;
-                        continue;
-                    }
-                    // The tracked initial penetration shrinks as the node leaves.
-                    if g_raw < st.g0 {
-                        st.g0 = g_raw.max(0.0);
-                    }
-                    let g = g_raw - st.g0;
-                    match best {
-                        Some((fi, _, mut n)) if g > 0.0 => {
-                            if n_count > 1 {
-                                let l = dot(&n_sum, &n_sum).sqrt();
-                                if l > 0.0 {
-                                    n = [n_sum[0] / l, n_sum[1] / l, n_sum[2] / l];
-                                }
-                            }
-                            // Shares λ_F = g_F/Σg of the penetrated faces; the foot's mass
-                            // and velocity are their λ-weighted interpolations, so that the
-                            // penalty and the friction slip are continuous as faces come and
-                            // go, and the power of the shared reaction is −f·v_foot.
-                            let g_pen: f64 = pen[..n_pen].iter().map(|e| e.2).sum();
-                            let ms = slave_m[si];
-                            let (mut mf, mut vf) = (0.0f64, [0.0f64; 3]);
-                            for &(fj, wj, gj) in &pen[..n_pen] {
-                                let lam = gj / g_pen;
-                                let fn_ = &faces[fj as usize];
-                                let fm = &face_m[fj as usize];
-                                for a in 0..nf {
-                                    let la = lam * wj[a];
-                                    mf += la * fm[a];
-                                    let va = &v[fn_[a] as usize];
-                                    for d in 0..3 {
-                                        vf[d] += la * va[d];
-                                    }
-                                }
-                            }
-                            let mstar = if ms > 0.0 { ms.min(mf) } else { mf };
-                            let k = kappa * mstar / dt2;
-                            let vr = sub(&v[s], &vf);
-                            let vn = dot(&vr, &n);
-                            let vt = [vr[0] - vn * n[0], vr[1] - vn * n[1], vr[2] - vn * n[2]];
-                            let (mut force, stored, mut diss) =
-                                pair_force(g, &n, k, &vt, dt_prev, &fr, st);
-                            // Where the face's thickness varies (a lenticular band), the
-                            // contact distance depends on where the foot lies: the force is
-                            // −∂(½kg²)/∂x_s = k g (n − ½∇t_F), normal to the thickness
-                            // envelope rather than to the mid-surface; ∇t_F is weighted over
-                            // the penetrated faces like n, so that it turns continuously over
-                            // the ridge of a band's centre line.
-                            if g_sum > 0.0 {
-                                for d in 0..3 {
-                                    force[d] -= 0.5 * k * g * tg_sum[d] / g_sum;
-                                }
-                            }
-                            if zeta > 0.0 {
-                                // Normal dashpot, never pulling the surfaces together.
-                                let c = 2.0 * zeta * (k * mstar).sqrt();
-                                let fd = (-c * vn).max(-k * g);
-                                for d in 0..3 {
-                                    force[d] += fd * n[d];
-                                }
-                                diss -= fd * vn * dt_prev;
-                            }
-                            out = PairOut {
-                                face: fi,
-                                f: force,
-                                stored,
-                                dissipated: diss,
-                                g,
+                                flat
                             };
-                            for &(fj, wj, gj) in &pen[..n_pen] {
-                                let lam = gj / g_pen;
-                                reactions.push(Reaction {
-                                    slave: si as u32,
-                                    face: fj,
-                                    w: std::array::from_fn(|a| lam * wj[a]),
-                                });
-                            }
-                        }
-                        _ => {
-                            // Open: what the stick spring stored is dissipated.
-                            if st.k > 0.0 {
-                                out.dissipated = dot(&st.ft, &st.ft) / (2.0 * st.k);
-                            }
-                            st.ft = [0.0; 3];
-                            st.k = 0.0;
+                            best = Some((fi, g, n));
                         }
                     }
-                    if out.face != u32::MAX {
-                        active.push(si as u32);
-                        sums[0] += out.stored;
-                    }
-                    sums[1] += out.dissipated;
-                    *o = out;
                 }
-            };
+                let mut out = PairOut {
+                    face: u32::MAX,
+                    ..Default::default()
+                };
+                let g_raw = best.as_ref().map_or(f64::NEG_INFINITY, |b| b.1);
+                if initial {
+                    st.g0 = if keep { 0.0 } else { g_raw.max(0.0) };
+                    if let Some(b) = &best {
+                        out.face = if g_raw > 0.0 { b.0 } else { u32::MAX };
+                    }
+                    *o = out;
+                    continue;
+                }
+                // The tracked initial penetration shrinks as the node leaves.
+                if g_raw < st.g0 {
+                    st.g0 = g_raw.max(0.0);
+                }
+                let g = g_raw - st.g0;
+                match best {
+                    Some((fi, _, mut n)) if g > 0.0 => {
+                        if n_count > 1 {
+                            let l = dot(&n_sum, &n_sum).sqrt();
+                            if l > 0.0 {
+                                n = [n_sum[0] / l, n_sum[1] / l, n_sum[2] / l];
+                            }
+                        }
+                        // Shares λ_F = g_F/Σg of the penetrated faces; the foot's mass
+                        // and velocity are their λ-weighted interpolations, so that the
+                        // penalty and the friction slip are continuous as faces come and
+                        // go, and the power of the shared reaction is −f·v_foot.
+                        let g_pen: f64 = pen[..n_pen].iter().map(|e| e.2).sum();
+                        let ms = slave_m[si];
+                        let (mut mf, mut vf) = (0.0f64, [0.0f64; 3]);
+                        for &(fj, wj, gj) in &pen[..n_pen] {
+                            let lam = gj / g_pen;
+                            let fn_ = &faces[fj as usize];
+                            let fm = &face_m[fj as usize];
+                            for a in 0..nf {
+                                let la = lam * wj[a];
+                                mf += la * fm[a];
+                                let va = &v[fn_[a] as usize];
+                                for d in 0..3 {
+                                    vf[d] += la * va[d];
+                                }
+                            }
+                        }
+                        let mstar = if ms > 0.0 { ms.min(mf) } else { mf };
+                        let k = kappa * mstar / dt2;
+                        let vr = sub(&v[s], &vf);
+                        let vn = dot(&vr, &n);
+                        let vt = [vr[0] - vn * n[0], vr[1] - vn * n[1], vr[2] - vn * n[2]];
+                        let (mut force, stored, mut diss) =
+                            pair_force(g, &n, k, &vt, dt_prev, &fr, st);
+                        // Where the face's thickness varies (a lenticular band), the
+                        // contact distance depends on where the foot lies: the force is
+                        // −∂(½kg²)/∂x_s = k g (n − ½∇t_F), normal to the thickness
+                        // envelope rather than to the mid-surface; ∇t_F is weighted over
+                        // the penetrated faces like n, so that it turns continuously over
+                        // the ridge of a band's centre line.
+                        if g_sum > 0.0 {
+                            for d in 0..3 {
+                                force[d] -= 0.5 * k * g * tg_sum[d] / g_sum;
+                            }
+                        }
+                        if zeta > 0.0 {
+                            // Normal dashpot, never pulling the surfaces together.
+                            let c = 2.0 * zeta * (k * mstar).sqrt();
+                            let fd = (-c * vn).max(-k * g);
+                            for d in 0..3 {
+                                force[d] += fd * n[d];
+                            }
+                            diss -= fd * vn * dt_prev;
+                        }
+                        out = PairOut {
+                            face: fi,
+                            f: force,
+                            stored,
+                            dissipated: diss,
+                            g,
+                        };
+                        for &(fj, wj, gj) in &pen[..n_pen] {
+                            let lam = gj / g_pen;
+                            reactions.push(Reaction {
+                                slave: si as u32,
+                                face: fj,
+                                w: std::array::from_fn(|a| lam * wj[a]),
+                            });
+                        }
+                    }
+                    _ => {
+                        // Open: what the stick spring stored is dissipated.
+                        if st.k > 0.0 {
+                            out.dissipated = dot(&st.ft, &st.ft) / (2.0 * st.k);
+                        }
+                        st.ft = [0.0; 3];
+                        st.k = 0.0;
+                    }
+                }
+                if out.face != u32::MAX {
+                    active.push(si as u32);
+                    sums[0] += out.stored;
+                }
+                sums[1] += out.dissipated;
+                *o = out;
+            }
+        };
         if self.slaves.len() <= SLAVE_CHUNK {
             self.out
                 .chunks_mut(SLAVE_CHUNK)
@@ -1437,7 +1444,11 @@ impl SurfaceContact {
             .map(|s| s.mean_face_size(&m.coords))
             .filter(|&h| h > 0.0)
             .fold(f64::INFINITY, f64::min);
-        let skin = if skin.is_finite() { SKIN_PER_FACE * skin } else { 0.0 };
+        let skin = if skin.is_finite() {
+            SKIN_PER_FACE * skin
+        } else {
+            0.0
+        };
         let kappa_max = sides.iter().map(|s| s.kappa).fold(0.0, f64::max);
         SurfaceContact {
             sides,
