@@ -639,7 +639,8 @@ impl Side {
         // Candidates: count, then fill, each in parallel over fixed slave chunks.
         let faces = &self.faces;
         let slaves = &self.slaves;
-        let candidates = |si: usize, f: &mut dyn FnMut(u32)| {
+        // (Pushes directly: a closure taking `dyn FnMut` made a call per candidate.)
+        let candidates = |si: usize, list: &mut Vec<u32>| {
             let s = slaves[si];
             let p = &x[s as usize];
             for &fi in grid.cell_of(p) {
@@ -647,7 +648,7 @@ impl Side {
                 if (0..3).all(|d| p[d] >= lo[d] && p[d] <= hi[d])
                     && !faces[fi as usize][..nf].contains(&s)
                 {
-                    f(fi);
+                    list.push(fi);
                 }
             }
         };
@@ -662,7 +663,7 @@ impl Side {
                 let mut list = Vec::new();
                 for si in c0..c1 {
                     let before = list.len();
-                    candidates(si, &mut |f| list.push(f));
+                    candidates(si, &mut list);
                     counts.push((list.len() - before) as u32);
                 }
                 (counts, list)
@@ -1066,11 +1067,15 @@ fn filter_block<const NF: usize>(
 ) -> usize {
     let p = [px, py, pz];
     let mut nn = 0;
+    // (Comparisons rather than f64::max, whose NaN rule took a third of the loop's
+    // instructions: for finite positions the same values; a non-finite one stops the run
+    // at the integrator whichever way its faces are filtered.)
+    let max = |a: f64, b: f64| if a > b { a } else { b };
     for &fi in block {
         let bx = &face_box[fi as usize];
         let mut d2 = 0.0;
         for d in 0..3 {
-            let e = (bx[d] - p[d]).max(p[d] - bx[d + 3]).max(0.0);
+            let e = max(max(bx[d] - p[d], p[d] - bx[d + 3]), 0.0);
             d2 += e * e;
         }
         near[nn] = fi;
@@ -1085,7 +1090,7 @@ fn filter_block<const NF: usize>(
             let up = m[0] * p[0] + m[1] * p[1] + m[2] * p[2] - b[6];
             let dn = m[3] * p[0] + m[4] * p[1] + m[5] * p[2] - b[7];
             near[kept] = fi;
-            kept += (up.max(dn) < reach) as usize;
+            kept += (max(up, dn) < reach) as usize;
         }
         nn = kept;
     }
@@ -1217,13 +1222,19 @@ impl Grid {
             })
             .collect();
         let block_members = |b: usize| members.iter().flat_map(move |m| m[b].iter().copied());
-        // Visit the cells of block `b` that box `fi` covers.
-        let visit = |b: usize, fi: u32, f: &mut dyn FnMut(usize)| {
-            let [ca, cb] = span[fi as usize];
-            let (r0, r1) = (b * rows_per, ((b + 1) * rows_per).min(nrows));
+        // Visit the cells of block `b` that box `fi` covers (a generic function, not a
+        // closure taking `dyn FnMut`: the visits inline, without a call per cell).
+        #[inline(always)]
+        fn visit(
+            span: &[[u32; 3]; 2],
+            (r0, r1): (usize, usize),
+            dims: &[usize; 3],
+            mut f: impl FnMut(usize),
+        ) {
+            let [ca, cb] = span;
             for k in ca[2]..=cb[2] {
                 for j in ca[1]..=cb[1] {
-                    let r = row_of(j, k);
+                    let r = k as usize * dims[1] + j as usize;
                     if r < r0 || r >= r1 {
                         continue;
                     }
@@ -1232,7 +1243,8 @@ impl Grid {
                     }
                 }
             }
-        };
+        }
+        let rows = |b: usize| (b * rows_per, ((b + 1) * rows_per).min(nrows));
         // Counts, then each block's running sums, then the blocks' offsets.
         let block_cells = rows_per * dims[0];
         let mut count = vec![0u32; ncell + 1];
@@ -1241,7 +1253,7 @@ impl Grid {
             .enumerate()
             .map(|(b, cnt)| {
                 for fi in block_members(b) {
-                    visit(b, fi, &mut |c| cnt[c] += 1);
+                    visit(&span[fi as usize], rows(b), &dims, |c| cnt[c] += 1);
                 }
                 let mut run = 0u32;
                 for c in cnt.iter_mut() {
@@ -1279,7 +1291,7 @@ impl Grid {
                 .map(|&p| p - base)
                 .collect();
             for fi in block_members(b) {
-                visit(b, fi, &mut |c| {
+                visit(&span[fi as usize], rows(b), &dims, |c| {
                     out[fill[c] as usize] = fi;
                     fill[c] += 1;
                 });
@@ -1331,14 +1343,17 @@ fn thickness_box(f: &[u32; 4], t: &[f64; 4], m: &[f32; 6], nf: usize, x: &[[f64;
         f64::NEG_INFINITY,
         f64::NEG_INFINITY,
     ];
+    // (Comparisons rather than f64::min and max, as in `filter_block`.)
+    let min = |a: f64, b: f64| if a < b { a } else { b };
+    let max = |a: f64, b: f64| if a > b { a } else { b };
     for a in 0..nf {
         let (xa, r) = (&x[f[a] as usize], 0.5 * t[a]);
         for d in 0..3 {
-            b[d] = b[d].min(xa[d] - r);
-            b[d + 3] = b[d + 3].max(xa[d] + r);
+            b[d] = min(b[d], xa[d] - r);
+            b[d + 3] = max(b[d + 3], xa[d] + r);
         }
-        b[6] = b[6].max(m[0] * xa[0] + m[1] * xa[1] + m[2] * xa[2] + r);
-        b[7] = b[7].max(m[3] * xa[0] + m[4] * xa[1] + m[5] * xa[2] + r);
+        b[6] = max(b[6], m[0] * xa[0] + m[1] * xa[1] + m[2] * xa[2] + r);
+        b[7] = max(b[7], m[3] * xa[0] + m[4] * xa[1] + m[5] * xa[2] + r);
     }
     b
 }
