@@ -311,6 +311,27 @@ pub struct ContactReport {
     /// check) and of the narrow phase with the scatter [s].
     pub build_seconds: f64,
     pub narrow_seconds: f64,
+    /// The same wall time by phase [s]: the faces' thickness boxes (every step), the
+    /// staleness test (every step), the broad-phase builds, the narrow phase proper, and
+    /// the scatter of the forces onto the nodes.
+    pub phases: ContactPhases,
+    /// Slave-steps (slaves × force evaluations), and over them: candidate faces whose
+    /// box was tested, faces past the box and envelope filters (whose closest point was
+    /// computed), and faces found penetrated.
+    pub slave_steps: u64,
+    pub tested: u64,
+    pub evaluated: u64,
+    pub penetrated: u64,
+}
+
+/// Wall time of the contact's phases [s] (see [`ContactReport::phases`]).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct ContactPhases {
+    pub boxes: f64,
+    pub staleness: f64,
+    pub builds: f64,
+    pub narrow: f64,
+    pub scatter: f64,
 }
 
 /// One direction of one contact definition: slaves against a master surface.
@@ -354,11 +375,12 @@ pub struct Side {
     pub state: Vec<SlaveState>,
     pub out: Vec<PairOut>,
     /// Per fixed chunk of slaves: the slaves in contact (indices), and the stored energy
-    /// and the friction work of the chunk, summed in chunk order.
+    /// and the friction work of the chunk, summed in chunk order (then the chunk's counts
+    /// of tested, evaluated and penetrated faces, whole numbers kept exactly).
     chunk_active: Vec<Vec<u32>>,
     /// ... the shares of their reactions over the faces they penetrate, in slave order ...
     chunk_reactions: Vec<Vec<Reaction>>,
-    chunk_sums: Vec<[f64; 2]>,
+    chunk_sums: Vec<[f64; 5]>,
 }
 
 /// Nodal contact thickness from a part's elements (None = all parts): membranes their
@@ -729,7 +751,7 @@ impl Side {
         let nchunks = self.slaves.len().div_ceil(SLAVE_CHUNK);
         self.chunk_active.resize_with(nchunks, Vec::new);
         self.chunk_reactions.resize_with(nchunks, Vec::new);
-        self.chunk_sums.resize(nchunks, [0.0; 2]);
+        self.chunk_sums.resize(nchunks, [0.0; 5]);
         type Chunk<'c> = (
             usize,
             (
@@ -737,13 +759,13 @@ impl Side {
                     ((&'c mut [PairOut], &'c mut [SlaveState]), &'c mut Vec<u32>),
                     &'c mut Vec<Reaction>,
                 ),
-                &'c mut [f64; 2],
+                &'c mut [f64; 5],
             ),
         );
         let body = |(ci, ((((outs, sts), active), reactions), sums)): Chunk| {
             active.clear();
             reactions.clear();
-            *sums = [0.0; 2];
+            *sums = [0.0; 5];
             // Scratch of the slaves (only the first n_pen, nn entries are read):
             // declared once per chunk, not zeroed per slave.
             let mut pen = [(0u32, [0.0f64; 4], 0.0f64); MAX_SHARED];
@@ -783,10 +805,12 @@ impl Side {
                 // ≤ 0 is open whether or not some face was evaluated, and a tracked initial
                 // penetration g₀ then drops to 0 either way.
                 let list = &cand[cand_ptr[si] as usize..cand_ptr[si + 1] as usize];
+                sums[2] += list.len() as f64;
                 for block in list.chunks(32) {
                     let nn = filter_block::<NF>(
                         p[0], p[1], p[2], reach, r2, block, face_box, face_dir, &mut near,
                     );
+                    sums[3] += nn as f64;
                     for &fi in &near[..nn] {
                         let Some(Hit {
                             w,
@@ -807,6 +831,7 @@ impl Side {
                         else {
                             continue;
                         };
+                        sums[4] += 1.0;
                         if n_pen < MAX_SHARED {
                             pen[n_pen] = (fi, w, g);
                             n_pen += 1;
@@ -1423,6 +1448,10 @@ pub struct SurfaceContact {
     pub builds: u64,
     pub build_time: std::time::Duration,
     pub narrow_time: std::time::Duration,
+    /// The same by phase, and the counts of [`ContactReport`] (slave-steps, tested,
+    /// evaluated and penetrated faces).
+    phases: ContactPhases,
+    counts: [u64; 4],
     /// Friction work dissipated so far [J].
     pub dissipated: f64,
     /// Stored energy at the last force evaluation [J].
@@ -1609,7 +1638,10 @@ impl SurfaceContact {
         for s in &mut self.sides {
             s.update_boxes(x);
         }
-        if self.stale(x) {
+        let t_boxes = std::time::Instant::now();
+        let stale = self.stale(x);
+        let t_stale = std::time::Instant::now();
+        if stale {
             self.rebuild(x);
         }
         let t1 = std::time::Instant::now();
@@ -1621,8 +1653,18 @@ impl SurfaceContact {
             for c in &s.chunk_sums {
                 stored += c[0];
                 self.dissipated += c[1];
+                for k in 0..3 {
+                    self.counts[k + 1] += c[k + 2] as u64;
+                }
             }
+            self.counts[0] += s.slaves.len() as u64;
         }
+        let t_narrow = std::time::Instant::now();
+        let ph = &mut self.phases;
+        ph.boxes += (t_boxes - t0).as_secs_f64();
+        ph.staleness += (t_stale - t_boxes).as_secs_f64();
+        ph.builds += (t1 - t_stale).as_secs_f64();
+        ph.narrow += (t_narrow - t1).as_secs_f64();
         // Gather onto the nodes: the nodes are split into one block per thread, and each
         // block takes the contributions to its nodes in the canonical order (side, chunk,
         // the chunk's slaves, then their reactions' face nodes), so every node's sum is the
@@ -1672,6 +1714,7 @@ impl SurfaceContact {
             fcon.par_chunks_mut(bs).enumerate().for_each(gather);
         }
         self.stored = stored;
+        self.phases.scatter += t_narrow.elapsed().as_secs_f64();
         self.narrow_time += t1.elapsed();
     }
 
@@ -1698,6 +1741,11 @@ impl SurfaceContact {
             skin: self.skin,
             build_seconds: self.build_time.as_secs_f64(),
             narrow_seconds: self.narrow_time.as_secs_f64(),
+            phases: self.phases,
+            slave_steps: self.counts[0],
+            tested: self.counts[1],
+            evaluated: self.counts[2],
+            penetrated: self.counts[3],
         }
     }
 
