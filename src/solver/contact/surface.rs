@@ -374,13 +374,24 @@ pub struct Side {
     face_dir: Vec<[f32; 6]>,
     pub state: Vec<SlaveState>,
     pub out: Vec<PairOut>,
-    /// Per fixed chunk of slaves: the slaves in contact (indices), and the stored energy
-    /// and the friction work of the chunk, summed in chunk order (then the chunk's counts
-    /// of tested, evaluated and penetrated faces, whole numbers kept exactly).
+    /// Per fixed chunk of slaves: the slaves in contact (indices), ...
     chunk_active: Vec<Vec<u32>>,
     /// ... the shares of their reactions over the faces they penetrate, in slave order ...
     chunk_reactions: Vec<Vec<Reaction>>,
-    chunk_sums: Vec<[f64; 5]>,
+    /// ... and the chunk's energies and counts, summed in chunk order.
+    chunk_sums: Vec<ChunkSums>,
+}
+
+/// What one chunk of slaves adds up in a narrow phase: the stored energy and the friction
+/// work [J], the candidate faces whose box was tested, the faces past the filters (whose
+/// closest point was computed), and the faces found penetrated.
+#[derive(Debug, Clone, Copy, Default)]
+struct ChunkSums {
+    stored: f64,
+    dissipated: f64,
+    tested: u64,
+    evaluated: u64,
+    penetrated: u64,
 }
 
 /// Nodal contact thickness from a part's elements (None = all parts): membranes their
@@ -751,7 +762,7 @@ impl Side {
         let nchunks = self.slaves.len().div_ceil(SLAVE_CHUNK);
         self.chunk_active.resize_with(nchunks, Vec::new);
         self.chunk_reactions.resize_with(nchunks, Vec::new);
-        self.chunk_sums.resize(nchunks, [0.0; 5]);
+        self.chunk_sums.resize(nchunks, ChunkSums::default());
         type Chunk<'c> = (
             usize,
             (
@@ -759,13 +770,13 @@ impl Side {
                     ((&'c mut [PairOut], &'c mut [SlaveState]), &'c mut Vec<u32>),
                     &'c mut Vec<Reaction>,
                 ),
-                &'c mut [f64; 5],
+                &'c mut ChunkSums,
             ),
         );
         let body = |(ci, ((((outs, sts), active), reactions), sums)): Chunk| {
             active.clear();
             reactions.clear();
-            *sums = [0.0; 5];
+            *sums = ChunkSums::default();
             // Scratch of the slaves (only the first n_pen, nn entries are read):
             // declared once per chunk, not zeroed per slave.
             let mut pen = [(0u32, [0.0f64; 4], 0.0f64); MAX_SHARED];
@@ -805,12 +816,12 @@ impl Side {
                 // ≤ 0 is open whether or not some face was evaluated, and a tracked initial
                 // penetration g₀ then drops to 0 either way.
                 let list = &cand[cand_ptr[si] as usize..cand_ptr[si + 1] as usize];
-                sums[2] += list.len() as f64;
+                sums.tested += list.len() as u64;
                 for block in list.chunks(32) {
                     let nn = filter_block::<NF>(
                         p[0], p[1], p[2], reach, r2, block, face_box, face_dir, &mut near,
                     );
-                    sums[3] += nn as f64;
+                    sums.evaluated += nn as u64;
                     for &fi in &near[..nn] {
                         let Some(Hit {
                             w,
@@ -831,7 +842,7 @@ impl Side {
                         else {
                             continue;
                         };
-                        sums[4] += 1.0;
+                        sums.penetrated += 1;
                         if n_pen < MAX_SHARED {
                             pen[n_pen] = (fi, w, g);
                             n_pen += 1;
@@ -965,9 +976,9 @@ impl Side {
                 }
                 if out.face != u32::MAX {
                     active.push(si as u32);
-                    sums[0] += out.stored;
+                    sums.stored += out.stored;
                 }
-                sums[1] += out.dissipated;
+                sums.dissipated += out.dissipated;
                 *o = out;
             }
         };
@@ -1067,6 +1078,30 @@ fn evaluate_face<const NF: usize>(
     })
 }
 
+/// The larger and the smaller of two numbers by one comparison, for the per-step box
+/// computation and the box test: `f64::max`'s NaN rule took a third of the box test's
+/// instructions. For finite values the same results; positions are finite whenever
+/// contact runs (the model's coordinates are checked, and the integrator stops the run on
+/// the step a position goes non-finite).
+#[inline(always)]
+fn fmax(a: f64, b: f64) -> f64 {
+    if a > b {
+        a
+    } else {
+        b
+    }
+}
+
+/// See [`fmax`].
+#[inline(always)]
+fn fmin(a: f64, b: f64) -> f64 {
+    if a < b {
+        a
+    } else {
+        b
+    }
+}
+
 /// The candidates of `block` a slave at (px, py, pz) may penetrate, in order, into `near`;
 /// returns how many. First, without branches, the distance to each face's thickness box
 /// at this step (within `reach` = t_s/2 + η, r2 its square).
@@ -1092,15 +1127,11 @@ fn filter_block<const NF: usize>(
 ) -> usize {
     let p = [px, py, pz];
     let mut nn = 0;
-    // (Comparisons rather than f64::max, whose NaN rule took a third of the loop's
-    // instructions: for finite positions the same values; a non-finite one stops the run
-    // at the integrator whichever way its faces are filtered.)
-    let max = |a: f64, b: f64| if a > b { a } else { b };
     for &fi in block {
         let bx = &face_box[fi as usize];
         let mut d2 = 0.0;
         for d in 0..3 {
-            let e = max(max(bx[d] - p[d], p[d] - bx[d + 3]), 0.0);
+            let e = fmax(fmax(bx[d] - p[d], p[d] - bx[d + 3]), 0.0);
             d2 += e * e;
         }
         near[nn] = fi;
@@ -1115,7 +1146,7 @@ fn filter_block<const NF: usize>(
             let up = m[0] * p[0] + m[1] * p[1] + m[2] * p[2] - b[6];
             let dn = m[3] * p[0] + m[4] * p[1] + m[5] * p[2] - b[7];
             near[kept] = fi;
-            kept += (max(up, dn) < reach) as usize;
+            kept += (fmax(up, dn) < reach) as usize;
         }
         nn = kept;
     }
@@ -1217,7 +1248,7 @@ impl Grid {
         let nrows = dims[1] * dims[2];
         let rows_per = nrows.div_ceil(GRID_BLOCKS).max(1);
         let nblocks = nrows.div_ceil(rows_per);
-        let row_of = |j: u32, k: u32| k as usize * dims[1] + j as usize;
+        let row_of = |j: u32, k: u32| grid_row(&dims, j, k);
         // The boxes that reach each block, in box order: found in parallel over fixed
         // ranges of boxes (`members[r][b]`, read range after range; the same lists for
         // any number of threads), each row's block looked up rather than divided for
@@ -1259,7 +1290,7 @@ impl Grid {
             let [ca, cb] = span;
             for k in ca[2]..=cb[2] {
                 for j in ca[1]..=cb[1] {
-                    let r = k as usize * dims[1] + j as usize;
+                    let r = grid_row(dims, j, k);
                     if r < r0 || r >= r1 {
                         continue;
                     }
@@ -1347,6 +1378,12 @@ impl Grid {
     }
 }
 
+/// The row (the cells of one (j, k)) of the grid's cell indices j, k.
+#[inline(always)]
+fn grid_row(dims: &[usize; 3], j: u32, k: u32) -> usize {
+    k as usize * dims[1] + j as usize
+}
+
 /// Round-off allowance of the thickness-box tests relative to the largest coordinate of a
 /// side's nodes: its foot and box are computed within ~10⁻¹⁵ of that.
 const BOX_MARGIN: f64 = 1e-9;
@@ -1368,17 +1405,14 @@ fn thickness_box(f: &[u32; 4], t: &[f64; 4], m: &[f32; 6], nf: usize, x: &[[f64;
         f64::NEG_INFINITY,
         f64::NEG_INFINITY,
     ];
-    // (Comparisons rather than f64::min and max, as in `filter_block`.)
-    let min = |a: f64, b: f64| if a < b { a } else { b };
-    let max = |a: f64, b: f64| if a > b { a } else { b };
     for a in 0..nf {
         let (xa, r) = (&x[f[a] as usize], 0.5 * t[a]);
         for d in 0..3 {
-            b[d] = min(b[d], xa[d] - r);
-            b[d + 3] = max(b[d + 3], xa[d] + r);
+            b[d] = fmin(b[d], xa[d] - r);
+            b[d + 3] = fmax(b[d + 3], xa[d] + r);
         }
-        b[6] = max(b[6], m[0] * xa[0] + m[1] * xa[1] + m[2] * xa[2] + r);
-        b[7] = max(b[7], m[3] * xa[0] + m[4] * xa[1] + m[5] * xa[2] + r);
+        b[6] = fmax(b[6], m[0] * xa[0] + m[1] * xa[1] + m[2] * xa[2] + r);
+        b[7] = fmax(b[7], m[3] * xa[0] + m[4] * xa[1] + m[5] * xa[2] + r);
     }
     b
 }
@@ -1448,10 +1482,11 @@ pub struct SurfaceContact {
     pub builds: u64,
     pub build_time: std::time::Duration,
     pub narrow_time: std::time::Duration,
-    /// The same by phase, and the counts of [`ContactReport`] (slave-steps, tested,
-    /// evaluated and penetrated faces).
+    /// The same by phase; slave-steps so far, and the chunks' counts summed over them
+    /// (see [`ContactReport`]).
     phases: ContactPhases,
-    counts: [u64; 4],
+    slave_steps: u64,
+    counts: ChunkSums,
     /// Friction work dissipated so far [J].
     pub dissipated: f64,
     /// Stored energy at the last force evaluation [J].
@@ -1651,13 +1686,13 @@ impl SurfaceContact {
             s.narrow(x, v, dt, dt_prev, false);
             // Sums in chunk order: bit-identical for any thread count.
             for c in &s.chunk_sums {
-                stored += c[0];
-                self.dissipated += c[1];
-                for k in 0..3 {
-                    self.counts[k + 1] += c[k + 2] as u64;
-                }
+                stored += c.stored;
+                self.dissipated += c.dissipated;
+                self.counts.tested += c.tested;
+                self.counts.evaluated += c.evaluated;
+                self.counts.penetrated += c.penetrated;
             }
-            self.counts[0] += s.slaves.len() as u64;
+            self.slave_steps += s.slaves.len() as u64;
         }
         let t_narrow = std::time::Instant::now();
         let ph = &mut self.phases;
@@ -1742,10 +1777,10 @@ impl SurfaceContact {
             build_seconds: self.build_time.as_secs_f64(),
             narrow_seconds: self.narrow_time.as_secs_f64(),
             phases: self.phases,
-            slave_steps: self.counts[0],
-            tested: self.counts[1],
-            evaluated: self.counts[2],
-            penetrated: self.counts[3],
+            slave_steps: self.slave_steps,
+            tested: self.counts.tested,
+            evaluated: self.counts.evaluated,
+            penetrated: self.counts.penetrated,
         }
     }
 
