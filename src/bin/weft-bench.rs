@@ -319,13 +319,14 @@ fn bench_woven(yarns: usize, end_time: f64, threads: &[usize]) -> anyhow::Result
         );
         let (ph, n) = (&rep.phases, rep.slave_steps.max(1) as f64);
         eprintln!(
-            "    contact phases: thickness boxes {:.1} s, staleness test {:.1} s, builds {:.1} s ({:.1} ms each), narrow {:.1} s, scatter {:.1} s; per slave-step: {:.2} candidate boxes tested, {:.3} faces evaluated, {:.3} penetrated ({} slave-steps)",
+            "    contact phases: thickness boxes {:.1} s, staleness test {:.1} s, builds {:.1} s ({:.1} ms each), narrow {:.1} s, scatter {:.1} s; per slave-step: {:.3} skipped whole, {:.2} candidate boxes tested, {:.3} faces evaluated, {:.3} penetrated ({} slave-steps)",
             ph.boxes,
             ph.staleness,
             ph.builds,
             1e3 * ph.builds / rep.builds.max(1) as f64,
             ph.narrow,
             ph.scatter,
+            rep.skipped as f64 / n,
             rep.tested as f64 / n,
             rep.evaluated as f64 / n,
             rep.penetrated as f64 / n,

@@ -62,6 +62,10 @@ pub struct Staleness {
     /// Per cell: min u (3), max u (3); then the same over its neighbourhood.
     range: Vec<[f64; 6]>,
     scratch: Vec<[f64; 6]>,
+    /// Per cell, the Euclidean norm |S| of the spreads (S_x, S_y, S_z) of the
+    /// displacements over its neighbourhood at the last test that found the lists fresh
+    /// (zero after a build; +∞ for an empty neighbourhood).
+    spread: Vec<f64>,
 }
 
 impl Staleness {
@@ -140,9 +144,12 @@ impl Staleness {
             .par_extend(self.cell_nodes.par_iter().map(|&n| x[n as usize]));
         self.range.resize(ncell, [0.0; 6]);
         self.scratch.resize(ncell, [0.0; 6]);
+        self.spread.clear();
+        self.spread.resize(ncell, 0.0);
     }
 
-    fn cell(&self, p: &[f64; 3]) -> usize {
+    /// The cell of a build position.
+    pub fn cell(&self, p: &[f64; 3]) -> usize {
         if !self.h.is_finite() {
             return 0;
         }
@@ -227,11 +234,30 @@ impl Staleness {
         }
         // After three passes (range → scratch → range → scratch) the neighbourhoods'
         // ranges are in `scratch` (an empty neighbourhood's spread is −∞).
+        // (Every cell's |S| is kept for the narrow phase, so no early exit.)
         let skin = self.skin;
         !self
-            .scratch
-            .par_iter()
-            .all(|r| (0..3).all(|d| r[d + 3] - r[d] <= skin))
+            .spread
+            .par_chunks_mut(CELL_CHUNK)
+            .zip(self.scratch.par_chunks(CELL_CHUNK))
+            .map(|(ss, rs)| {
+                let mut fresh = true;
+                for (s, r) in ss.iter_mut().zip(rs) {
+                    let sd: [f64; 3] = std::array::from_fn(|d| r[d + 3] - r[d]);
+                    fresh &= sd.iter().all(|&e| e <= skin);
+                    // (An empty neighbourhood: −∞ spreads, an infinite norm.)
+                    *s = (sd[0] * sd[0] + sd[1] * sd[1] + sd[2] * sd[2]).sqrt();
+                }
+                fresh
+            })
+            .reduce(|| true, |a, b| a & b)
+    }
+
+    /// Per cell, the norm |S| of its neighbourhood's spreads of the displacements since
+    /// the build, at the last [`Staleness::stale`] that found the lists fresh (zero right
+    /// after a build).
+    pub fn spread(&self) -> &[f64] {
+        &self.spread
     }
 }
 

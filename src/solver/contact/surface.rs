@@ -319,6 +319,9 @@ pub struct ContactReport {
     /// box was tested, faces past the box and envelope filters (whose closest point was
     /// computed), and faces found penetrated.
     pub slave_steps: u64,
+    /// Slave-steps skipped whole: the slave was farther from every candidate at the
+    /// build than its neighbourhood's nodes have since moved apart (see `Side::margin`).
+    pub skipped: u64,
     pub tested: u64,
     pub evaluated: u64,
     pub penetrated: u64,
@@ -366,6 +369,27 @@ pub struct Side {
     /// Candidates per slave (CSR), from the last broad phase.
     cand_ptr: Vec<u32>,
     cand: Vec<u32>,
+    /// Per slave, from the last broad phase: its margin [m] (+∞ without candidates), so
+    /// that the narrow phase can skip a slave that no candidate can reach yet.
+    ///
+    /// Let e_F be the Euclidean distance from x_s to the thickness box of a candidate F,
+    /// and v_F = max over its two envelope directions m of m·x_s − h (the narrow phase's
+    /// filter passes F only when e_F ≤ t_s/2 + η and v_F < t_s/2 + η). Between builds
+    /// the directions are fixed, |m| ≤ 1, and for a pair that passes the box test every
+    /// component d of the displacement since the build of a node a of F differs from the
+    /// slave's by at most S_d, the spread of the displacements over the 3 × 3 × 3 cells
+    /// around the slave's cell ([`super::staleness`]: F's nodes lie in them). The box's
+    /// faces then move by at most S_d relative to the slave, so e_F ≥ e_F^b − |S|
+    /// (b: at the build); and h = max_a (m·x_a + t_a/2) grows by at most m·u_s + |S|, so
+    /// v_F ≥ v_F^b − |S|. With the margin min_F max(e_F^b, v_F^b) − t_s/2 − 2η, a slave
+    /// whose margin exceeds |S| at a step passes no candidate, finds no penetration and
+    /// opens (its stick spring released, a tracked initial penetration dropped): exactly
+    /// what the full test gives; the second η covers the round-off of the margin, 10⁶
+    /// times it as in the box test. Measured on the 60 × 60 woven quarter: 86 % of the
+    /// slave-steps skipped to 10 µs, 43 % to 60 µs.
+    margin: Vec<f64>,
+    /// Per slave, its cell of the staleness test at the last build.
+    slave_cell: Vec<u32>,
     /// The faces' thickness boxes at the current step (lo, hi) [m], and their envelope
     /// bounds h₊, h₋ along `face_dir` (see [`Side::set_directions`]).
     face_box: Vec<[f64; 8]>,
@@ -373,6 +397,11 @@ pub struct Side {
     /// phase (zero for a segment or a face too distorted to have them).
     face_dir: Vec<[f32; 6]>,
     pub state: Vec<SlaveState>,
+    /// Per slave: whether its state differs from the default (a stick spring or a
+    /// tracked initial penetration).
+    held: Vec<bool>,
+    /// Per slave, its contact at the last step; valid only for the slaves in
+    /// `chunk_active` (after the setup's narrow phase: for every slave).
     pub out: Vec<PairOut>,
     /// Per fixed chunk of slaves: the slaves in contact (indices), ...
     chunk_active: Vec<Vec<u32>>,
@@ -389,6 +418,7 @@ pub struct Side {
 struct ChunkSums {
     stored: f64,
     dissipated: f64,
+    skipped: u64,
     tested: u64,
     evaluated: u64,
     penetrated: u64,
@@ -557,6 +587,7 @@ impl Side {
             row,
             slave_m: slaves.iter().map(|&s| mass[s as usize]).collect(),
             state: vec![SlaveState::default(); slaves.len()],
+            held: vec![false; slaves.len()],
             out: vec![
                 PairOut {
                     face: u32::MAX,
@@ -584,6 +615,8 @@ impl Side {
             box_margin: BOX_MARGIN * (x_max + 0.5 * (ts_max + tf_max)),
             cand_ptr: vec![],
             cand: vec![],
+            margin: vec![],
+            slave_cell: vec![],
             // Before the first broad phase there are no directions yet: zero ones never
             // reject.
             face_box: vec![[0.0; 8]; n_faces],
@@ -672,31 +705,41 @@ impl Side {
         // Candidates: count, then fill, each in parallel over fixed slave chunks.
         let faces = &self.faces;
         let slaves = &self.slaves;
+        let (slave_t, face_box, face_dir) = (&self.slave_t, &self.face_box, &self.face_dir);
+        let eta = self.box_margin;
+        // A slave's candidates, and its margin (see `Side::margin`).
         // (Pushes directly: a closure taking `dyn FnMut` made a call per candidate.)
-        let candidates = |si: usize, list: &mut Vec<u32>| {
+        let candidates = |si: usize, list: &mut Vec<u32>| -> f64 {
             let s = slaves[si];
             let p = &x[s as usize];
+            let mut near = f64::INFINITY;
             for &fi in grid.cell_of(p) {
-                let (lo, hi) = &boxes[fi as usize];
-                if (0..3).all(|d| p[d] >= lo[d] && p[d] <= hi[d])
+                // (The inflated box, as `boxes` holds it.)
+                let b = &face_box[fi as usize];
+                if (0..3).all(|d| p[d] >= b[d] - r && p[d] <= b[d + 3] + r)
                     && !faces[fi as usize][..nf].contains(&s)
                 {
                     list.push(fi);
+                    near = fmin(near, excess(p, b, &face_dir[fi as usize], nf));
                 }
             }
+            near - 0.5 * slave_t[si] - 2.0 * eta
         };
         let ns = slaves.len();
         // One pass: each fixed chunk of slaves collects its candidates, the chunks are
         // then joined in order.
-        let chunks: Vec<(Vec<u32>, Vec<u32>)> = (0..ns.div_ceil(SLAVE_CHUNK))
-            .into_par_iter()
-            .map(|ci| {
-                let (c0, c1) = (ci * SLAVE_CHUNK, ((ci + 1) * SLAVE_CHUNK).min(ns));
-                let mut counts = Vec::with_capacity(c1 - c0);
+        self.margin.resize(ns, 0.0);
+        let chunks: Vec<(Vec<u32>, Vec<u32>)> = self
+            .margin
+            .par_chunks_mut(SLAVE_CHUNK)
+            .enumerate()
+            .map(|(ci, ms)| {
+                let c0 = ci * SLAVE_CHUNK;
+                let mut counts = Vec::with_capacity(ms.len());
                 let mut list = Vec::new();
-                for si in c0..c1 {
+                for (j, m) in ms.iter_mut().enumerate() {
                     let before = list.len();
-                    candidates(si, &mut list);
+                    *m = candidates(c0 + j, &mut list);
                     counts.push((list.len() - before) as u32);
                 }
                 (counts, list)
@@ -732,14 +775,32 @@ impl Side {
         self.cand = cand;
     }
 
+    /// After a build at `x`: each slave's cell of the staleness test (`cell`).
+    fn set_cells(&mut self, x: &[[f64; 3]], cell: impl Fn(&[f64; 3]) -> usize + Sync) {
+        let slaves = &self.slaves;
+        self.slave_cell.clear();
+        self.slave_cell
+            .par_extend(slaves.par_iter().map(|&s| cell(&x[s as usize]) as u32));
+    }
+
     /// Narrow phase and friction for every slave, in parallel chunks, into `out`.
     /// `initial`: report penetrations instead of pushing (setup).
-    fn narrow(&mut self, x: &[[f64; 3]], v: &[[f64; 3]], dt: f64, dt_prev: f64, initial: bool) {
+    /// `spread`: per cell of the staleness test, |S| of `Side::margin` at this step
+    /// (None: no slave is skipped).
+    fn narrow(
+        &mut self,
+        x: &[[f64; 3]],
+        v: &[[f64; 3]],
+        dt: f64,
+        dt_prev: f64,
+        initial: bool,
+        spread: Option<&[f64]>,
+    ) {
         // One copy per face kind, so that the loops over a face's nodes are unrolled.
         match self.nf {
-            2 => self.narrow_n::<2>(x, v, dt, dt_prev, initial),
-            3 => self.narrow_n::<3>(x, v, dt, dt_prev, initial),
-            _ => self.narrow_n::<4>(x, v, dt, dt_prev, initial),
+            2 => self.narrow_n::<2>(x, v, dt, dt_prev, initial, spread),
+            3 => self.narrow_n::<3>(x, v, dt, dt_prev, initial, spread),
+            _ => self.narrow_n::<4>(x, v, dt, dt_prev, initial, spread),
         }
     }
 
@@ -750,8 +811,10 @@ impl Side {
         dt: f64,
         dt_prev: f64,
         initial: bool,
+        spread: Option<&[f64]>,
     ) {
         let (face_box, face_dir) = (&self.face_box, &self.face_dir);
+        let (margin, slave_cell) = (&self.margin, &self.slave_cell);
         let (faces, nf, face_t, face_m) = (&self.faces, NF, &self.face_t, &self.face_m);
         let (slaves, slave_t, slave_m) = (&self.slaves, &self.slave_t, &self.slave_m);
         let (cand_ptr, cand) = (&self.cand_ptr, &self.cand);
@@ -767,13 +830,16 @@ impl Side {
             usize,
             (
                 (
-                    ((&'c mut [PairOut], &'c mut [SlaveState]), &'c mut Vec<u32>),
+                    (
+                        (&'c mut [PairOut], (&'c mut [SlaveState], &'c mut [bool])),
+                        &'c mut Vec<u32>,
+                    ),
                     &'c mut Vec<Reaction>,
                 ),
                 &'c mut ChunkSums,
             ),
         );
-        let body = |(ci, ((((outs, sts), active), reactions), sums)): Chunk| {
+        let body = |(ci, ((((outs, (sts, held)), active), reactions), sums)): Chunk| {
             active.clear();
             reactions.clear();
             *sums = ChunkSums::default();
@@ -781,8 +847,27 @@ impl Side {
             // declared once per chunk, not zeroed per slave.
             let mut pen = [(0u32, [0.0f64; 4], 0.0f64); MAX_SHARED];
             let mut near = [0u32; 32];
-            for (j, (o, st)) in outs.iter_mut().zip(sts.iter_mut()).enumerate() {
+            // (A slave that is open and holds no state is not written: its output is
+            // read only while it is in contact, and its state is the default one. At the
+            // setup every slave is written.)
+            for (j, ((o, st), hd)) in outs
+                .iter_mut()
+                .zip(sts.iter_mut())
+                .zip(held.iter_mut())
+                .enumerate()
+            {
                 let si = ci * SLAVE_CHUNK + j;
+                if spread.is_some_and(|sp| margin[si] > sp[slave_cell[si] as usize]) {
+                    // No candidate can pass the filter (see `Side::margin`): what the
+                    // full test gives a slave that finds no face.
+                    sums.skipped += 1;
+                    if *hd {
+                        st.g0 = 0.0;
+                        sums.dissipated += release(st);
+                        *hd = false;
+                    }
+                    continue;
+                }
                 let s = slaves[si] as usize;
                 let p = x[s];
                 // The candidate of largest raw penetration.
@@ -883,10 +968,16 @@ impl Side {
                 let g_raw = best.as_ref().map_or(f64::NEG_INFINITY, |b| b.1);
                 if initial {
                     st.g0 = if keep { 0.0 } else { g_raw.max(0.0) };
+                    *hd = st.g0 != 0.0;
                     if let Some(b) = &best {
                         out.face = if g_raw > 0.0 { b.0 } else { u32::MAX };
                     }
                     *o = out;
+                    continue;
+                }
+                if !*hd && !(g_raw > 0.0) {
+                    // Open before and now, holding nothing (g₀ = 0, no stick spring):
+                    // nothing changes.
                     continue;
                 }
                 // The tracked initial penetration shrinks as the node leaves.
@@ -965,15 +1056,9 @@ impl Side {
                             });
                         }
                     }
-                    _ => {
-                        // Open: what the stick spring stored is dissipated.
-                        if st.k > 0.0 {
-                            out.dissipated = dot(&st.ft, &st.ft) / (2.0 * st.k);
-                        }
-                        st.ft = [0.0; 3];
-                        st.k = 0.0;
-                    }
+                    _ => out.dissipated = release(st),
                 }
+                *hd = st.k != 0.0 || st.g0 != 0.0 || st.ft != [0.0; 3];
                 if out.face != u32::MAX {
                     active.push(si as u32);
                     sums.stored += out.stored;
@@ -985,7 +1070,11 @@ impl Side {
         if self.slaves.len() <= SLAVE_CHUNK {
             self.out
                 .chunks_mut(SLAVE_CHUNK)
-                .zip(self.state.chunks_mut(SLAVE_CHUNK))
+                .zip(
+                    self.state
+                        .chunks_mut(SLAVE_CHUNK)
+                        .zip(self.held.chunks_mut(SLAVE_CHUNK)),
+                )
                 .zip(self.chunk_active.iter_mut())
                 .zip(self.chunk_reactions.iter_mut())
                 .zip(self.chunk_sums.iter_mut())
@@ -994,7 +1083,11 @@ impl Side {
         } else {
             self.out
                 .par_chunks_mut(SLAVE_CHUNK)
-                .zip(self.state.par_chunks_mut(SLAVE_CHUNK))
+                .zip(
+                    self.state
+                        .par_chunks_mut(SLAVE_CHUNK)
+                        .zip(self.held.par_chunks_mut(SLAVE_CHUNK)),
+                )
                 .zip(self.chunk_active.par_iter_mut())
                 .zip(self.chunk_reactions.par_iter_mut())
                 .zip(self.chunk_sums.par_iter_mut())
@@ -1007,6 +1100,39 @@ impl Side {
                 .for_each(body);
         }
     }
+}
+
+/// How far a slave at `p` is from a face's thickness box (Euclidean distance) or beyond
+/// either of its envelope bounds, whichever is more [m] (see [`Side::margin`]).
+#[inline(always)]
+fn excess(p: &[f64; 3], b: &[f64; 8], m: &[f32; 6], nf: usize) -> f64 {
+    let mut d2 = 0.0;
+    for d in 0..3 {
+        let e = fmax(fmax(b[d] - p[d], p[d] - b[d + 3]), 0.0);
+        d2 += e * e;
+    }
+    let e = d2.sqrt();
+    if nf < 3 {
+        return e;
+    }
+    let m: [f64; 6] = std::array::from_fn(|k| m[k] as f64);
+    let up = m[0] * p[0] + m[1] * p[1] + m[2] * p[2] - b[6];
+    let dn = m[3] * p[0] + m[4] * p[1] + m[5] * p[2] - b[7];
+    fmax(e, fmax(up, dn))
+}
+
+/// A slave opens: its stick spring is released, and what it stored is dissipated (the
+/// returned work [J]).
+#[inline]
+fn release(st: &mut SlaveState) -> f64 {
+    let w = if st.k > 0.0 {
+        dot(&st.ft, &st.ft) / (2.0 * st.k)
+    } else {
+        0.0
+    };
+    st.ft = [0.0; 3];
+    st.k = 0.0;
+    w
 }
 
 /// A face a slave penetrates: the weights `w` of its foot q, the penetration `g` = c − |r|
@@ -1473,6 +1599,9 @@ pub struct SurfaceContact {
     /// Their positions at the last broad phase, and the test of when the candidate lists
     /// go stale.
     motion: Staleness,
+    /// Whether the narrow phase skips the slaves that no candidate can reach yet (see
+    /// `Side::margin`; on by default, the same results either way).
+    pub skip_far: bool,
     /// Skin of the broad phase [m].
     pub skin: f64,
     /// Largest κ_c of the definitions (stable-step guard).
@@ -1533,6 +1662,7 @@ impl SurfaceContact {
             sides,
             nodes,
             motion: Staleness::new(skin),
+            skip_far: true,
             skin,
             kappa_max,
             builds: 0,
@@ -1604,6 +1734,10 @@ impl SurfaceContact {
             })
             .fold(0.0, f64::max);
         self.motion.reset(&self.nodes, x, rho_w);
+        let motion = &self.motion;
+        for s in &mut self.sides {
+            s.set_cells(x, |p| motion.cell(p));
+        }
         self.builds += 1;
     }
 
@@ -1622,7 +1756,7 @@ impl SurfaceContact {
         self.rebuild(x);
         let zero = vec![[0.0; 3]; m.num_nodes()];
         for s in &mut self.sides {
-            s.narrow(x, &zero, 1.0, 0.0, true);
+            s.narrow(x, &zero, 1.0, 0.0, true, None);
             for (si, o) in s.out.iter().enumerate() {
                 if o.face == u32::MAX {
                     continue;
@@ -1682,12 +1816,14 @@ impl SurfaceContact {
         let t1 = std::time::Instant::now();
         self.build_time += t1 - t0;
         let mut stored = 0.0;
+        let spread = self.skip_far.then(|| self.motion.spread());
         for s in &mut self.sides {
-            s.narrow(x, v, dt, dt_prev, false);
+            s.narrow(x, v, dt, dt_prev, false, spread);
             // Sums in chunk order: bit-identical for any thread count.
             for c in &s.chunk_sums {
                 stored += c.stored;
                 self.dissipated += c.dissipated;
+                self.counts.skipped += c.skipped;
                 self.counts.tested += c.tested;
                 self.counts.evaluated += c.evaluated;
                 self.counts.penetrated += c.penetrated;
@@ -1778,6 +1914,7 @@ impl SurfaceContact {
             narrow_seconds: self.narrow_time.as_secs_f64(),
             phases: self.phases,
             slave_steps: self.slave_steps,
+            skipped: self.counts.skipped,
             tested: self.counts.tested,
             evaluated: self.counts.evaluated,
             penetrated: self.counts.penetrated,
@@ -1788,7 +1925,7 @@ impl SurfaceContact {
     pub fn active(&self) -> usize {
         self.sides
             .iter()
-            .map(|s| s.out.iter().filter(|o| o.face != u32::MAX).count())
+            .map(|s| s.chunk_active.iter().map(|a| a.len()).sum::<usize>())
             .sum()
     }
 }
