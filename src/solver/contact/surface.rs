@@ -35,7 +35,10 @@
 //!   quad thins to 0 at the band's edge, where the thickness box stays as high as the
 //!   thick nodes.
 //! - **narrow phase** (pure kernels [`closest_on_face`], [`pair_force`]): the faces'
-//!   thickness boxes and envelope bounds once per step; per slave, the candidates whose
+//!   thickness boxes and envelope bounds once per step; a slave whose margin at the
+//!   build (its distance beyond reach from all its candidates) exceeds how far the nodes
+//!   around it have since moved apart is skipped, as no candidate can pass (`Side::margin`:
+//!   the same results); per other slave, the candidates whose
 //!   thickness box is within t_s/2 + η of it and that are not beyond either envelope
 //!   bound by t_s/2 + η (branch-free passes), then the closest point on each of those;
 //!   of the faces it penetrates, the one of largest penetration sets g, and all of
