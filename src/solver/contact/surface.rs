@@ -322,12 +322,12 @@ pub struct ContactReport {
     /// box was tested, faces past the box and envelope filters (whose closest point was
     /// computed), and faces found penetrated.
     pub slave_steps: u64,
-    /// Slave-steps skipped whole: the slave was farther from every candidate at the
-    /// build than its neighbourhood's nodes have since moved apart (see `Side::margin`).
-    pub skipped: u64,
     pub tested: u64,
     pub evaluated: u64,
     pub penetrated: u64,
+    /// Slave-steps skipped whole: the slave was farther from every candidate at the
+    /// build than its neighbourhood's nodes have since moved apart (see `Side::margin`).
+    pub skipped: u64,
 }
 
 /// Wall time of the contact's phases [s] (see [`ContactReport::phases`]).
@@ -415,8 +415,8 @@ pub struct Side {
 }
 
 /// What one chunk of slaves adds up in a narrow phase: the stored energy and the friction
-/// work [J], the candidate faces whose box was tested, the faces past the filters (whose
-/// closest point was computed), and the faces found penetrated.
+/// work [J], the slaves skipped whole, the candidate faces whose box was tested, the faces
+/// past the filters (whose closest point was computed), and the faces found penetrated.
 #[derive(Debug, Clone, Copy, Default)]
 struct ChunkSums {
     stored: f64,
