@@ -1105,16 +1105,23 @@ impl Side {
     }
 }
 
-/// How far a slave at `p` is from a face's thickness box (Euclidean distance) or beyond
-/// either of its envelope bounds, whichever is more [m] (see [`Side::margin`]).
+/// The squared Euclidean distance from `p` to the box (lo, hi) = (b[0..3], b[3..6]),
+/// without branches (the narrow phase's box test and the build's margins).
 #[inline(always)]
-fn excess(p: &[f64; 3], b: &[f64; 8], m: &[f32; 6], nf: usize) -> f64 {
+fn box_distance2(p: &[f64; 3], b: &[f64; 8]) -> f64 {
     let mut d2 = 0.0;
     for d in 0..3 {
         let e = fmax(fmax(b[d] - p[d], p[d] - b[d + 3]), 0.0);
         d2 += e * e;
     }
-    let e = d2.sqrt();
+    d2
+}
+
+/// How far a slave at `p` is from a face's thickness box (Euclidean distance) or beyond
+/// either of its envelope bounds, whichever is more [m] (see [`Side::margin`]).
+#[inline(always)]
+fn excess(p: &[f64; 3], b: &[f64; 8], m: &[f32; 6], nf: usize) -> f64 {
+    let e = box_distance2(p, b).sqrt();
     if nf < 3 {
         return e;
     }
@@ -1257,12 +1264,7 @@ fn filter_block<const NF: usize>(
     let p = [px, py, pz];
     let mut nn = 0;
     for &fi in block {
-        let bx = &face_box[fi as usize];
-        let mut d2 = 0.0;
-        for d in 0..3 {
-            let e = fmax(fmax(bx[d] - p[d], p[d] - bx[d + 3]), 0.0);
-            d2 += e * e;
-        }
+        let d2 = box_distance2(&p, &face_box[fi as usize]);
         near[nn] = fi;
         nn += (d2 <= r2) as usize;
     }
