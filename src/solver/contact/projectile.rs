@@ -177,7 +177,7 @@ pub fn friction(n: &[f64; 3], fnorm: f64, vr: &[f64; 3], mu: f64) -> ([f64; 3], 
 
 /// Closest point of the triangle (a, b, c) to p, as barycentric weights (w_a, w_b, w_c)
 /// (Ericson, *Real-Time Collision Detection*, §5.1.5).
-#[inline]
+#[inline(always)]
 pub fn closest_on_triangle(p: &[f64; 3], a: &[f64; 3], b: &[f64; 3], c: &[f64; 3]) -> [f64; 3] {
     let sub = |x: &[f64; 3], y: &[f64; 3]| [x[0] - y[0], x[1] - y[1], x[2] - y[2]];
     let dot = |x: &[f64; 3], y: &[f64; 3]| x[0] * y[0] + x[1] * y[1] + x[2] * y[2];
