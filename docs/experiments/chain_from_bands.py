@@ -36,6 +36,13 @@ ap.add_argument("--time-step", type=float, default=None, help="fixed time step [
 a = ap.parse_args()
 
 read = lambda f: pd.read_parquet(os.path.join(a.bands, f + ".parquet"))
+for f in ("nodes", "parts", "elements_quad", "contacts", "analysis", "symmetry", "projectile",
+          "constraints", "node_sets"):
+    if not os.path.exists(os.path.join(a.bands, f + ".parquet")):
+        raise SystemExit(f"{a.bands}: no {f}.parquet; expected a woven band model "
+                         "(weft-weave woven --out DIR)")
+if os.path.abspath(a.out) == os.path.abspath(a.bands):
+    raise SystemExit(f"{a.out}: the output folder is the input model; give another folder")
 nodes, parts, quads = read("nodes"), read("parts"), read("elements_quad")
 # Nodal thickness (largest over a node's quads) and family (its quads' part).
 thick, fam = {}, {}
