@@ -158,27 +158,27 @@ pub fn closest_on_quad(p: &[f64; 3], x: &[[f64; 3]; 4]) -> [f64; 4] {
     let d = super::closest_on_triangle(p, &x[1], &x[3], &x[0]);
     // Split 0-2: triangles (0,1,2), (0,2,3); split 1-3: (1,2,3), (1,3,0). Each split
     // takes its nearer triangle; the two splits are averaged.
-    // The foot of each triangle and its squared distance. The foot's sum runs over the
-    // triangle's nodes in ascending order (`i`, with `w` in the same order): the quad's
-    // four-term sum in node order, less its zero term, so the same bits.
-    let q = |w: [f64; 3], i: [usize; 3]| -> f64 {
-        let qp: [f64; 3] = std::array::from_fn(|dd| {
-            -0.0 + w[0] * x[i[0]][dd] + w[1] * x[i[1]][dd] + w[2] * x[i[2]][dd]
-        });
-        let r = sub(p, &qp);
-        dot(&r, &r)
-    };
-    let put = |w: [f64; 3], i: [usize; 3]| -> [f64; 4] {
+    // Each triangle's weights on the quad's nodes and the squared distance to its foot.
+    // The foot is summed over the triangle's three nodes in node order: the four-term
+    // sum less its zero term (the node `skip` not in the triangle), so the same bits.
+    let q = |w: [f64; 3], i: [usize; 3]| -> ([f64; 4], f64) {
         let mut ww = [0.0; 4];
         for k in 0..3 {
             ww[i[k]] = w[k];
         }
-        ww
+        let skip = 6 - i[0] - i[1] - i[2];
+        let qp: [f64; 3] = std::array::from_fn(|dd| {
+            (0..4)
+                .filter(|&k| k != skip)
+                .fold(-0.0, |s, k| s + ww[k] * x[k][dd])
+        });
+        let r = sub(p, &qp);
+        (ww, dot(&r, &r))
     };
-    let (da, db) = (q(a, [0, 1, 2]), q(b, [0, 2, 3]));
-    let (dc, dd) = (q(c, [1, 2, 3]), q([d[2], d[0], d[1]], [0, 1, 3]));
-    let (wa, wb) = (put(a, [0, 1, 2]), put(b, [0, 2, 3]));
-    let (wc, wd) = (put(c, [1, 2, 3]), put(d, [1, 3, 0]));
+    let (wa, da) = q(a, [0, 1, 2]);
+    let (wb, db) = q(b, [0, 2, 3]);
+    let (wc, dc) = q(c, [1, 2, 3]);
+    let (wd, dd) = q(d, [1, 3, 0]);
     let s1 = if da <= db { wa } else { wb };
     let s2 = if dc <= dd { wc } else { wd };
     std::array::from_fn(|k| 0.5 * (s1[k] + s2[k]))
