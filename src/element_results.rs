@@ -172,7 +172,7 @@ impl ElementResults {
                     ElementKind::Truss => {
                         let l = norm(sub(nodes[0], nodes[1]));
                         let l0 = l / (1.0 + p.prestrain.unwrap_or(0.0));
-                        let ea = p.youngs_modulus.unwrap_or(0.0) * p.area.unwrap_or(0.0);
+                        let ea = p.youngs_modulus.unwrap_or(0.0) * b.truss_area(&m.parts, e);
                         Item::Truss {
                             nodes: [nodes[0], nodes[1]],
                             k: ea / l0,

@@ -171,6 +171,19 @@ fn family(m: &Model, part: usize) -> Option<usize> {
     }
 }
 
+/// The yarn elements of `m` (quads of bands, trusses of chains, of parts named `warp…`
+/// or `weft…`): (block, nodes per element, element).
+fn yarn_elements(m: &Model) -> impl Iterator<Item = (&crate::model::ElementBlock, usize, usize)> {
+    [ElementKind::Quad, ElementKind::Truss]
+        .into_iter()
+        .filter_map(move |k| m.elements.get(&k).map(|b| (b, k.nodes_per_element())))
+        .flat_map(move |(b, npe)| {
+            (0..b.len())
+                .filter(move |&e| family(m, b.part[e]).is_some())
+                .map(move |e| (b, npe, e))
+        })
+}
+
 /// The centre line of the yarn of family `fam` through the first node of `set`: the
 /// nodes of its part with the same reference y (warp) or x (weft), along the yarn.
 fn centre_line(m: &Model, set: &str, fam: usize) -> Vec<usize> {
@@ -179,15 +192,20 @@ fn centre_line(m: &Model, set: &str, fam: usize) -> Vec<usize> {
     };
     let (across, along) = if fam == 0 { (1, 0) } else { (0, 1) };
     let c = m.coords[n0][across];
-    let Some(b) = m.elements.get(&ElementKind::Quad) else {
+    // The yarn's elements: band quads or chain trusses.
+    let Some((b, npe)) = [ElementKind::Quad, ElementKind::Truss]
+        .into_iter()
+        .filter_map(|k| m.block(k).map(|b| (b, k.nodes_per_element())))
+        .find(|(b, npe)| (0..b.len()).any(|e| b.nodes[npe * e..npe * (e + 1)].contains(&n0)))
+    else {
         return vec![];
     };
     let part = (0..b.len())
-        .find(|&e| b.nodes[4 * e..4 * e + 4].contains(&n0))
+        .find(|&e| b.nodes[npe * e..npe * (e + 1)].contains(&n0))
         .map(|e| b.part[e]);
     let mut nodes: Vec<usize> = (0..b.len())
         .filter(|&e| Some(b.part[e]) == part)
-        .flat_map(|e| b.nodes[4 * e..4 * e + 4].to_vec())
+        .flat_map(|e| b.nodes[npe * e..npe * (e + 1)].to_vec())
         .filter(|&n| (m.coords[n][across] - c).abs() < 1e-12)
         .collect();
     nodes.sort_unstable_by(|a, b| m.coords[*a][along].total_cmp(&m.coords[*b][along]));
@@ -270,12 +288,16 @@ pub fn form(
     form_from(m, p, None, progress)
 }
 
-/// Quad part name of each node (the first quad that holds it), or "".
+/// Part name of each node (the first quad, else truss, that holds it), or "".
 fn node_parts(m: &Model) -> Vec<&str> {
     let mut out = vec![""; m.num_nodes()];
-    if let Some(b) = m.elements.get(&ElementKind::Quad) {
+    for kind in [ElementKind::Quad, ElementKind::Truss] {
+        let Some(b) = m.elements.get(&kind) else {
+            continue;
+        };
+        let npe = kind.nodes_per_element();
         for e in 0..b.len() {
-            for &n in &b.nodes[4 * e..4 * e + 4] {
+            for &n in &b.nodes[npe * e..npe * (e + 1)] {
                 if out[n].is_empty() {
                     out[n] = &m.parts[b.part[e]].name;
                 }
@@ -473,14 +495,21 @@ pub fn form_from(
                 .expected("a step budget ≥ 1"),
         );
     }
-    let quads = m
-        .elements
-        .get(&ElementKind::Quad)
-        .filter(|b| !b.is_empty())
-        .ok_or_else(|| {
-            WeftError::input("the model has no membrane quads: nothing to form")
-                .hint("form a model from `weft-weave woven`")
-        })?;
+    // The yarns: bands of quads, or chains of trusses (`weft-weave woven --yarn-model`).
+    let no_elements = crate::model::ElementBlock::default();
+    let quads = m.elements.get(&ElementKind::Quad).unwrap_or(&no_elements);
+    let trusses = m.elements.get(&ElementKind::Truss).unwrap_or(&no_elements);
+    let yarn_elements = |b: &crate::model::ElementBlock| {
+        (0..b.len())
+            .filter(|&e| family(m, b.part[e]).is_some())
+            .count()
+    };
+    if yarn_elements(quads) + yarn_elements(trusses) == 0 {
+        return Err(WeftError::input(
+            "the model has no yarns (quads or trusses of parts named `warp…` or `weft…`): nothing to form",
+        )
+        .hint("form a model from `weft-weave woven`"));
+    }
     if !(0..m.parts.len()).any(|i| family(m, i).is_some()) {
         return Err(WeftError::input(
             "no part is named `warp…` or `weft…`: no yarns to put under tension",
@@ -551,6 +580,26 @@ pub fn form_from(
             end_fam[n] = f;
             end_part[n] = quads.part[e];
         }
+    }
+    // A chain's end: the held node of a truss with one node held carries its section.
+    for e in 0..trusses.len() {
+        let Some(f) = family(m, trusses.part[e]) else {
+            continue;
+        };
+        let [a, b] = [trusses.nodes[2 * e], trusses.nodes[2 * e + 1]];
+        let (end, inner) = match (held[a], held[b]) {
+            (true, false) => (a, b),
+            (false, true) => (b, a),
+            _ => continue,
+        };
+        share[end] += trusses.truss_area(&m.parts, e);
+        end_sign[end] = if m.coords[end][f] >= m.coords[inner][f] {
+            1.0
+        } else {
+            -1.0
+        };
+        end_fam[end] = f;
+        end_part[end] = trusses.part[e];
     }
     // Each yarn end: its nodes (connected held nodes of one part at one edge) share T.
     // The end section of one yarn is the sum of the shares of its nodes; group the end
@@ -681,6 +730,8 @@ pub fn form_from(
         }
         stress0 = Some((membrane, s0));
     }
+    // The largest yarn thickness: the bands' nodal thickness, or the chains' contact
+    // thickness.
     let t_max = if quads.thickness.is_empty() {
         m.parts
             .iter()
@@ -688,7 +739,14 @@ pub fn form_from(
             .fold(0.0, f64::max)
     } else {
         quads.thickness.iter().cloned().fold(0.0, f64::max)
-    };
+    }
+    .max(
+        m.contacts
+            .iter()
+            .flat_map(|c| [c.slave_thickness, c.master_thickness])
+            .flatten()
+            .fold(0.0, f64::max),
+    );
     let credited = start.map_or(0.0, |s| s.work);
     if let Some(s) = start {
         if s.u.len() != m.num_nodes() {
@@ -741,6 +799,23 @@ pub fn form_from(
                 let vol = qs.reference[e].area * qs.thickness[e];
                 sv += tension_1(&xe, &qs.reference[e], &qs.material[e]) * vol;
                 v += vol;
+            }
+            // Chains: the length-weighted mean of the trusses' stress N/A.
+            let tg = &solver.op.el.truss;
+            for e in 0..tg.id.len() {
+                if family(m, trusses.part[e]) != Some(f) {
+                    continue;
+                }
+                let [a, b] = tg.nodes[e].map(|n| n as usize);
+                let n = crate::solver::truss::axial_force(
+                    &x[a],
+                    &x[b],
+                    tg.k[e],
+                    tg.l0[e],
+                    tg.tension_only[e],
+                );
+                sv += n * tg.l0[e];
+                v += trusses.truss_area(&m.parts, e) * tg.l0[e];
             }
             if v > 0.0 {
                 *t = sv / v * section[f];
@@ -868,8 +943,15 @@ pub fn form_from(
     let max_pen = solver.op.surfaces.deepest();
     if let Some((r, g, cid, node, el)) = max_pen {
         if r > p.penetration_limit {
+            // The surface's element kind (of the definition's master part; a two-way
+            // definition between bands or between chains has one kind on both sides).
+            let kind = m
+                .contacts
+                .iter()
+                .find(|c| c.id == cid)
+                .map_or("element", |c| m.parts[c.master].kind.name());
             return Err(WeftError::input(format!(
-                "after forming, node `{}` is {g:.3e} m inside the surface of quad `{el}` (contact `{cid}`): {:.0} % of the contact distance",
+                "after forming, node `{}` is {g:.3e} m inside the surface of {kind} `{el}` (contact `{cid}`): {:.0} % of the contact distance",
                 m.node_id[node],
                 100.0 * r
             ))
@@ -1003,16 +1085,10 @@ pub fn cell_start(m: &Model, p: &Params, progress: &mut dyn FnMut(&RelaxStats)) 
     let f = cell::form(&c, p, CELL_TENSION_TOLERANCE, progress)
         .map_err(|e| e.context("cannot form the periodic cell".to_string()))?;
     let u = cell::tile(m, &c, &f)?;
-    let yarn_quads = |mm: &Model| {
-        mm.elements.get(&ElementKind::Quad).map_or(0, |b| {
-            (0..b.len())
-                .filter(|&e| family(mm, b.part[e]).is_some())
-                .count()
-        })
-    };
+    let yarn_count = |mm: &Model| yarn_elements(mm).count();
     Ok(Start {
         u,
-        work: f.work * yarn_quads(m) as f64 / yarn_quads(&c.model).max(1) as f64,
+        work: f.work * yarn_count(m) as f64 / yarn_count(&c.model).max(1) as f64,
         cell: Some(CellSummary {
             rounds: f.rounds,
             steps: f.steps,
@@ -1037,9 +1113,9 @@ pub fn run(c: &Config, progress: &mut dyn FnMut(&RelaxStats)) -> Result<Report> 
                 .map_err(|e| e.context(format!("cannot start from `{name}`")))?;
             let rp = dir.join("form.parquet");
             let w = Table::read(&rp)?.f64("forming_work", "forming_work (from weft-form)")?;
-            let quads = |mm: &Model| mm.elements.get(&ElementKind::Quad).map_or(0, |b| b.len());
+            let yarns = |mm: &Model| yarn_elements(mm).count();
             let work =
-                w.first().copied().unwrap_or(0.0) * quads(&m) as f64 / quads(&cell).max(1) as f64;
+                w.first().copied().unwrap_or(0.0) * yarns(&m) as f64 / yarns(&cell).max(1) as f64;
             Some(Start {
                 u,
                 work,

@@ -48,6 +48,10 @@ struct Cli {
     woven_yarns: usize,
     #[arg(long, default_value_t = 6e-5)]
     woven_end_time: f64,
+    /// The yarns of the woven benchmark: `band` (the reference) or `chain` (truss chains;
+    /// `weft-weave woven --yarn-model`).
+    #[arg(long, value_enum, default_value_t = weft::generate::woven::YarnModel::Band)]
+    woven_yarn_model: weft::generate::woven::YarnModel,
     /// Sweep sizes for the pipeline benchmark.
     #[arg(long, value_delimiter = ',', default_values_t = vec![1000usize, 10_000])]
     instances: Vec<usize>,
@@ -271,16 +275,26 @@ fn bench_contact(nodes: &[usize], threads: &[usize], node_steps: f64) -> anyhow:
 
 /// The yarn-level patch: wall time, elements, step, element-cycles per second, the
 /// contact's share.
-fn bench_woven(yarns: usize, end_time: f64, threads: &[usize]) -> anyhow::Result<()> {
-    use weft::generate::woven::{woven, WovenBandParams};
+fn bench_woven(
+    yarns: usize,
+    end_time: f64,
+    yarn_model: weft::generate::woven::YarnModel,
+    threads: &[usize],
+) -> anyhow::Result<()> {
+    use weft::generate::woven::{woven, WovenBandParams, YarnModel};
+    let model = match yarn_model {
+        YarnModel::Band => "band",
+        YarnModel::Chain => "chain",
+    };
     let p = WovenBandParams {
         yarns,
         end_time,
+        yarn_model,
         output_interval: end_time / 20.0,
         ..WovenBandParams::default()
     };
     let (m, _) = woven(&p)?;
-    println!("yarns,threads,elements,nodes,steps,dt,wall_seconds,element_cycles_per_second,contact_seconds,contact_share,broad_phase_builds,max_balance_error_relative,finished");
+    println!("yarn_model,yarns,threads,elements,nodes,steps,dt,wall_seconds,element_cycles_per_second,contact_seconds,contact_share,broad_phase_builds,max_balance_error_relative,finished");
     for &t in threads {
         let pool = rayon::ThreadPoolBuilder::new().num_threads(t).build()?;
         let t0 = Instant::now();
@@ -300,7 +314,7 @@ fn bench_woven(yarns: usize, end_time: f64, threads: &[usize]) -> anyhow::Result
         let c = rep.build_seconds + rep.narrow_seconds;
         let cycles = steps as f64 * m.num_elements() as f64 / wall;
         println!(
-            "{yarns},{t},{},{},{steps},{:.4e},{wall:.2},{cycles:.3e},{c:.2},{:.3},{},{bal:.3e},{done}",
+            "{model},{yarns},{t},{},{},{steps},{:.4e},{wall:.2},{cycles:.3e},{c:.2},{:.3},{},{bal:.3e},{done}",
             m.num_elements(),
             m.num_nodes(),
             s.stable.dt,
@@ -308,7 +322,7 @@ fn bench_woven(yarns: usize, end_time: f64, threads: &[usize]) -> anyhow::Result
             rep.builds
         );
         eprintln!(
-            "  woven {yarns}×{yarns} quarter, {t} thread(s): {} band quads, {} nodes, {steps} steps of {:.3e} s in {wall:.1} s: {cycles:.3e} element-cycles/s; contact {c:.1} s ({:.0} %: broad phase {:.1} s in {} builds, narrow {:.1} s); finished: {done}",
+            "  woven {yarns}×{yarns} quarter ({model}s), {t} thread(s): {} elements, {} nodes, {steps} steps of {:.3e} s in {wall:.1} s: {cycles:.3e} element-cycles/s; contact {c:.1} s ({:.0} %: broad phase {:.1} s in {} builds, narrow {:.1} s); finished: {done}",
             m.num_elements(),
             m.num_nodes(),
             s.stable.dt,
@@ -339,7 +353,12 @@ fn bench_woven(yarns: usize, end_time: f64, threads: &[usize]) -> anyhow::Result
 fn main() -> anyhow::Result<()> {
     let cli: Cli = weft::cli::parse();
     if cli.woven {
-        return bench_woven(cli.woven_yarns, cli.woven_end_time, &cli.threads);
+        return bench_woven(
+            cli.woven_yarns,
+            cli.woven_end_time,
+            cli.woven_yarn_model,
+            &cli.threads,
+        );
     }
     if cli.pipeline {
         return bench_pipeline(&cli.instances);

@@ -99,6 +99,14 @@ struct WovenBandArgs {
     /// Quads across a yarn's width (even, ≥ 2).
     #[arg(long, default_value_t = 2)]
     across: usize,
+    /// How each yarn is modelled: `band`, the paper's reference (orthotropic membrane
+    /// quads across the width, contact on the lenticular band faces), or `chain`, trusses
+    /// along the band's centre line with the band's section and mass and its centre
+    /// thickness as contact thickness (no width: 4–5 × faster; the yarn on a symmetry
+    /// plane has half the section; the projectile's nose grows by half that thickness,
+    /// its tip as much lower, so that it meets the yarns' surfaces).
+    #[arg(long, value_enum, default_value_t = weft::generate::woven::YarnModel::Band)]
+    yarn_model: weft::generate::woven::YarnModel,
     /// Yarn Young's modulus along the yarn [Pa] (aramid, Kevlar 29 class).
     #[arg(long, default_value_t = 80e9)]
     modulus: f64,
@@ -675,6 +683,7 @@ fn run() -> anyhow::Result<ExitCode> {
                 crimp_amplitude: a.crimp_amplitude,
                 per_spacing: a.per_spacing,
                 across: a.across,
+                yarn_model: a.yarn_model,
                 modulus: a.modulus,
                 transverse_modulus: a.transverse_modulus,
                 shear_modulus: a.shear_modulus,
@@ -705,7 +714,7 @@ fn run() -> anyhow::Result<ExitCode> {
             };
             let m = weave::run(&Spec::Woven(p), &a.out, &mut warn)?;
             eprintln!(
-                "weft-weave woven: {} nodes, {} band quads, {} contact definitions -> {}",
+                "weft-weave woven: {} nodes, {} elements, {} contact definitions -> {}",
                 m.num_nodes(),
                 m.num_elements(),
                 m.contacts.len(),

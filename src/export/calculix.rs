@@ -199,7 +199,7 @@ pub fn deck(m: &Model, dt: f64, nsub: u64, provenance: &str) -> Result<(String, 
             let p = &m.parts[b.part[e]].props;
             let (ym, area, rho) = (
                 p.youngs_modulus.unwrap_or(0.0),
-                p.area.unwrap_or(0.0),
+                b.truss_area(&m.parts, e),
                 p.density.unwrap_or(0.0),
             );
             let l = dist(a, c);

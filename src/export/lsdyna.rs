@@ -54,6 +54,13 @@ fn check(m: &Model) -> Result<()> {
             {
                 return Err(refuse(FORMAT, &what("the prestrain or tension-only law"), "not mapped yet (LS-DYNA's cable, MAT_071, is a discrete beam with its own offset law)"));
             }
+            if *kind == ElementKind::Truss && b.truss_area(&m.parts, e) != p.area.unwrap_or(0.0) {
+                return Err(refuse(
+                    FORMAT,
+                    &what("a cross-section area of its own (elements_truss.parquet `area`)"),
+                    "not mapped yet (*ELEMENT_BEAM_THICKNESS)",
+                ));
+            }
             if *kind == ElementKind::Link && p.sliding == Some(true) {
                 return Err(refuse(
                     FORMAT,

@@ -36,7 +36,7 @@ use crate::model::{ElementKind, Model, Part, SymmetryPlane};
 use crate::solver::relax::{RelaxOptions, RelaxStats};
 use crate::solver::Solver;
 
-use super::{family, Params};
+use super::{family, yarn_elements, Params};
 
 /// Largest number of relaxations of the cell while its planes are moved to the tension.
 const ROUNDS: usize = 40;
@@ -95,20 +95,19 @@ fn in_cell(c: f64, x0: f64, p: f64, tol: f64) -> bool {
 pub fn extract(m: &Model, spacing: f64) -> Result<Cell> {
     let p = spacing;
     let tol = 1e-6 * p;
-    let Some(quads) = m.elements.get(&ElementKind::Quad) else {
-        return Err(
-            WeftError::input("the model has no membrane quads: no yarns to form")
-                .hint("form a model from `weft-weave woven`"),
-        );
-    };
-    let yarn_quad = |e: usize| family(m, quads.part[e]).is_some();
+    if yarn_elements(m).next().is_none() {
+        return Err(WeftError::input(
+            "the model has no yarns (quads or trusses of parts named `warp…` or `weft…`): no yarns to form",
+        )
+        .hint("form a model from `weft-weave woven`"));
+    }
     // x₀: the first warp centre line at y ≥ its smallest coordinate: a quarter patch's
     // warp 0 lies on y = 0, a full patch's first on (−N/2 + ½)p. The crossing nodes of
     // `axis_x` give the wefts' centre lines (x); the warps' are the same by symmetry.
     let mut lo = f64::INFINITY;
     let mut hi = f64::NEG_INFINITY;
-    for e in (0..quads.len()).filter(|&e| yarn_quad(e)) {
-        for &n in &quads.nodes[4 * e..4 * e + 4] {
+    for (b, npe, e) in yarn_elements(m) {
+        for &n in &b.nodes[npe * e..npe * (e + 1)] {
             lo = lo.min(m.coords[n][0]);
             hi = hi.max(m.coords[n][0]);
         }
@@ -130,8 +129,8 @@ pub fn extract(m: &Model, spacing: f64) -> Result<Cell> {
     }
     // Cell nodes: of yarn quads, within the cell.
     let mut keep = vec![false; m.num_nodes()];
-    for e in (0..quads.len()).filter(|&e| yarn_quad(e)) {
-        for &n in &quads.nodes[4 * e..4 * e + 4] {
+    for (b, npe, e) in yarn_elements(m) {
+        for &n in &b.nodes[npe * e..npe * (e + 1)] {
             let c = m.coords[n];
             if in_cell(c[0], x0, p, tol) && in_cell(c[1], x0, p, tol) {
                 keep[n] = true;
@@ -151,12 +150,12 @@ pub fn extract(m: &Model, spacing: f64) -> Result<Cell> {
     }
     let mut part_index = vec![usize::MAX; m.parts.len()];
     let mut patch_part = vec![];
-    for e in (0..quads.len()).filter(|&e| yarn_quad(e)) {
-        let ns = &quads.nodes[4 * e..4 * e + 4];
+    for (b, npe, e) in yarn_elements(m) {
+        let ns = &b.nodes[npe * e..npe * (e + 1)];
         if !ns.iter().all(|&n| keep[n]) {
             continue;
         }
-        let pi = quads.part[e];
+        let pi = b.part[e];
         if part_index[pi] == usize::MAX {
             let Part {
                 id,
@@ -168,21 +167,37 @@ pub fn extract(m: &Model, spacing: f64) -> Result<Cell> {
             patch_part.push(pi);
         }
         let local: Vec<usize> = ns.iter().map(|&n| index[n]).collect();
-        if quads.thickness.is_empty() {
-            cell.add_element(quads.id[e], part_index[pi], &local);
+        if npe == 2 {
+            // A chain on one of the cell's planes is half in the cell: half the full
+            // yarn's section (the patch's own yarn on a symmetry plane is half already).
+            let [a, c] = [ns[0], ns[1]];
+            let on_plane = [0, 1].into_iter().any(|d| {
+                [x0, x0 + p].into_iter().any(|at| {
+                    (m.coords[a][d] - at).abs() <= tol && (m.coords[c][d] - at).abs() <= tol
+                })
+            });
+            let full = m.parts[pi].props.area.unwrap_or(0.0);
+            let area = if on_plane {
+                0.5 * full
+            } else {
+                b.truss_area(&m.parts, e)
+            };
+            cell.add_truss_with_area(b.id[e], part_index[pi], [local[0], local[1]], area);
+        } else if b.thickness.is_empty() {
+            cell.add_element(b.id[e], part_index[pi], &local);
         } else {
             cell.add_element_with_thickness(
-                quads.id[e],
+                b.id[e],
                 part_index[pi],
                 &local,
-                &quads.thickness[4 * e..4 * e + 4],
+                &b.thickness[npe * e..npe * (e + 1)],
             );
         }
     }
-    // A node within the cell that no cell quad holds (a band edge beyond a cut) would
+    // A node within the cell that no cell element holds (a band edge beyond a cut) would
     // carry no mass.
     let mut held = vec![false; cell.num_nodes()];
-    if let Some(b) = cell.elements.get(&ElementKind::Quad) {
+    for b in cell.elements.values() {
         for &n in &b.nodes {
             held[n] = true;
         }
@@ -235,10 +250,11 @@ pub fn extract(m: &Model, spacing: f64) -> Result<Cell> {
             continue;
         }
         layers += 1;
-        let b = &cell.elements[&ElementKind::Quad];
+        let kind = cell.parts[ci].kind;
+        let (b, npe) = (&cell.elements[&kind], kind.nodes_per_element());
         let pick = (0..b.len())
             .filter(|&e| b.part[e] == ci)
-            .flat_map(|e| b.nodes[4 * e..4 * e + 4].to_vec())
+            .flat_map(|e| b.nodes[npe * e..npe * (e + 1)].to_vec())
             .min_by(|&a, &b| {
                 let da =
                     (cell.coords[a][0] - (x0 + 0.5 * p)).abs() + (cell.coords[a][1] - x0).abs();
@@ -321,7 +337,15 @@ pub fn form(
         .elements
         .get(&ElementKind::Quad)
         .map(|b| b.thickness.iter().cloned().fold(0.0, f64::max))
-        .unwrap_or(0.0);
+        .unwrap_or(0.0)
+        .max(
+            model
+                .contacts
+                .iter()
+                .flat_map(|c| [c.slave_thickness, c.master_thickness])
+                .flatten()
+                .fold(0.0, f64::max),
+        );
     // The first guess: the cell stretched so that the warp's centre line, of the
     // generated path length, runs straight between crossings at ±a (a the generated
     // amplitude): δ = p (L/L_straight − 1).
@@ -330,10 +354,9 @@ pub fn form(
             let mut v: Vec<usize> = (0..model.num_nodes())
                 .filter(|&n| (model.coords[n][1 - d] - cell.origin).abs() <= 1e-6 * pp)
                 .filter(|&n| {
-                    let b = &model.elements[&ElementKind::Quad];
-                    (0..b.len()).any(|e| {
+                    yarn_elements(&model).any(|(b, npe, e)| {
                         family(&model, b.part[e]) == Some(d)
-                            && b.nodes[4 * e..4 * e + 4].contains(&n)
+                            && b.nodes[npe * e..npe * (e + 1)].contains(&n)
                     })
                 })
                 .collect();
@@ -494,12 +517,10 @@ pub fn tile(m: &Model, cell: &Cell, f: &CellForm) -> Result<Vec<[f64; 3]>> {
     let key = |part: usize, x: f64, y: f64| (part, (x / q).round() as i64, (y / q).round() as i64);
     let mut index: std::collections::HashMap<(usize, i64, i64), usize> = Default::default();
     let cm = &cell.model;
-    if let Some(b) = cm.elements.get(&ElementKind::Quad) {
-        for e in 0..b.len() {
-            for &n in &b.nodes[4 * e..4 * e + 4] {
-                let c = cm.coords[n];
-                index.insert(key(cell.patch_part[b.part[e]], c[0], c[1]), n);
-            }
+    for (b, npe, e) in yarn_elements(cm) {
+        for &n in &b.nodes[npe * e..npe * (e + 1)] {
+            let c = cm.coords[n];
+            index.insert(key(cell.patch_part[b.part[e]], c[0], c[1]), n);
         }
     }
     // Fold a coordinate into the cell: (folded, sign of the displacement, planes passed).
@@ -515,14 +536,8 @@ pub fn tile(m: &Model, cell: &Cell, f: &CellForm) -> Result<Vec<[f64; 3]>> {
     };
     let mut u = vec![[0.0; 3]; m.num_nodes()];
     let mut done = vec![false; m.num_nodes()];
-    let Some(b) = m.elements.get(&ElementKind::Quad) else {
-        return Ok(u);
-    };
-    for e in 0..b.len() {
-        if family(m, b.part[e]).is_none() {
-            continue;
-        }
-        for &n in &b.nodes[4 * e..4 * e + 4] {
+    for (b, npe, e) in yarn_elements(m) {
+        for &n in &b.nodes[npe * e..npe * (e + 1)] {
             if done[n] {
                 continue;
             }

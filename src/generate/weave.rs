@@ -58,6 +58,17 @@ pub fn run(spec: &Spec, out: &Path, on_warning: &mut dyn FnMut(&str)) -> Result<
         Spec::Combined(p) => combined(p),
         Spec::WovenReduced(p) => woven_reduced(p),
         Spec::Woven(p) => woven(p).map(|(m, info)| {
+            if p.yarn_model == crate::generate::woven::YarnModel::Chain {
+                on_warning(&format!(
+                    "note: truss chains of the lenticular section {:.4e} m² (halved on the symmetry planes), contact thickness {:.4e} m (the bands' centre thickness); crimp amplitude {:.4e} m (crimp {:.3} %); areal density {:.1} g/m² per layer",
+                    info.area,
+                    info.contact_thickness,
+                    info.crimp_amplitude,
+                    100.0 * info.crimp,
+                    1e3 * info.areal_density
+                ));
+                return m;
+            }
             on_warning(&format!(
                 "note: lenticular section {:.4e} m², nodal thickness scaled by {:.4} so that the bands carry it exactly; crimp amplitude {:.4e} m (crimp {:.3} %); areal density {:.1} g/m² per layer",
                 info.area,

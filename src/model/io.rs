@@ -243,6 +243,12 @@ fn read_model_inner(dir: &Path) -> Result<Model> {
                 .expected("all three or none"));
             }
         }
+        // Cross-section area of trusses (null: the part's area).
+        let acol = if kind == ElementKind::Truss {
+            t.f64_opt("area")?
+        } else {
+            None
+        };
         // Frame nodes of links: f1…f4 (all or none; see `ElementBlock::frame`).
         let mut fcols = Vec::new();
         if kind == ElementKind::Link {
@@ -279,6 +285,10 @@ fn read_model_inner(dir: &Path) -> Result<Model> {
             for c in &tcols {
                 let pt = m.parts[part].props.thickness.unwrap_or(0.0);
                 b.thickness.push(c[row].unwrap_or(pt));
+            }
+            if let Some(c) = &acol {
+                b.area
+                    .push(c[row].unwrap_or(m.parts[part].props.area.unwrap_or(0.0)));
             }
             if !s0cols.is_empty() {
                 b.stress0
@@ -664,6 +674,9 @@ fn write_tables(m: &Model, dir: &Path, prov: &Provenance) -> Result<()> {
                     b.thickness.iter().skip(j).step_by(npe).copied().collect(),
                 ));
             }
+        }
+        if !b.area.is_empty() {
+            cols.push(Col::F64("area", b.area.clone()));
         }
         if !b.stress0.is_empty() {
             for (j, c) in ["s0_11", "s0_22", "s0_12"].into_iter().enumerate() {

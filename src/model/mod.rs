@@ -89,6 +89,9 @@ pub struct ElementBlock {
     /// element (LS-DYNA's shell nodal thickness); empty when every element has its
     /// part's thickness.
     pub thickness: Vec<f64>,
+    /// Trusses: cross-section area of each element [m²] (a yarn on a symmetry plane
+    /// carries half its section); empty when every truss has its part's area.
+    pub area: Vec<f64>,
     /// Membranes: initial stress [S₁₁, S₂₂, S₁₂] [Pa] in material axes, one per element
     /// (a formed, pre-stressed state); empty when every element starts unstressed.
     pub stress0: Vec<[f64; 3]>,
@@ -105,6 +108,13 @@ impl ElementBlock {
     }
     pub fn is_empty(&self) -> bool {
         self.id.is_empty()
+    }
+    /// Trusses: the cross-section area of element `e` [m²], its own or its part's.
+    pub fn truss_area(&self, parts: &[Part], e: usize) -> f64 {
+        match self.area.get(e) {
+            Some(&a) => a,
+            None => parts[self.part[e]].props.area.unwrap_or(0.0),
+        }
     }
 }
 
@@ -381,12 +391,16 @@ impl Model {
             kind.name()
         );
         let t = self.parts[part].props.thickness.unwrap_or(0.0);
+        let a = self.parts[part].props.area.unwrap_or(0.0);
         let b = self.elements.entry(kind).or_default();
         b.id.push(id);
         b.part.push(part);
         b.nodes.extend_from_slice(nodes);
         if !b.thickness.is_empty() {
             b.thickness.extend(std::iter::repeat_n(t, nodes.len()));
+        }
+        if !b.area.is_empty() {
+            b.area.push(a);
         }
         if !b.stress0.is_empty() {
             b.stress0.push([0.0; 3]);
@@ -456,6 +470,31 @@ impl Model {
         } else {
             let n = b.thickness.len();
             b.thickness[n - thickness.len()..].copy_from_slice(thickness);
+        }
+    }
+
+    /// Add a truss with a cross-section area of its own [m²] (not its part's).
+    pub fn add_truss_with_area(&mut self, id: i64, part: usize, nodes: [usize; 2], area: f64) {
+        let parts = &self.parts;
+        let b = self.elements.entry(ElementKind::Truss).or_default();
+        if b.area.is_empty() && !b.is_empty() {
+            // Earlier trusses have their part's area.
+            b.area = b
+                .part
+                .iter()
+                .map(|&p| parts[p].props.area.unwrap_or(0.0))
+                .collect();
+        }
+        let fresh = b.area.is_empty();
+        self.add_element(id, part, &nodes);
+        let b = self
+            .elements
+            .get_mut(&ElementKind::Truss)
+            .expect("just added");
+        if fresh {
+            b.area.push(area);
+        } else {
+            *b.area.last_mut().expect("one per truss") = area;
         }
     }
 
@@ -790,6 +829,31 @@ impl Model {
                             .at_row(e)
                             .expected("a finite stress in Pa, or null for 0"));
                         }
+                    }
+                }
+            }
+            if !b.area.is_empty() {
+                let file = format!("elements_{}.parquet", kind.name());
+                if *kind != ElementKind::Truss || b.area.len() != b.len() {
+                    return Err(WeftError::input(format!(
+                        "{} elements carry {} cross-section areas for {} elements",
+                        kind.name(),
+                        b.area.len(),
+                        b.len()
+                    ))
+                    .in_file(file)
+                    .expected("an area column on the truss table only, one per element"));
+                }
+                for (e, &a) in b.area.iter().enumerate() {
+                    if !(a.is_finite() && a > 0.0) {
+                        return Err(WeftError::input(format!(
+                            "truss `{}` has cross-section area `{a}`",
+                            b.id[e]
+                        ))
+                        .in_file(file)
+                        .in_column("area")
+                        .at_row(e)
+                        .expected("an area > 0 in m², or null for the part's area"));
                     }
                 }
             }

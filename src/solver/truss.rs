@@ -102,7 +102,7 @@ impl Family for TrussGroup {
             let (e_mod, rho, area) = (
                 p.youngs_modulus.unwrap(),
                 p.density.unwrap(),
-                p.area.unwrap(),
+                b.truss_area(&m.parts, e),
             );
             let me = rho * area * l0;
             mass[a] += 0.5 * me;

@@ -458,7 +458,7 @@ fn nodal_thickness(m: &Model, part: Option<usize>) -> Vec<f64> {
                         }
                     }
                     ElementKind::Truss => {
-                        (4.0 * p.area.unwrap_or(0.0) / std::f64::consts::PI).sqrt()
+                        (4.0 * b.truss_area(&m.parts, e) / std::f64::consts::PI).sqrt()
                     }
                     ElementKind::Beam => p.height.unwrap_or(0.0),
                     _ => continue,
