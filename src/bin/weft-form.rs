@@ -195,7 +195,7 @@ fn run_cli() -> anyhow::Result<ExitCode> {
         100.0 * r.crimp_target,
     );
     eprintln!(
-        "  tension per yarn in the bands: warp {:.4} N, weft {:.4} N (at the ends {:.4} N, {:.4} N); deepest contact {:.1} % of its contact distance; fabric top rose {:.3e} m; {:.1} s",
+        "  mean tension per yarn along the yarns: warp {:.4} N, weft {:.4} N (at the ends {:.4} N, {:.4} N); deepest contact {:.1} % of its contact distance; fabric top rose {:.3e} m; {:.1} s",
         r.warp_tension,
         r.weft_tension,
         r.warp_end_tension,

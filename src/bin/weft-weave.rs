@@ -65,6 +65,7 @@ enum Model {
     /// within and between layers, a round-nosed 9 mm, 8 g projectile at 400 m/s.
     /// Quarter model (symmetry planes x = 0, y = 0) unless --full. Node sets: axis_x,
     /// axis_x_weft, diagonal, diagonal_weft (centre-line nodes at the crossings), edge.
+    /// --yarn-model chain: truss chains along the bands' centre lines instead (faster).
     Woven(WovenBandArgs),
 }
 
