@@ -31,7 +31,7 @@ use serde::Serialize;
 
 use crate::analysis::{interpolation, mismatch_paired, pair, Matching, Pairing, Series};
 use crate::error::{Result, WeftError};
-use crate::model::{props, Model, PartProps};
+use crate::model::{props, ElementKind, Model, PartProps};
 use crate::solver::output::MemorySink;
 use crate::solver::Solver;
 
@@ -169,6 +169,27 @@ pub fn parse_param(spec: &str, m: &Model) -> Result<Parameter> {
                 kind.name(),
                 applies.join(", ")
             )));
+        }
+        // A truss with an area of its own (elements_truss.parquet `area`) would keep it
+        // whatever the part's area is set to.
+        if prop == "area" {
+            if let Some(b) = m.block(ElementKind::Truss) {
+                if let Some(e) = (0..b.len()).find(|&e| {
+                    b.part[e] == pi
+                        && b.area
+                            .get(e)
+                            .is_some_and(|&a| Some(a) != m.parts[pi].props.area)
+                }) {
+                    return Err(bad_param(
+                        spec,
+                        format!(
+                            "truss `{}` of part `{part}` has a cross-section area of its own ({:e} m², elements_truss.parquet `area`), which the part's area does not set",
+                            b.id[e], b.area[e]
+                        ),
+                    )
+                    .hint("fit a part whose trusses all take the part's area (their `area` null in elements_truss.parquet)"));
+                }
+            }
         }
         targets.push(Target {
             part: part.to_string(),

@@ -293,3 +293,20 @@ fn a_bad_truss_area_is_refused_with_the_element_named() {
         "{err}"
     );
 }
+
+/// Fitting a chain part's `area` would leave the half yarns' own areas as they are:
+/// `weft-fit` refuses it, naming the truss.
+#[test]
+fn fitting_the_area_of_trusses_with_their_own_area_is_refused() {
+    let (m, _) = woven(&params(2, YarnModel::Chain)).unwrap();
+    let err = weft::fit::parse_param("warp_1.area:1e-8:1e-7", &m)
+        .unwrap_err()
+        .to_string();
+    println!("{err}");
+    assert!(
+        err.contains("truss `1` of part `warp_1` has a cross-section area of its own"),
+        "{err}"
+    );
+    // The part's modulus is fitted as usual.
+    assert!(weft::fit::parse_param("warp_1.E:1e10:1e11", &m).is_ok());
+}

@@ -64,7 +64,7 @@ pub enum YarnModel {
     Band,
     /// A chain of trusses along the band's centre line, of the band's section and mass,
     /// with the band's centre thickness t_c as contact thickness (nodes and segments; the
-    /// issue's "beam chain with a contact radius"): 4–5 × faster, for studies that need
+    /// issue's "beam chain with a contact radius"): 4–6 × faster, for studies that need
     /// no yarn width (measured against the bands in the README).
     Chain,
 }
