@@ -103,7 +103,7 @@ struct WovenBandArgs {
     /// How each yarn is modelled: `band`, the paper's reference (orthotropic membrane
     /// quads across the width, contact on the lenticular band faces), or `chain`, trusses
     /// along the band's centre line with the band's section and mass and its centre
-    /// thickness as contact thickness (no width: 4–5 × faster; the yarn on a symmetry
+    /// thickness as contact thickness (no width: 4–6 × faster; the yarn on a symmetry
     /// plane has half the section; the projectile's nose grows by half that thickness,
     /// its tip as much lower, so that it meets the yarns' surfaces).
     #[arg(long, value_enum, default_value_t = weft::generate::woven::YarnModel::Band)]
