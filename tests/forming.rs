@@ -250,18 +250,11 @@ fn forming_is_thread_independent() {
     assert!(one.1 == two.1, "from the cell: 1 and 2 threads differ");
 }
 
-#[test]
-fn pulling_the_warp_straightens_it_and_crimps_the_weft() {
-    // Strip tension as a sequence of equilibria (the quasi-static limit of a slow pull):
-    // the warp pulled with T, the weft held at 0.5 N; the strain from the displacement of
-    // the warp ends over the half length.
-    let p0 = WovenBandParams {
-        yarns: 6,
-        ..WovenBandParams::default()
-    };
-    let m = woven(&p0).unwrap().0;
+/// Strip tension as a sequence of equilibria (the quasi-static limit of a slow pull): the
+/// warp of `m` pulled with T = 0.5 … 100 N, the weft held at 0.5 N; per load (T, the
+/// strain from the warp ends' displacement over the half length, warp crimp, weft crimp).
+fn pull_strip(m: &Model, p0: &WovenBandParams) -> Vec<(f64, f64, f64, f64)> {
     let half = (p0.yarns as f64 - 0.5) * p0.spacing;
-    let ea = p0.modulus * Lenticular::new(p0.width, p0.thickness).area();
     let end = m
         .coords
         .iter()
@@ -270,7 +263,7 @@ fn pulling_the_warp_straightens_it_and_crimps_the_weft() {
     let mut pts = vec![];
     for t in [0.5, 5.0, 25.0, 30.0, 90.0, 100.0] {
         let (f, r) = formed(
-            &m,
+            m,
             &Params {
                 warp_tension: t,
                 kinetic_tolerance: 1e-5,
@@ -299,6 +292,48 @@ fn pulling_the_warp_straightens_it_and_crimps_the_weft() {
             100.0 * r.max_penetration_ratio
         );
     }
+    pts
+}
+
+/// The same strip of chains (`--yarn-model chain`): the truss's law is linear in the
+/// engineering strain, N = E·A(L − L₀)/L₀, so the straight yarn's stiffness is E·A exactly
+/// and λ = 1 + T/(E·A).
+#[test]
+fn pulling_a_chain_warp_straightens_it_and_crimps_the_weft() {
+    let p0 = WovenBandParams {
+        yarns: 6,
+        yarn_model: weft::generate::woven::YarnModel::Chain,
+        ..WovenBandParams::default()
+    };
+    let m = woven(&p0).unwrap().0;
+    let ea = p0.modulus * Lenticular::new(p0.width, p0.thickness).area();
+    let pts = pull_strip(&m, &p0);
+    let k = |a: usize, b: usize| (pts[b].0 - pts[a].0) / ea / (pts[b].1 - pts[a].1);
+    println!(
+        "chain strip: (T, strain, warp crimp, weft crimp) {pts:?}; stiffness / E·A: {:.4} (0.5–5 N), {:.4} (25–30 N), {:.4} (90–100 N)",
+        k(0, 1),
+        k(2, 3),
+        k(4, 5)
+    );
+    // Measured 0.058 (de-crimping), 0.974 (25–30 N), 0.984 (90–100 N: the issue asks
+    // 3 %); the warp's crimp 1.39 % → 6·10⁻⁴ % at 30 N while the weft's grows to 6.7 %
+    // (7.0 % at 100 N). The bands: 0.083, 0.897, 0.971 and 1.37 % → 8.1 %.
+    assert!(k(0, 1) < 0.1);
+    assert!(k(2, 3) < k(4, 5));
+    assert!((k(4, 5) - 1.0).abs() < 0.03, "{}", k(4, 5));
+    assert!(pts[3].2 < 0.01 * pts[0].2);
+    assert!(pts[3].3 > 4.0 * pts[0].3);
+}
+
+#[test]
+fn pulling_the_warp_straightens_it_and_crimps_the_weft() {
+    let p0 = WovenBandParams {
+        yarns: 6,
+        ..WovenBandParams::default()
+    };
+    let m = woven(&p0).unwrap().0;
+    let ea = p0.modulus * Lenticular::new(p0.width, p0.thickness).area();
+    let pts = pull_strip(&m, &p0);
     // The straight yarn: the bands' law is St Venant–Kirchhoff, so a straight yarn
     // pulled by T stretches to λ with T = E·A·λ(λ² − 1)/2 (uniaxial plane stress, the
     // nominal force of S = E·(λ² − 1)/2), a tangent E·A(3λ² − 1)/2.
