@@ -499,20 +499,9 @@ pub fn form_from(
     let no_elements = crate::model::ElementBlock::default();
     let quads = m.elements.get(&ElementKind::Quad).unwrap_or(&no_elements);
     let trusses = m.elements.get(&ElementKind::Truss).unwrap_or(&no_elements);
-    let yarn_elements = |b: &crate::model::ElementBlock| {
-        (0..b.len())
-            .filter(|&e| family(m, b.part[e]).is_some())
-            .count()
-    };
-    if yarn_elements(quads) + yarn_elements(trusses) == 0 {
+    if yarn_elements(m).next().is_none() {
         return Err(WeftError::input(
-            "the model has no yarns (quads or trusses of parts named `warp…` or `weft…`): nothing to form",
-        )
-        .hint("form a model from `weft-weave woven`"));
-    }
-    if !(0..m.parts.len()).any(|i| family(m, i).is_some()) {
-        return Err(WeftError::input(
-            "no part is named `warp…` or `weft…`: no yarns to put under tension",
+            "the model has no yarns (quads or trusses of parts named `warp…` or `weft…`): nothing to put under tension",
         )
         .in_file("parts.parquet")
         .hint("form a model from `weft-weave woven`"));

@@ -17,7 +17,10 @@
 //!   are `tests/projectile.rs`' `smith_transverse_impact_strain_and_kink_speed`.
 
 mod common;
+use std::collections::HashMap;
+
 use common::rel;
+use common::woven::run_on;
 use weft::generate::woven::{woven, Lenticular, WovenBandParams, YarnModel};
 use weft::model::ElementKind;
 use weft::solver::{run_in_memory, Solver};
@@ -117,25 +120,18 @@ fn a_chain_patch_impact_keeps_its_energy_and_is_thread_independent() {
         ..params(6, YarnModel::Chain)
     };
     let (m, _) = woven(&p).unwrap();
-    let run = |threads: usize| {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
-        pool.install(|| {
-            let (s, out, stats) = run_in_memory(&m).unwrap();
-            let rep = s.op.surfaces.report(&s.node_id);
-            (out.u, out.energy, out.projectile, rep, stats)
-        })
-    };
-    let (u1, e1, p1, rep, stats) = run(1);
-    let (u2, e2, p2, _, _) = run(2);
+    let (o1, rep, stats) = run_on(&m, 1);
+    let (o2, _, _) = run_on(&m, 2);
+    let (e1, p1) = (&o1.energy, &o1.projectile);
     let last = e1.last().unwrap();
     println!(
         "chain 6×6 quarter, 6 µs: {} slaves in contact, friction work {:.3e} J, contact {:.3e} J, internal {:.3e} J, balance {:.2e}",
         rep.active, rep.friction_work, last.contact, last.internal, stats.max_balance_error_relative
     );
-    assert!(u1 == u2 && e1 == e2 && p1 == p2, "1 and 2 threads differ");
+    assert!(
+        o1.u == o2.u && o1.energy == o2.energy && o1.projectile == o2.projectile,
+        "1 and 2 threads differ"
+    );
     // The issue asks ≤ 1 % with contact and friction; measured 2.6e-5.
     assert!(stats.max_balance_error_relative < 0.01);
     assert!(rep.friction_work > 0.0 && rep.active > 0);
@@ -162,97 +158,48 @@ fn the_chain_patch_front_runs_at_smiths_speed_with_the_fabrics_mass() {
         ..params(16, YarnModel::Chain)
     };
     let (m, _) = woven(&p).unwrap();
-    let dir = tempfile::tempdir().unwrap();
-    let prov = weft::table::Provenance::new("test", serde_json::json!({}));
-    weft::model::io::write_model(&m, &dir.path().join("model"), &prov).unwrap();
-    weft::simulate::run(
-        &weft::simulate::Config {
-            model: dir.path().join("model"),
-            out: dir.path().join("run"),
-            history_sets: Some(vec![]),
-            element_results: vec!["warp_1".into()],
-            ..Default::default()
-        },
-        &mut |_| {},
-    )
-    .unwrap();
+    // The axis warp's trusses (on y = 0): their centre x and area, and their nodes.
     let warp = m.parts.iter().position(|q| q.name == "warp_1").unwrap();
     let b = &m.elements[&ElementKind::Truss];
-    let mut mid: std::collections::HashMap<i64, (f64, f64)> = Default::default();
+    let (mut centre, mut area) = (HashMap::new(), HashMap::new());
     let mut line: Vec<usize> = vec![];
     for e in 0..b.len() {
         let (n1, n2) = (b.nodes[2 * e], b.nodes[2 * e + 1]);
         if b.part[e] != warp || m.coords[n1][1] != 0.0 {
             continue;
         }
-        let xc = 0.5 * (m.coords[n1][0] + m.coords[n2][0]);
-        mid.insert(b.id[e], (xc, b.truss_area(&m.parts, e)));
+        centre.insert(b.id[e], 0.5 * (m.coords[n1][0] + m.coords[n2][0]));
+        area.insert(b.id[e], b.truss_area(&m.parts, e));
         line.extend([n1, n2]);
     }
     line.sort_by(|a, c| m.coords[*a][0].total_cmp(&m.coords[*c][0]));
     line.dedup();
-    let id_of: std::collections::HashMap<i64, usize> = line
-        .iter()
-        .enumerate()
-        .map(|(j, &n)| (m.node_id[n], j))
-        .collect();
-    let h = weft::table::Table::read(&dir.path().join("run/history.parquet")).unwrap();
-    let (ht, hid, huz) = (
-        h.f64("t", "").unwrap(),
-        h.i64("node_id", "").unwrap(),
-        h.f64("uz", "").unwrap(),
-    );
-    let el = weft::table::Table::read(&dir.path().join("run/elements.parquet")).unwrap();
-    let (et, eid, eps_col, n_col) = (
-        el.f64("t", "").unwrap(),
+    let (el, samples) = common::woven::front(&m, &line, &centre);
+    let (eid, eps_col, n_col) = (
         el.i64("element_id", "").unwrap(),
         el.f64("axial_strain", "").unwrap(),
         el.f64("axial_force", "").unwrap(),
     );
-    let sample = |t: f64| (t / p.output_interval).round() as usize;
-    let ns = sample(p.end_time) + 1;
-    let mut uz = vec![vec![0.0; line.len()]; ns];
-    for r in 0..ht.len() {
-        if let Some(&j) = id_of.get(&hid[r]) {
-            uz[sample(ht[r])][j] = huz[r];
-        }
-    }
-    let mut front = vec![];
-    for (k, row) in uz.iter().enumerate() {
-        let t = k as f64 * p.output_interval;
-        if t < 2e-6 - 1e-12 {
-            continue;
-        }
-        let jf = (0..line.len()).rev().find(|&j| -row[j] > 2e-4).unwrap();
-        let xf = m.coords[line[jf]][0];
-        let (mut se, mut sp, mut n) = (0.0, 0.0, 0.0);
-        for r in 0..et.len() {
-            if sample(et[r]) != k {
-                continue;
+    // Per sample: the mean nominal stress N/A and strain behind the front.
+    let front: Vec<(f64, f64)> = samples
+        .iter()
+        .map(|f| {
+            let n = f.rows.len() as f64;
+            for &r in &f.rows {
+                assert!(n_col[r].is_finite() && eps_col[r].is_finite(), "row {r}");
             }
-            if let Some(&(xc, a)) = mid.get(&eid[r]) {
-                if xc > xf - 2e-3 && xc < xf {
-                    assert!(n_col[r].is_finite() && eps_col[r].is_finite(), "row {r}");
-                    se += eps_col[r];
-                    sp += n_col[r] / a;
-                    n += 1.0;
-                }
-            }
-        }
-        front.push((t, xf, sp / n, se / n));
-    }
+            let sp: f64 = f.rows.iter().map(|&r| n_col[r] / area[&eid[r]]).sum();
+            let se: f64 = f.rows.iter().map(|&r| eps_col[r]).sum();
+            (sp / n, se / n)
+        })
+        .collect();
+    let speed = common::woven::front_speed(&samples);
     let nf = front.len() as f64;
-    let (mt, mx) = (
-        front.iter().map(|f| f.0).sum::<f64>() / nf,
-        front.iter().map(|f| f.1).sum::<f64>() / nf,
-    );
-    let speed = front.iter().map(|f| (f.0 - mt) * (f.1 - mx)).sum::<f64>()
-        / front.iter().map(|f| (f.0 - mt).powi(2)).sum::<f64>();
     // P and ε averaged over the samples, then U_L: behind a chain's front (point
     // crossings, every 0.25 mm a node) the strain rings, down to −2 % in one sample,
     // where U_L has no value.
-    let pn = front.iter().map(|f| f.2).sum::<f64>() / nf;
-    let eps = front.iter().map(|f| f.3).sum::<f64>() / nf;
+    let pn = front.iter().map(|f| f.0).sum::<f64>() / nf;
+    let eps = front.iter().map(|f| f.1).sum::<f64>() / nf;
     let smith = (pn / (2.0 * p.density * (1.0 + eps))).sqrt();
     println!(
         "chain patch front {speed:.0} m/s; Smith's U_L with the fabric's mass (2ρ) at the measured strain ({:.2} %): {smith:.0} m/s ({:+.3}); with the yarn's alone: {:.0} m/s",

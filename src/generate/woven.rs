@@ -360,13 +360,15 @@ fn check(p: &WovenBandParams) -> Result<()> {
 /// lines' distance at the crossing, the chords rising from the lower node come within
 /// 0.7 µm of the upper one (the default weave); the bands' curved faces do not.
 pub fn chain_touching_amplitude(t: f64, p: f64, per_spacing: usize) -> f64 {
+    use crate::solver::contact::projectile::closest_on_segment;
     let s = p / per_spacing as f64;
-    // Distance from (0, 0, a) to the chord from (0, 0, −a) to (s, −a cos(πs/p)).
+    // Distance from (0, 0, a) to the chord from (0, 0, −a) to (s, 0, −a cos(πs/p)).
     let dist = |a: f64| {
-        let d = [s, a * (1.0 - (std::f64::consts::PI * s / p).cos())];
-        let w = [0.0, 2.0 * a];
-        let u = ((w[0] * d[0] + w[1] * d[1]) / (d[0] * d[0] + d[1] * d[1])).clamp(0.0, 1.0);
-        ((w[0] - u * d[0]).powi(2) + (w[1] - u * d[1]).powi(2)).sqrt()
+        let (node, c0) = ([0.0, 0.0, a], [0.0, 0.0, -a]);
+        let c1 = [s, 0.0, -a * (std::f64::consts::PI * s / p).cos()];
+        let u = closest_on_segment(&node, &c0, &c1);
+        let foot: [f64; 3] = std::array::from_fn(|d| c0[d] + u * (c1[d] - c0[d]));
+        crate::solver::vec3::norm(&crate::solver::vec3::sub(&node, &foot))
     };
     let want = t + 2e-9;
     let (mut lo, mut hi) = (0.5 * t, t);

@@ -5,6 +5,8 @@ use std::path::{Path, PathBuf};
 
 use weft::model::{Analysis, ElementKind, Load, Model, PartProps, TimeLaw};
 
+pub mod woven;
+
 /// Node 0 fixed, node 1 a point mass `m` joined to it by a link (k, c along x) and free
 /// along x only. Returns the model; initial velocity and loads are added by the caller.
 pub fn oscillator(m: f64, k: f64, c: f64) -> Model {
