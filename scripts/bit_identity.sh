@@ -10,7 +10,7 @@
 # Without --full: the generators except the 60 x 60 woven impact (generated and compared,
 # not simulated) and the pipelines rod_waves and girder_membrane (minutes). With --full:
 # the woven impact simulated too and every pipeline in pipelines/ (about an hour a build
-# on 2 cores).
+# on 2 cores). WEFT_BITID_PIPELINES="rod_waves woven_patch" chooses the pipelines instead.
 #
 # BEFORE and AFTER are each a folder of built binaries (e.g. target/release) or a git
 # revision, which is checked out in a temporary worktree and built (release) into
@@ -45,7 +45,7 @@ run_all() { # $1: binaries, $2: output folder
   done
   mkdir -p "$o/study"
   cp -r "$root/pipelines" "$o/study/"
-  local pipes="rod_waves girder_membrane"
+  local pipes="${WEFT_BITID_PIPELINES:-rod_waves girder_membrane}"
   [ "$full" = 1 ] && pipes="$(cd "$root/pipelines" && ls *.toml | sed 's/\.toml$//')"
   for p in $pipes; do
     (cd "$o/study" && "$b/weft" run --quiet "pipelines/$p.toml" >/dev/null 2>"$o/$p.log") || {
