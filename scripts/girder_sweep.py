@@ -70,7 +70,7 @@ def main():
     w = out.append
     w(f"""# The paper's §4, second half: the membrane y = {{G_m, s_m, ρ_m}} fitted to girders over a
 # grid of x, gathered into one table x → y, T (the remaining mismatch Δ) with the lattice
-# closed forms beside (DESIGN.md §8: s = b²/a, ρ = ρ_g(2 − b/a), G = E(b/a)²/2), then the
+# closed forms beside (docs/theory.md, "Closed forms used as oracles": s = b²/a, ρ = ρ_g(2 − b/a), G = E(b/a)²/2), then the
 # regression and network surrogates of x → y (weft-surrogate) and the paper's Fig. 6b.
 #
 #   weft run pipelines/girder_sweep.toml       (from the project root)

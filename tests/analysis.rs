@@ -72,7 +72,7 @@ fn wavespeed_stage_measures_the_rod_wave_speed() {
 /// The §4 girder (a rigid-jointed square lattice of rods, E = 150 GPa, ρ_g = 7800 kg/m³,
 /// b/a = 0.1) clamped at x = 0 and pulsed along x = L: the longitudinal wave runs at the
 /// lattice's long-wave speed √(E/(ρ_g(2 − b/a))) = 3181 m/s (lattice homogenisation,
-/// DESIGN.md §8: the membrane of thickness b²/a, density ρ_g(2 − b/a)). One level for all
+/// docs/theory.md, "Closed forms used as oracles": the membrane of thickness b²/a, density ρ_g(2 − b/a)). One level for all
 /// nodes and the incident front only; with each node's own half peak, the nodes by the
 /// clamp read −10 000 to −49 000 m/s (a bug found in the §4 figure).
 #[test]

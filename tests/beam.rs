@@ -5,7 +5,7 @@
 //! ω₁ = (β₁L)² √(EI/(ρAL⁴)), β₁L = 1.875104 (Blevins, *Formulas for Natural Frequency
 //! and Mode Shape*, table 8-1); a square lattice of rigidly jointed rods (spacing a,
 //! in-plane width b, height h) has the membrane shear stiffness per unit width
-//! E h b³/(2a³) (Gibson & Ashby, *Cellular Solids*, §4.3, square cells; DESIGN.md §8).
+//! E h b³/(2a³) (Gibson & Ashby, *Cellular Solids*, §4.3, square cells; docs/theory.md, "Closed forms used as oracles").
 //!
 //! ```text
 //!   clamped |==o==o==o== ... ==o  <- P        20 beams, L = 0.1 m, b = 2 mm, h = 1 mm

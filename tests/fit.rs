@@ -141,7 +141,7 @@ fn fit_recovers_a_models_own_parameters() {
 }
 
 /// Relative errors of the fitted (G, s, ρ) against the closed forms of a square lattice of
-/// rigid-jointed rods (DESIGN.md §8; Gibson & Ashby, Cellular Solids, 2nd ed. 1997, §4.3:
+/// rigid-jointed rods (docs/theory.md, "Closed forms used as oracles"; Gibson & Ashby, Cellular Solids, 2nd ed. 1997, §4.3:
 /// stretching E·b·h/a, shear E·h·b³/(2a³) per unit width): with E_m = E_g and b = h,
 /// s = b²/a, ρ = ρ_g(2 − b/a), G = E(b/a)²/2.
 fn section4_errors(cells: usize, static_mode: bool) -> (Vec<f64>, f64, usize) {
@@ -464,7 +464,7 @@ fn weft_fit_binary_writes_its_tables_and_refuses_bad_input() {
 }
 
 /// The wave-speed objective: a membrane's density is recovered from the arrival times of
-/// its own longitudinal wave along y = 0 (c = √(E/ρ), DESIGN.md §8).
+/// its own longitudinal wave along y = 0 (c = √(E/ρ), docs/theory.md, "Closed forms used as oracles").
 #[test]
 fn arrival_time_objective_recovers_the_wave_speed() {
     let p = period();
@@ -537,7 +537,7 @@ fn thickness_problem(cand: Model, set: &str, matching: weft::analysis::Matching)
 }
 
 /// Fit [`thickness_problem`]: the fitted s relative to the closed form s = b²/a of the
-/// girder's cell a = L/12 with b = a/10 (Gibson & Ashby §4.3; DESIGN.md §8), T and the
+/// girder's cell a = L/12 with b = a/10 (Gibson & Ashby §4.3; docs/theory.md, "Closed forms used as oracles"), T and the
 /// start's T.
 fn fit_thickness(problem: &Problem) -> (f64, f64, f64) {
     let opts = Options {
@@ -556,7 +556,7 @@ fn fit_thickness(problem: &Problem) -> (f64, f64, f64) {
 /// girder's (N_m = 5 against N_g = 12), its response interpolated at the girder's nodes
 /// of the central zone. In static tension (ν = 0) the lattice strains uniformly and a
 /// membrane of any mesh reproduces it, so the fitted thickness is the closed form
-/// s = b²/a of the girder's cell a = L/N_g (Gibson & Ashby §4.3; DESIGN.md §8), where
+/// s = b²/a of the girder's cell a = L/N_g (Gibson & Ashby §4.3; docs/theory.md, "Closed forms used as oracles"), where
 /// position matching finds no membrane node at most reference nodes.
 #[test]
 fn fit_across_meshes_recovers_the_closed_form_thickness() {
@@ -577,7 +577,7 @@ fn fit_across_meshes_recovers_the_closed_form_thickness() {
 /// --girder-cells`), fitted so that the zone's nodes (its `centre` set, matched by
 /// position to the full girder's) move as the girder's do. In static tension (ν = 0) the
 /// lattice strains uniformly, so the membrane around the zone must have the closed-form
-/// thickness s = b²/a (Gibson & Ashby §4.3; DESIGN.md §8), from a start 2.4 × off.
+/// thickness s = b²/a (Gibson & Ashby §4.3; docs/theory.md, "Closed forms used as oracles"), from a start 2.4 × off.
 #[test]
 fn the_combined_models_fit_recovers_the_closed_form_thickness() {
     use weft::generate::square::GirderZone;
@@ -613,7 +613,7 @@ fn the_combined_models_fit_recovers_the_closed_form_thickness() {
 /// `--objective both`: T plus the arrival-time mismatch of a wave at one absolute level
 /// for all nodes (the paper's "pre-selected level", §3). A membrane's own density and
 /// thickness are recovered from a far start (its in-plane speed c = √(E/ρ) and its
-/// stiffness E·s set the arrivals and the displacements; DESIGN.md §8), and the
+/// stiffness E·s set the arrivals and the displacements; docs/theory.md, "Closed forms used as oracles"), and the
 /// objective is 0 at the truth (both terms vanish).
 #[test]
 fn displacement_and_arrival_objective_recovers_density_and_thickness() {

@@ -2,7 +2,7 @@
 //! warning, stable default runs, and the lattice homogenisation the paper's §4 relies on.
 //!
 //! References: the square lattice of rods (spacing a, width b, height h) as a membrane
-//! (DESIGN.md §8; Gibson & Ashby, *Cellular Solids*, §4.3): stretching stiffness E·b·h/a
+//! (docs/theory.md, "Closed forms used as oracles"; Gibson & Ashby, *Cellular Solids*, §4.3): stretching stiffness E·b·h/a
 //! per unit width, shear stiffness E·h·b³/(2a³) with rigid joints, areal density
 //! ρ·b·h·(2 − b/a)/a; with b = h the equivalent membrane has s = b²/a, ρ_m = ρ(2 − b/a),
 //! G = E(b/a)²/2. The paper's rod range L/(20N) ≤ b ≤ L/(8N) is its eq. (3).
@@ -462,7 +462,7 @@ fn an_unloaded_model_at_rest_runs_with_no_energy_error() {
 /// The paper's Fig. 5b: the membrane of N_m cells per side with a girder zone L/2 × L/2
 /// at its centre (rods of the girder of N_g cells per side), its closed-form equivalent
 /// membrane around it (s = b²/a, ρ = ρ_g(2 − b/a), a = L/N_g; Gibson & Ashby §4.3,
-/// DESIGN.md §8).
+/// docs/theory.md, "Closed forms used as oracles").
 fn zone_membrane(nm: usize, ng: usize, lc: LoadCase) -> (MembraneParams, Model) {
     use weft::generate::square::GirderZone;
     let z = GirderZone {

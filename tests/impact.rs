@@ -6,7 +6,7 @@
 //! must reproduce the full model (any FE text on symmetry, e.g. Cook et al., *Concepts
 //! and Applications of FEA*, §2.11); the hourglass energy of one-point quads must stay a
 //! small fraction of the internal energy (below 10 %, the usual acceptance criterion;
-//! Belytschko, Liu, Moran §8.7; DESIGN.md §8).
+//! Belytschko, Liu, Moran §8.7; docs/theory.md, "Closed forms used as oracles").
 //!
 //! ```text
 //!        y                      quarter:  y

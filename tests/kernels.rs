@@ -89,7 +89,7 @@ fn truss_force_is_minus_energy_gradient() {
     }
 }
 
-/// The link's spring law written out here, independently of the code (DESIGN.md: springs
+/// The link's spring law written out here, independently of the code (the paper's §5 links: springs
 /// along x, y, z on the relative displacement d = x₂ − x₁ − d₀, a slider's slip s taken
 /// off the tangential part): W = ½[k_x (d_x − s_x)² + k_y (d_y − s_y)² + k_z e_z²], with
 /// e_z = d_z, or min(d_z, 0) for a unilateral (push-only) normal spring.

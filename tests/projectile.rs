@@ -6,7 +6,7 @@
 //! struck transversely at constant velocity V carries a strain ε behind a longitudinal
 //! front at c = √(E/ρ), and a transverse kink at the lab-frame speed
 //! U = c(√(ε(1+ε)) − ε), with V = c√(2ε√(ε(1+ε)) − ε²). For E = 80 GPa,
-//! ρ = 1440 kg/m³, V = 300 m/s: ε = 0.895 %, U = 641.5 m/s (DESIGN.md §8).
+//! ρ = 1440 kg/m³, V = 300 m/s: ε = 0.895 %, U = 641.5 m/s (docs/theory.md, "Closed forms used as oracles").
 //!
 //! ```text
 //!                   | V = 300 m/s (prescribed)

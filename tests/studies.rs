@@ -31,7 +31,7 @@ fn weft_run(root: &Path, pipeline: &str) -> String {
 }
 
 /// The paper's §4 study: the fitted membrane matches the closed forms of a rigid-jointed
-/// square lattice (DESIGN.md §8; Gibson & Ashby, Cellular Solids, §4.3) within 5 % at
+/// square lattice (docs/theory.md, "Closed forms used as oracles"; Gibson & Ashby, Cellular Solids, §4.3) within 5 % at
 /// N = 10, statically and dynamically, with T far below its start; figures are written.
 #[test]
 fn girder_membrane_study_recovers_the_lattice_closed_forms() {

@@ -1,6 +1,6 @@
 //! weft-surrogate: the regression and the paper's two-layer network (§4, Fig. 6).
 //!
-//! References: the closed forms of a square lattice of rigid-jointed rods (DESIGN.md §8;
+//! References: the closed forms of a square lattice of rigid-jointed rods (docs/theory.md, "Closed forms used as oracles";
 //! Gibson & Ashby, Cellular Solids, 2nd ed. 1997, §4.3) with E_m = E_g, b = h, a = L/N:
 //! s = b²/a, ρ = ρ_g(2 − b/a), G = E(b/a)²/2, over the paper's range L/(20N) ≤ b ≤
 //! L/(8N) (its eq. 3); least squares reproduces a polynomial of its own degree exactly.

@@ -24,7 +24,7 @@ use weft::solver::{run_in_memory, Solver};
 fn lenticular_section_and_areal_density_match_their_closed_forms() {
     let p = WovenBandParams::default();
     let lens = Lenticular::new(p.width, p.thickness);
-    // Thickness: h at the centre line, 0 at the edges; area ≈ (2/3)wh (DESIGN §12).
+    // Thickness: h at the centre line, 0 at the edges; area ≈ (2/3)wh (docs/theory.md, "The yarn-level woven patch").
     assert!(rel(lens.thickness(0.0), p.thickness) < 1e-12);
     assert!(lens.thickness(0.5 * p.width).abs() < 1e-12);
     assert!(
