@@ -9,6 +9,7 @@
 //! stage binaries share: `main`, error printing, progress).
 
 pub mod analysis;
+pub mod ballistic;
 pub mod cli;
 pub mod element_results;
 pub mod error;
@@ -19,6 +20,7 @@ pub mod generate;
 pub mod model;
 pub mod pipeline;
 pub mod plot;
+pub mod random;
 pub mod simulate;
 pub mod solver;
 pub mod surrogate;
