@@ -36,7 +36,8 @@ use crate::model::{ElementKind, Model, Part, SymmetryPlane};
 use crate::solver::relax::{RelaxOptions, RelaxStats};
 use crate::solver::Solver;
 
-use super::{family, yarn_elements, Params};
+use super::params::Params;
+use super::weave::{family, yarn_elements};
 
 /// Largest number of relaxations of the cell while its planes are moved to the tension.
 const ROUNDS: usize = 40;
