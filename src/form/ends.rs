@@ -244,3 +244,62 @@ impl Ends {
         out
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::form::params::Params;
+    use crate::form::pull::pulled_model;
+    use crate::generate::woven::{woven, WovenBandParams};
+
+    fn quarter(yarns: usize) -> Model {
+        woven(&WovenBandParams {
+            yarns,
+            ..WovenBandParams::default()
+        })
+        .unwrap()
+        .0
+    }
+
+    #[test]
+    fn a_clamped_quarter_has_one_pulled_end_per_yarn_at_its_far_edges() {
+        let m = quarter(4);
+        let ends = Ends::find(&m, &CentreLines::of(&m).unwrap()).unwrap();
+        assert!(!ends.tied);
+        for f in 0..2 {
+            let of_f: Vec<_> = ends.of_family(f).collect();
+            assert_eq!(of_f.len(), 4, "family {f}");
+            // Outwards at the far edge; the yarn on the symmetry plane is half a band.
+            assert!(of_f.iter().all(|e| e.sign == 1.0));
+            let halves = of_f
+                .iter()
+                .filter(|e| (e.section() - 0.5 * ends.section[f]).abs() < 1e-9 * ends.section[f])
+                .count();
+            assert_eq!(halves, 1, "family {f}");
+        }
+    }
+
+    #[test]
+    fn the_pulled_model_loads_each_end_with_its_share_of_t_and_lets_it_go_along_its_yarn() {
+        let m = quarter(4);
+        let ends = Ends::find(&m, &CentreLines::of(&m).unwrap()).unwrap();
+        let p = Params {
+            warp_tension: 0.5,
+            weft_tension: 0.25,
+            ..Params::default()
+        };
+        let mm = pulled_model(&m, &p, &ends);
+        let force = |n: usize| mm.loads.iter().find(|l| l.node == n).unwrap().force;
+        for e in &ends.ends {
+            let along: f64 = e.nodes.iter().map(|n| force(n.node)[e.family]).sum();
+            let t = p.tension()[e.family] * e.section() / ends.section[e.family];
+            assert!((along - t).abs() < 1e-12, "{along} vs {t}");
+            for n in &e.nodes {
+                let held = mm.constraints.iter().find(|c| c.0 == n.node).unwrap().1;
+                assert!(!held[e.family] && held[1 - e.family] && held[2]);
+            }
+        }
+        assert!(mm.projectiles.is_empty());
+        assert!(mm.contacts.iter().all(|c| c.static_friction == 0.0));
+    }
+}

@@ -180,3 +180,22 @@ pub fn centre_line(m: &Model, set: &str, fam: usize) -> Vec<usize> {
     nodes.dedup();
     nodes
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_coordinate_belongs_to_the_nearest_centre_line() {
+        // A full patch's yarns straddle x = 0: centre lines at p/2 + jp.
+        let lines = CentreLines {
+            spacing: 1e-3,
+            phase: 0.5e-3,
+        };
+        assert_eq!(lines.yarn(0.5e-3), 0);
+        assert_eq!(lines.yarn(1.4e-3), 1);
+        assert_eq!(lines.yarn(-0.5e-3), -1);
+        assert!(lines.on_line(2.5e-3));
+        assert!(!lines.on_line(2e-3));
+    }
+}
