@@ -6,7 +6,7 @@ use std::process::ExitCode;
 use anyhow::Context;
 use clap::Parser;
 use weft::cli::Progress;
-use weft::form::{run, Config, Params, StartMode};
+use weft::form::{run, Config, Params, Report, StartMode};
 
 #[derive(Parser)]
 #[command(
@@ -52,44 +52,44 @@ struct Cli {
     #[arg(long)]
     out: PathBuf,
     /// Residual tension per warp yarn [N] (0: the weave settles stress-free).
-    #[arg(long, default_value_t = 0.5)]
+    #[arg(long, default_value_t = Params::default().warp_tension)]
     warp_tension: f64,
     /// Residual tension per weft yarn [N].
-    #[arg(long, default_value_t = 0.5)]
+    #[arg(long, default_value_t = Params::default().weft_tension)]
     weft_tension: f64,
     /// Step budget; forming that has not converged by then is an error.
-    #[arg(long, default_value_t = 400_000)]
+    #[arg(long, default_value_t = Params::default().max_steps)]
     max_steps: u64,
     /// No convergence test before this many steps.
-    #[arg(long, default_value_t = 1000)]
+    #[arg(long, default_value_t = Params::default().min_steps)]
     min_steps: u64,
     /// Converged when the largest kinetic energy of a test window is ≤ this × the energy
     /// removed so far ...
-    #[arg(long, default_value_t = 1e-6)]
+    #[arg(long, default_value_t = Params::default().kinetic_tolerance)]
     kinetic_tolerance: f64,
     /// ... and the largest residual nodal force is ≤ this × the largest contact force.
-    #[arg(long, default_value_t = 0.05)]
+    #[arg(long, default_value_t = Params::default().force_tolerance)]
     force_tolerance: f64,
     /// ... and then, left alone at rest (a free run), no node moves more than this × the
     /// largest yarn thickness within --creep-time.
-    #[arg(long, default_value_t = 1e-2)]
+    #[arg(long, default_value_t = Params::default().creep_tolerance)]
     creep_tolerance: f64,
     /// Length of the free rest test [s].
-    #[arg(long, default_value_t = 50e-6)]
+    #[arg(long, default_value_t = Params::default().creep_time)]
     creep_time: f64,
     /// Largest contact penetration allowed after forming, as a fraction of the contact
     /// distance of the thickest slave and face, (t_s,max + t_F,max)/2.
-    #[arg(long, default_value_t = 0.5)]
+    #[arg(long, default_value_t = Params::default().penetration_limit)]
     penetration_limit: f64,
     /// Keep the contacts' friction while forming (default: frictionless, so that each
     /// yarn's tension is uniform and the impact run starts in equilibrium).
     #[arg(long)]
     friction: bool,
     /// Normal contact damping while forming, as a fraction of critical (≥ 0).
-    #[arg(long, default_value_t = 0.5)]
+    #[arg(long, default_value_t = Params::default().contact_damping)]
     contact_damping: f64,
     /// Local damping α of the relaxation, 0 < α < 1.
-    #[arg(long, default_value_t = 0.5)]
+    #[arg(long, default_value_t = Params::default().damping)]
     damping: f64,
     /// Start from a formed smaller quarter patch of the same weave (a `weft-form` output
     /// folder) instead of the generated geometry: its displacement, periodic in two
@@ -123,22 +123,7 @@ fn run_cli() -> anyhow::Result<ExitCode> {
             .build_global()
             .context("cannot set up the worker threads")?;
     }
-    let d = Params::default();
-    let params = Params {
-        warp_tension: cli.warp_tension,
-        weft_tension: cli.weft_tension,
-        max_steps: cli.max_steps,
-        min_steps: cli.min_steps,
-        kinetic_tolerance: cli.kinetic_tolerance,
-        force_tolerance: cli.force_tolerance,
-        penetration_limit: cli.penetration_limit,
-        friction: cli.friction,
-        damping: cli.damping,
-        contact_damping: cli.contact_damping,
-        creep_tolerance: cli.creep_tolerance,
-        creep_time: cli.creep_time,
-        ..d
-    };
+    let params = cli.params();
     let progress = Progress::new(
         cli.quiet,
         params.max_steps,
@@ -178,6 +163,34 @@ fn run_cli() -> anyhow::Result<ExitCode> {
             cli.out.display()
         )
     })?;
+    print_report(&r);
+    eprintln!("  wrote {} (formed model, form.parquet)", cli.out.display());
+    Ok(ExitCode::SUCCESS)
+}
+
+impl Cli {
+    /// The forming parameters the flags give (the rest at their defaults).
+    fn params(&self) -> Params {
+        Params {
+            warp_tension: self.warp_tension,
+            weft_tension: self.weft_tension,
+            max_steps: self.max_steps,
+            min_steps: self.min_steps,
+            kinetic_tolerance: self.kinetic_tolerance,
+            force_tolerance: self.force_tolerance,
+            penetration_limit: self.penetration_limit,
+            friction: self.friction,
+            damping: self.damping,
+            contact_damping: self.contact_damping,
+            creep_tolerance: self.creep_tolerance,
+            creep_time: self.creep_time,
+            ..Params::default()
+        }
+    }
+}
+
+/// What forming did, on stderr.
+fn print_report(r: &Report) {
     eprintln!(
         "weft-form: equilibrium after {} steps of {:.3e} s (local damping): kinetic energy {:.2e} of the forming work {:.3e} J; largest residual force {:.3e} N against contact forces up to {:.3e} N; left alone at rest, nodes moved ≤ {:.3e} m",
         r.steps, r.time_step, r.kinetic_over_work, r.forming_work, r.max_residual_force, r.max_contact_force, r.creep
@@ -210,6 +223,4 @@ fn run_cli() -> anyhow::Result<ExitCode> {
             r.cell.rounds, r.cell.steps, r.cell.stretch[0], r.cell.stretch[1], r.cell.tension[0], r.cell.tension[1], r.creep
         );
     }
-    eprintln!("  wrote {} (formed model, form.parquet)", cli.out.display());
-    Ok(ExitCode::SUCCESS)
 }

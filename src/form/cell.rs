@@ -36,7 +36,8 @@ use crate::model::{ElementKind, Model, Part, SymmetryPlane};
 use crate::solver::relax::{RelaxOptions, RelaxStats};
 use crate::solver::Solver;
 
-use super::{family, yarn_elements, Params};
+use super::params::Params;
+use super::weave::{family, yarn_elements};
 
 /// Largest number of relaxations of the cell while its planes are moved to the tension.
 const ROUNDS: usize = 40;
@@ -90,6 +91,16 @@ fn in_cell(c: f64, x0: f64, p: f64, tol: f64) -> bool {
     c >= x0 - tol && c <= x0 + p + tol
 }
 
+/// Where the patch's nodes and parts went in the cell.
+struct CellIndex {
+    /// The patch node of each cell node.
+    patch_node: Vec<usize>,
+    /// The cell part of each patch part (`usize::MAX` if none) ...
+    part: Vec<usize>,
+    /// ... and the patch part of each cell part.
+    patch_part: Vec<usize>,
+}
+
 /// The cell of the woven patch `m` (from `weft-weave woven`, a quarter or a full patch
 /// of at least two yarns per side beyond its first centre line).
 pub fn extract(m: &Model, spacing: f64) -> Result<Cell> {
@@ -101,9 +112,64 @@ pub fn extract(m: &Model, spacing: f64) -> Result<Cell> {
         )
         .hint("form a model from `weft-weave woven`"));
     }
-    // x₀: the first warp centre line at y ≥ its smallest coordinate: a quarter patch's
-    // warp 0 lies on y = 0, a full patch's first on (−N/2 + ½)p. The crossing nodes of
-    // `axis_x` give the wefts' centre lines (x); the warps' are the same by symmetry.
+    let x0 = cell_origin(m, p, tol)?;
+    let keep = nodes_in_cell(m, x0, p, tol);
+    let mut cell = Model {
+        analysis: m.analysis.clone(),
+        ..Default::default()
+    };
+    cell.analysis.history_sets.clear();
+    let index = copy_yarns(m, &keep, x0, p, tol, &mut cell);
+    check_every_node_in_an_element(&cell)?;
+    copy_contacts(m, &index.part, &mut cell);
+    for normal in [0, 1] {
+        for position in [x0, x0 + p] {
+            cell.symmetry.push(SymmetryPlane {
+                normal,
+                position,
+                tolerance: tol,
+            });
+        }
+    }
+    let on = |d: usize, at: f64| {
+        (0..cell.num_nodes())
+            .filter(|&n| (cell.coords[n][d] - at).abs() <= tol)
+            .collect::<Vec<_>>()
+    };
+    let planes = [0, 1].map(|d| on(d, x0 + p));
+    let fixed_planes = [0, 1].map(|d| on(d, x0));
+    // Warp parts are named warp_<layer>.
+    let layers = index
+        .patch_part
+        .iter()
+        .filter(|&&pi| family(m, pi) == Some(0))
+        .count();
+    let axis_nodes = hold_axis_nodes(m, &index.patch_part, x0, p, &mut cell);
+    if layers == 0 || cell.contacts.is_empty() {
+        return Err(WeftError::input(
+            "the periodic cell holds no warp band or no contact between its yarns",
+        )
+        .hint("form a model from `weft-weave woven`"));
+    }
+    cell.validate()?;
+    Ok(Cell {
+        model: cell,
+        patch_node: index.patch_node,
+        patch_part: index.patch_part,
+        spacing: p,
+        origin: x0,
+        planes,
+        fixed_planes,
+        axis_nodes,
+        layers,
+    })
+}
+
+/// x₀: the first warp centre line at y ≥ its smallest coordinate: a quarter patch's
+/// warp 0 lies on y = 0, a full patch's first on (−N/2 + ½)p. The crossing nodes of
+/// `axis_x` give the wefts' centre lines (x); the warps' are the same by symmetry. An
+/// error when the yarns do not reach one spacing beyond it.
+fn cell_origin(m: &Model, p: f64, tol: f64) -> Result<f64> {
     let mut lo = f64::INFINITY;
     let mut hi = f64::NEG_INFINITY;
     for (b, npe, e) in yarn_elements(m) {
@@ -127,7 +193,11 @@ pub fn extract(m: &Model, spacing: f64) -> Result<Cell> {
         ))
         .hint("form patches of at least 2 yarns per side with the cell, or use --start geometry"));
     }
-    // Cell nodes: of yarn quads, within the cell.
+    Ok(x0)
+}
+
+/// Cell nodes: of yarn quads, within the cell [x₀, x₀ + p]².
+fn nodes_in_cell(m: &Model, x0: f64, p: f64, tol: f64) -> Vec<bool> {
     let mut keep = vec![false; m.num_nodes()];
     for (b, npe, e) in yarn_elements(m) {
         for &n in &b.nodes[npe * e..npe * (e + 1)] {
@@ -137,11 +207,12 @@ pub fn extract(m: &Model, spacing: f64) -> Result<Cell> {
             }
         }
     }
-    let mut cell = Model {
-        analysis: m.analysis.clone(),
-        ..Default::default()
-    };
-    cell.analysis.history_sets.clear();
+    keep
+}
+
+/// Copy into `cell` the nodes `keep` of `m` and the yarn elements all of whose nodes it
+/// keeps, with their parts.
+fn copy_yarns(m: &Model, keep: &[bool], x0: f64, p: f64, tol: f64, cell: &mut Model) -> CellIndex {
     let mut index = vec![usize::MAX; m.num_nodes()];
     let mut patch_node = vec![];
     for n in (0..m.num_nodes()).filter(|&n| keep[n]) {
@@ -194,8 +265,16 @@ pub fn extract(m: &Model, spacing: f64) -> Result<Cell> {
             );
         }
     }
-    // A node within the cell that no cell element holds (a band edge beyond a cut) would
-    // carry no mass.
+    CellIndex {
+        patch_node,
+        part: part_index,
+        patch_part,
+    }
+}
+
+/// A node within the cell that no cell element holds (a band edge beyond a cut) would
+/// carry no mass: an error naming it.
+fn check_every_node_in_an_element(cell: &Model) -> Result<()> {
     let mut held = vec![false; cell.num_nodes()];
     for b in cell.elements.values() {
         for &n in &b.nodes {
@@ -211,6 +290,12 @@ pub fn extract(m: &Model, spacing: f64) -> Result<Cell> {
         .expected("yarn bands whose quads end on the cell's planes (an even number of quads across and per spacing)")
         .hint("generate the patch with `weft-weave woven`, or use --start geometry"));
     }
+    Ok(())
+}
+
+/// Copy into `cell` the contacts of `m` between parts it holds (`part_index`: the cell
+/// part of each patch part), acting on the full depth of any initial overlap.
+fn copy_contacts(m: &Model, part_index: &[usize], cell: &mut Model) {
     for d in &m.contacts {
         let slave = match d.slave {
             Slave::Part(s) if part_index[s] != usize::MAX => Slave::Part(part_index[s]),
@@ -225,31 +310,22 @@ pub fn extract(m: &Model, spacing: f64) -> Result<Cell> {
         c.initial_penetration = InitialPenetration::Keep;
         cell.contacts.push(c);
     }
-    for normal in [0, 1] {
-        for position in [x0, x0 + p] {
-            cell.symmetry.push(SymmetryPlane {
-                normal,
-                position,
-                tolerance: tol,
-            });
-        }
-    }
-    let on = |d: usize, at: f64| {
-        (0..cell.num_nodes())
-            .filter(|&n| (cell.coords[n][d] - at).abs() <= tol)
-            .collect::<Vec<_>>()
-    };
-    let planes = [0, 1].map(|d| on(d, x0 + p));
-    let fixed_planes = [0, 1].map(|d| on(d, x0));
-    // One node per layer held in z: the warp's centre line at mid-span (on the cell's
-    // two-fold axis). Warp parts are named warp_<layer>.
-    let mut layers = 0;
+}
+
+/// Hold one node per layer of `cell` in z: the warp's centre line at mid-span (on the
+/// cell's two-fold axis). Those nodes.
+fn hold_axis_nodes(
+    m: &Model,
+    patch_part: &[usize],
+    x0: f64,
+    p: f64,
+    cell: &mut Model,
+) -> Vec<usize> {
     let mut axis_nodes = vec![];
     for (ci, &pi) in patch_part.iter().enumerate() {
         if family(m, pi) != Some(0) {
             continue;
         }
-        layers += 1;
         let kind = cell.parts[ci].kind;
         let (b, npe) = (&cell.elements[&kind], kind.nodes_per_element());
         let pick = (0..b.len())
@@ -267,24 +343,19 @@ pub fn extract(m: &Model, spacing: f64) -> Result<Cell> {
             axis_nodes.push(n);
         }
     }
-    if layers == 0 || cell.contacts.is_empty() {
-        return Err(WeftError::input(
-            "the periodic cell holds no warp band or no contact between its yarns",
-        )
-        .hint("form a model from `weft-weave woven`"));
-    }
-    cell.validate()?;
-    Ok(Cell {
-        model: cell,
-        patch_node,
-        patch_part,
-        spacing: p,
-        origin: x0,
-        planes,
-        fixed_planes,
-        axis_nodes,
-        layers,
-    })
+    axis_nodes
+}
+
+/// The cell's balance at a state: the forces its symmetry planes and its axis nodes
+/// take.
+#[derive(Debug, Clone, Copy)]
+struct Balance {
+    /// Force across the moved planes, per yarn and layer, warp and weft [N] ...
+    moved: [f64; 2],
+    /// ... and across the fixed ones [N].
+    fixed: [f64; 2],
+    /// The largest z force on the nodes held on the two-fold axes [N].
+    axis: f64,
 }
 
 /// The cell's balance at the solver's state (its contacts evaluated there): the force
@@ -292,7 +363,7 @@ pub fn extract(m: &Model, spacing: f64) -> Result<Cell> {
 /// f_contact) along the normal over the moved plane's nodes, Σ (f_int + f_contact) over
 /// the fixed plane's (the reactions its symmetry condition supplies) [N] — and the
 /// largest z force on the nodes held on the two-fold axes [N].
-fn balance(cell: &Cell, solver: &mut Solver) -> ([f64; 2], [f64; 2], f64) {
+fn balance(cell: &Cell, solver: &mut Solver) -> Balance {
     let fi = solver.internal_forces();
     let fc = &solver.op.fcon;
     let has_fc = solver.op.has_fcon();
@@ -305,7 +376,119 @@ fn balance(cell: &Cell, solver: &mut Solver) -> ([f64; 2], [f64; 2], f64) {
         .iter()
         .map(|&n| f(n, 2).abs())
         .fold(0.0, f64::max);
-    (moved, fixed, axis)
+    Balance { moved, fixed, axis }
+}
+
+/// The largest yarn thickness of the cell's model: its quads' nodal thickness, or its
+/// contacts' thickness [m].
+fn largest_thickness(model: &Model) -> f64 {
+    model
+        .elements
+        .get(&ElementKind::Quad)
+        .map(|b| b.thickness.iter().cloned().fold(0.0, f64::max))
+        .unwrap_or(0.0)
+        .max(
+            model
+                .contacts
+                .iter()
+                .flat_map(|c| [c.slave_thickness, c.master_thickness])
+                .flatten()
+                .fold(0.0, f64::max),
+        )
+}
+
+/// The first guess of the plane displacement δ along `d` (0 x, 1 y): the cell
+/// stretched so that the centre line of the yarn along `d`, of the generated path
+/// length, runs straight between crossings at ±a (a the generated amplitude):
+/// δ = p (L/L_straight − 1).
+fn first_stretch(model: &Model, cell: &Cell, d: usize) -> f64 {
+    let pp = cell.spacing;
+    let fam_line: Vec<usize> = {
+        let mut v: Vec<usize> = (0..model.num_nodes())
+            .filter(|&n| (model.coords[n][1 - d] - cell.origin).abs() <= 1e-6 * pp)
+            .filter(|&n| {
+                yarn_elements(model).any(|(b, npe, e)| {
+                    family(model, b.part[e]) == Some(d)
+                        && b.nodes[npe * e..npe * (e + 1)].contains(&n)
+                })
+            })
+            .collect();
+        v.sort_by(|&a, &b| model.coords[a][d].total_cmp(&model.coords[b][d]));
+        v
+    };
+    if fam_line.len() < 2 {
+        return 1e-3 * pp;
+    }
+    let x = &model.coords;
+    let len: f64 = fam_line
+        .windows(2)
+        .map(|w| {
+            let e = [0, 1, 2].map(|k| x[w[1]][k] - x[w[0]][k]);
+            (e[0] * e[0] + e[1] * e[1] + e[2] * e[2]).sqrt()
+        })
+        .sum();
+    let z: Vec<f64> = fam_line.iter().map(|&n| x[n][2]).collect();
+    let a = 0.5
+        * (z.iter().cloned().fold(f64::NEG_INFINITY, f64::max)
+            - z.iter().cloned().fold(f64::INFINITY, f64::min));
+    let straight = pp * (1.0 + (2.0 * a / pp).powi(2)).sqrt();
+    (pp * (len / straight - 1.0)).max(0.0)
+}
+
+/// One evaluation of a family's plane: its displacement δ [m] and the force across it
+/// per yarn [N].
+#[derive(Debug, Clone, Copy)]
+struct Evaluation {
+    stretch: f64,
+    force: f64,
+}
+
+/// The search for one family's plane displacement δ: the bracket (δ with force below,
+/// δ with force above) and the last evaluation, for the secant.
+#[derive(Debug, Clone, Copy, Default)]
+struct PlaneSearch {
+    below: Option<Evaluation>,
+    above: Option<Evaluation>,
+    last: Option<Evaluation>,
+}
+
+impl PlaneSearch {
+    /// The next δ after the evaluation `now`, for the force `tension`: secant through the
+    /// last two evaluations, kept inside the bracket once there is one (bisection when it
+    /// leaves it); before a bracket, steps of p/1000 (`pp` the spacing p; the
+    /// de-crimping compliance: 0.5 N moves a plane ~1 µm).
+    fn next(&mut self, now: Evaluation, tension: f64, pp: f64) -> f64 {
+        let (d, r) = (now.stretch, now.force);
+        if r < tension {
+            self.below = Some(now);
+        } else {
+            self.above = Some(now);
+        }
+        let mut cand = match self.last {
+            Some(Evaluation {
+                stretch: d1,
+                force: r1,
+            }) if (r - r1).abs() > 1e-12 * tension && d != d1 => {
+                d + (tension - r) * (d - d1) / (r - r1)
+            }
+            _ => {
+                if r < tension {
+                    d + 1e-3 * pp
+                } else {
+                    d - 1e-3 * pp
+                }
+            }
+        };
+        if let (Some(lo), Some(hi)) = (self.below, self.above) {
+            let (dl, dh) = (lo.stretch, hi.stretch);
+            let (a, b) = (dl.min(dh), dl.max(dh));
+            if !(cand > a && cand < b) {
+                cand = 0.5 * (a + b);
+            }
+        }
+        self.last = Some(now);
+        cand
+    }
 }
 
 /// Form the cell: relax it with its planes moved until the force across each is the
@@ -316,7 +499,7 @@ pub fn form(
     tolerance: f64,
     progress: &mut dyn FnMut(&RelaxStats),
 ) -> Result<CellForm> {
-    let tension = [p.warp_tension, p.weft_tension];
+    let tension = p.tension();
     if tension.iter().any(|&t| !(t > 0.0)) {
         return Err(WeftError::input(format!(
             "a residual tension of {} / {} N per warp / weft yarn with the periodic cell",
@@ -333,55 +516,11 @@ pub fn form(
             c.dynamic_friction = 0.0;
         }
     }
-    let t_max = model
-        .elements
-        .get(&ElementKind::Quad)
-        .map(|b| b.thickness.iter().cloned().fold(0.0, f64::max))
-        .unwrap_or(0.0)
-        .max(
-            model
-                .contacts
-                .iter()
-                .flat_map(|c| [c.slave_thickness, c.master_thickness])
-                .flatten()
-                .fold(0.0, f64::max),
-        );
-    // The first guess: the cell stretched so that the warp's centre line, of the
-    // generated path length, runs straight between crossings at ±a (a the generated
-    // amplitude): δ = p (L/L_straight − 1).
-    let guess = |d: usize| -> f64 {
-        let fam_line: Vec<usize> = {
-            let mut v: Vec<usize> = (0..model.num_nodes())
-                .filter(|&n| (model.coords[n][1 - d] - cell.origin).abs() <= 1e-6 * pp)
-                .filter(|&n| {
-                    yarn_elements(&model).any(|(b, npe, e)| {
-                        family(&model, b.part[e]) == Some(d)
-                            && b.nodes[npe * e..npe * (e + 1)].contains(&n)
-                    })
-                })
-                .collect();
-            v.sort_by(|&a, &b| model.coords[a][d].total_cmp(&model.coords[b][d]));
-            v
-        };
-        if fam_line.len() < 2 {
-            return 1e-3 * pp;
-        }
-        let x = &model.coords;
-        let len: f64 = fam_line
-            .windows(2)
-            .map(|w| {
-                let e = [0, 1, 2].map(|k| x[w[1]][k] - x[w[0]][k]);
-                (e[0] * e[0] + e[1] * e[1] + e[2] * e[2]).sqrt()
-            })
-            .sum();
-        let z: Vec<f64> = fam_line.iter().map(|&n| x[n][2]).collect();
-        let a = 0.5
-            * (z.iter().cloned().fold(f64::NEG_INFINITY, f64::max)
-                - z.iter().cloned().fold(f64::INFINITY, f64::min));
-        let straight = pp * (1.0 + (2.0 * a / pp).powi(2)).sqrt();
-        (pp * (len / straight - 1.0)).max(0.0)
-    };
-    let mut delta = [guess(0), guess(1)];
+    let t_max = largest_thickness(&model);
+    let mut delta = [
+        first_stretch(&model, cell, 0),
+        first_stretch(&model, cell, 1),
+    ];
     let mut u: Vec<[f64; 3]> = model
         .coords
         .iter()
@@ -393,32 +532,15 @@ pub fn form(
             ]
         })
         .collect();
-    // Per family: the bracket (δ with force below, δ with force above) and the last
-    // evaluation, for the secant.
-    let mut below: [Option<(f64, f64)>; 2] = [None, None];
-    let mut above: [Option<(f64, f64)>; 2] = [None, None];
-    let mut last: [Option<(f64, f64)>; 2] = [None, None];
+    let mut search = [PlaneSearch::default(); 2];
     let (mut steps, mut work) = (0u64, 0.0f64);
     let mut forces = [f64::NAN; 2];
     for round in 1..=ROUNDS {
         model.initial_displacement = u.clone();
         let mut solver = Solver::new(&model)?;
         let opts = RelaxOptions {
-            max_steps: p.max_steps,
-            min_steps: p.min_steps.min(p.max_steps),
-            check_every: p.check_every,
-            alpha: p.damping,
-            kinetic_tolerance: p.kinetic_tolerance,
-            force_tolerance: p.force_tolerance,
-            force_scale: tension[0].max(tension[1]),
-            creep_window: ((p.creep_time / (solver.stable.dt / (1.0 + p.damping).sqrt())).ceil()
-                as u64)
-                .max(1),
-            creep_tolerance: p.creep_tolerance * t_max,
             work_offset: work,
-            contact_damping: p.contact_damping,
-            hold_in_rest_test: vec![],
-            probe_first: false,
+            ..p.relax_options(solver.stable.dt, tension[0].max(tension[1]), t_max)
         };
         let st = solver.relax(&opts, progress)?;
         steps += st.steps;
@@ -430,8 +552,8 @@ pub fn form(
             ))
             .hint("raise --max-steps, or loosen --kinetic-tolerance / --force-tolerance"));
         }
-        let (moved, fixed, axis) = balance(cell, &mut solver);
-        forces = moved;
+        let balance = balance(cell, &mut solver);
+        forces = balance.moved;
         u = solver
             .state
             .x
@@ -447,48 +569,24 @@ pub fn form(
                 u,
                 stretch: delta,
                 tension: forces,
-                fixed_tension: fixed,
-                axis_reaction: axis,
+                fixed_tension: balance.fixed,
+                axis_reaction: balance.axis,
                 rounds: round,
                 steps,
                 work,
                 last: st,
             });
         }
-        // Next δ per family: secant through the last two evaluations, kept inside the
-        // bracket once there is one (bisection when it leaves it); before a bracket,
-        // steps of p/1000 (the de-crimping compliance: 0.5 N moves a plane ~1 µm).
+        // Next δ per family (a family already at its tension stays).
         let mut next = delta;
         for f in 0..2 {
-            let (d, r) = (delta[f], forces[f]);
-            if (r / tension[f] - 1.0).abs() <= tolerance {
-                continue;
+            if (forces[f] / tension[f] - 1.0).abs() > tolerance {
+                let now = Evaluation {
+                    stretch: delta[f],
+                    force: forces[f],
+                };
+                next[f] = search[f].next(now, tension[f], pp);
             }
-            if r < tension[f] {
-                below[f] = Some((d, r));
-            } else {
-                above[f] = Some((d, r));
-            }
-            let mut cand = match last[f] {
-                Some((d1, r1)) if (r - r1).abs() > 1e-12 * tension[f] && d != d1 => {
-                    d + (tension[f] - r) * (d - d1) / (r - r1)
-                }
-                _ => {
-                    if r < tension[f] {
-                        d + 1e-3 * pp
-                    } else {
-                        d - 1e-3 * pp
-                    }
-                }
-            };
-            if let (Some((dl, _)), Some((dh, _))) = (below[f], above[f]) {
-                let (a, b) = (dl.min(dh), dl.max(dh));
-                if !(cand > a && cand < b) {
-                    cand = 0.5 * (a + b);
-                }
-            }
-            last[f] = Some((d, r));
-            next[f] = cand;
         }
         for (n, c) in model.coords.iter().enumerate() {
             for f in 0..2 {
