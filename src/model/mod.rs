@@ -8,8 +8,10 @@
 
 pub mod contacts;
 pub mod io;
+pub mod kinds;
 pub mod props;
 
+pub use kinds::ElementKind;
 pub use props::PartProps;
 
 use std::collections::{BTreeMap, HashMap};
@@ -17,57 +19,8 @@ use std::sync::Arc;
 
 use crate::error::{Result, WeftError};
 
-/// Element families known to the solver. The string form is the `kind` column of
-/// `parts.parquet` and the suffix of `elements_<kind>.parquet`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub enum ElementKind {
-    /// Two-node corotational truss (rod), optionally tension-only.
-    Truss,
-    /// Two-node discrete link: spring and dashpot per global axis, optional friction
-    /// slider in the global x–y plane.
-    Link,
-    /// One-node point mass.
-    PointMass,
-    /// Three-node constant-strain membrane triangle.
-    Tri,
-    /// Four-node one-point membrane quadrilateral with hourglass control.
-    Quad,
-    /// Two-node 3-D corotational beam with a rectangular section (rigid joints).
-    Beam,
-}
-
-impl ElementKind {
-    pub const ALL: [ElementKind; 6] = [
-        ElementKind::Truss,
-        ElementKind::Link,
-        ElementKind::PointMass,
-        ElementKind::Tri,
-        ElementKind::Quad,
-        ElementKind::Beam,
-    ];
-    pub fn name(self) -> &'static str {
-        match self {
-            ElementKind::Truss => "truss",
-            ElementKind::Link => "link",
-            ElementKind::PointMass => "point_mass",
-            ElementKind::Tri => "tri",
-            ElementKind::Quad => "quad",
-            ElementKind::Beam => "beam",
-        }
-    }
-    pub fn nodes_per_element(self) -> usize {
-        match self {
-            ElementKind::Truss | ElementKind::Link | ElementKind::Beam => 2,
-            ElementKind::PointMass => 1,
-            ElementKind::Tri => 3,
-            ElementKind::Quad => 4,
-        }
-    }
-    pub fn parse(s: &str) -> Option<Self> {
-        Self::ALL.into_iter().find(|k| k.name() == s)
-    }
-}
-
+/// A part (`parts.parquet`): a named group of elements of one kind that share their
+/// properties.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Part {
     pub id: i64,
@@ -1129,7 +1082,7 @@ fn require_pos(p: &Part, col: &str, v: Option<f64>, unit: &str) -> Result<()> {
 /// [`props::PROPERTIES`], in table order, then the checks that involve two properties.
 pub fn validate_part(p: &Part) -> Result<()> {
     for prop in props::PROPERTIES {
-        prop.check(p)?;
+        prop.check(&p.name, p.kind, &p.props)?;
     }
     let q = &p.props;
     match p.kind {
