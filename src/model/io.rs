@@ -5,6 +5,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use super::*;
+use crate::error::{Result, WeftError};
 use crate::table::{batch, write_table, Col, Provenance, Table};
 
 const NODES: &str = "node_id, x, y, z";
