@@ -8,11 +8,11 @@
 //! part's nodes against the slave part's surface; a part against itself is self-contact
 //! (a node never meets the faces it belongs to).
 
-use std::collections::HashMap;
 use std::path::Path;
 
-use super::{ElementKind, Model};
-use crate::error::{Result, WeftError};
+use super::kinds::ElementKind;
+use super::types::Model;
+use crate::error::Result;
 use crate::table::{batch, write_table, Col, Provenance, Table};
 
 /// Expected columns, for error messages.
@@ -99,13 +99,6 @@ impl ContactDef {
     }
 }
 
-fn err(row: usize, col: &str, what: String) -> WeftError {
-    WeftError::input(what)
-        .in_file("contacts.parquet")
-        .in_column(col)
-        .at_row(row)
-}
-
 /// Part kinds that can form a contact surface.
 pub fn is_surface_kind(k: ElementKind) -> bool {
     matches!(
@@ -114,133 +107,8 @@ pub fn is_surface_kind(k: ElementKind) -> bool {
     )
 }
 
-/// Checks every definition; the messages name contacts.parquet, the column, row and value.
-pub fn validate(m: &Model) -> Result<()> {
-    let mut ids = HashMap::new();
-    for (row, c) in m.contacts.iter().enumerate() {
-        if let Some(first) = ids.insert(c.id, row) {
-            return Err(err(
-                row,
-                "contact_id",
-                format!("duplicate contact id `{}` (first at row {first})", c.id),
-            )
-            .expected("unique contact ids"));
-        }
-        let Some(mp) = m.parts.get(c.master) else {
-            return Err(err(
-                row,
-                "master_part",
-                format!("master part index {} out of range", c.master),
-            ));
-        };
-        if !is_surface_kind(mp.kind) {
-            return Err(err(
-                row,
-                "master_part",
-                format!(
-                    "master part `{}` is a {} part and has no faces or segments",
-                    mp.name,
-                    mp.kind.name()
-                ),
-            )
-            .expected("a part of triangles, quads, trusses or beams")
-            .hint("a contact surface is made of membrane faces or of rod segments"));
-        }
-        let has_elements = m
-            .elements
-            .get(&mp.kind)
-            .is_some_and(|b| b.part.contains(&c.master));
-        if !has_elements {
-            return Err(err(
-                row,
-                "master_part",
-                format!(
-                    "master part `{}` has no elements: the surface has no faces",
-                    mp.name
-                ),
-            )
-            .expected("a part with at least one element"));
-        }
-        match &c.slave {
-            Slave::Part(p) => {
-                if m.parts.get(*p).is_none() {
-                    return Err(err(
-                        row,
-                        "slave_part",
-                        format!("slave part index {p} out of range"),
-                    ));
-                }
-                if c.two_way && !is_surface_kind(m.parts[*p].kind) {
-                    return Err(err(row, "two_way", format!("two-way contact needs a surface on the slave side, but `{}` is a {} part", m.parts[*p].name, m.parts[*p].kind.name()))
-                        .expected("false, or a slave part of triangles, quads, trusses or beams"));
-                }
-            }
-            Slave::Set(s) => {
-                if !m.node_sets.contains_key(s) {
-                    return Err(
-                        err(row, "slave_set", format!("node set `{s}` does not exist")).expected(
-                            format!(
-                                "one of the model's node sets: {}",
-                                names(m.node_sets.keys())
-                            ),
-                        ),
-                    );
-                }
-                if c.two_way {
-                    return Err(err(
-                        row,
-                        "two_way",
-                        "two-way contact needs a slave part, not a node set".into(),
-                    )
-                    .expected("false with slave_set"));
-                }
-            }
-        }
-        for (col, v) in [
-            ("static_friction", c.static_friction),
-            ("dynamic_friction", c.dynamic_friction),
-            ("friction_decay", c.friction_decay),
-        ] {
-            if !(v.is_finite() && v >= 0.0) {
-                return Err(err(row, col, format!("{col} is `{v}`")).expected("a finite value ≥ 0"));
-            }
-        }
-        if c.dynamic_friction > c.static_friction {
-            return Err(err(
-                row,
-                "dynamic_friction",
-                format!(
-                    "dynamic_friction {} exceeds static_friction {}",
-                    c.dynamic_friction, c.static_friction
-                ),
-            )
-            .expected("μ_d ≤ μ_s")
-            .hint("leave dynamic_friction empty for one coefficient"));
-        }
-        if !(c.penalty_scale.is_finite() && c.penalty_scale > 0.0) {
-            return Err(err(
-                row,
-                "penalty_scale",
-                format!("penalty_scale is `{}`", c.penalty_scale),
-            )
-            .expected("a finite value > 0 (null = 1)"));
-        }
-        for (col, v) in [
-            ("slave_thickness", c.slave_thickness),
-            ("master_thickness", c.master_thickness),
-        ] {
-            if let Some(v) = v {
-                if !(v.is_finite() && v >= 0.0) {
-                    return Err(err(row, col, format!("{col} is `{v}`"))
-                        .expected("a thickness ≥ 0 in m, or null (from the elements)"));
-                }
-            }
-        }
-    }
-    Ok(())
-}
-
-fn names<'a>(it: impl Iterator<Item = &'a String>) -> String {
+/// Names, each in backticks, comma-separated (for messages that list the choices).
+pub(super) fn names<'a>(it: impl Iterator<Item = &'a String>) -> String {
     it.map(|k| format!("`{k}`")).collect::<Vec<_>>().join(", ")
 }
 

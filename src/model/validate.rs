@@ -4,10 +4,10 @@
 
 use std::collections::HashMap;
 
-use super::contacts;
+use super::contacts::{self, ContactDef, Slave};
 use super::kinds::ElementKind;
 use super::props;
-use super::types::{Analysis, Model, Part, TimeLaw};
+use super::types::{Analysis, ElementBlock, Model, Part, TimeLaw};
 use super::yarn::HALF;
 use crate::error::{Result, WeftError};
 
@@ -15,6 +15,26 @@ impl Model {
     /// Check ids, references and properties. Errors name the part, element or node and
     /// the value (rows refer to the tables' row order).
     pub fn validate(&self) -> Result<()> {
+        self.validate_node_ids()?;
+        self.validate_initial_displacement()?;
+        self.validate_coordinates()?;
+        self.validate_parts()?;
+        self.validate_elements()?;
+        self.validate_node_sets()?;
+        self.validate_loads()?;
+        self.validate_initial_velocities()?;
+        self.validate_projectiles()?;
+        self.validate_ties()?;
+        self.validate_symmetry()?;
+        self.validate_element_columns()?;
+        self.validate_link_frames()?;
+        self.validate_sliding_links()?;
+        self.validate_contacts()?;
+        validate_analysis(&self.analysis)
+    }
+
+    /// Node ids: unique.
+    fn validate_node_ids(&self) -> Result<()> {
         let mut seen = HashMap::new();
         for (row, id) in self.node_id.iter().enumerate() {
             if let Some(first) = seen.insert(*id, row) {
@@ -28,6 +48,11 @@ impl Model {
                 .hint("renumber the nodes or merge coincident ones"));
             }
         }
+        Ok(())
+    }
+
+    /// Initial displacements: none, or one finite value per node and axis.
+    fn validate_initial_displacement(&self) -> Result<()> {
         if !self.initial_displacement.is_empty()
             && self.initial_displacement.len() != self.coords.len()
         {
@@ -53,6 +78,11 @@ impl Model {
                 }
             }
         }
+        Ok(())
+    }
+
+    /// Coordinates: finite.
+    fn validate_coordinates(&self) -> Result<()> {
         for (row, x) in self.coords.iter().enumerate() {
             for (c, v) in ["x", "y", "z"].iter().zip(x) {
                 if !v.is_finite() {
@@ -67,6 +97,11 @@ impl Model {
                 }
             }
         }
+        Ok(())
+    }
+
+    /// Parts: unique ids, and each part's properties ([`validate_part`]).
+    fn validate_parts(&self) -> Result<()> {
         let mut part_ids = HashMap::new();
         for (row, p) in self.parts.iter().enumerate() {
             if let Some(first) = part_ids.insert(p.id, row) {
@@ -81,6 +116,12 @@ impl Model {
             }
             validate_part(p).map_err(|e| e.in_file("parts.parquet").at_row(row))?;
         }
+        Ok(())
+    }
+
+    /// Elements: ids unique across all element tables, each of its part's kind, a
+    /// two-node element on two distinct nodes, a truss of non-zero length.
+    fn validate_elements(&self) -> Result<()> {
         let mut elem_ids: HashMap<i64, ElementKind> = HashMap::new();
         for (kind, b) in &self.elements {
             let file = format!("elements_{}.parquet", kind.name());
@@ -136,6 +177,11 @@ impl Model {
                 }
             }
         }
+        Ok(())
+    }
+
+    /// Node sets: none empty.
+    fn validate_node_sets(&self) -> Result<()> {
         for (name, set) in &self.node_sets {
             if set.is_empty() {
                 return Err(WeftError::input(format!("node set `{name}` is empty"))
@@ -143,6 +189,11 @@ impl Model {
                     .expected("at least one node per set"));
             }
         }
+        Ok(())
+    }
+
+    /// Loads: a finite start, and a duration > 0 for the laws that have one.
+    fn validate_loads(&self) -> Result<()> {
         for l in &self.loads {
             let ok = match &l.law {
                 TimeLaw::SinePulse { start, duration } | TimeLaw::Ramp { start, duration } => {
@@ -162,6 +213,11 @@ impl Model {
                 .expected("duration > 0 s for sine_pulse and ramp"));
             }
         }
+        Ok(())
+    }
+
+    /// Initial velocities: zero along the fixed directions.
+    fn validate_initial_velocities(&self) -> Result<()> {
         // A node both fixed and given an initial velocity in that direction is a
         // contradiction, not something to resolve silently.
         let mut fixed = vec![[false; 3]; self.num_nodes()];
@@ -187,6 +243,12 @@ impl Model {
                 }
             }
         }
+        Ok(())
+    }
+
+    /// Projectiles: radius and mass > 0, length and friction ≥ 0, a stiffness > 0 when
+    /// given, a non-zero axis.
+    fn validate_projectiles(&self) -> Result<()> {
         for (row, p) in self.projectiles.iter().enumerate() {
             let bad = |col: &str, v: f64, exp: &str| {
                 Err(
@@ -227,6 +289,12 @@ impl Model {
                 );
             }
         }
+        Ok(())
+    }
+
+    /// Ties: 2 to 4 distinct master nodes, none of them the slave or itself tied; each
+    /// slave in one tie.
+    fn validate_ties(&self) -> Result<()> {
         let mut slave_of = vec![false; self.num_nodes()];
         for t in &self.ties {
             slave_of[t.slave] = true;
@@ -271,6 +339,11 @@ impl Model {
                 }
             }
         }
+        Ok(())
+    }
+
+    /// Symmetry planes: a finite position and a tolerance ≥ 0.
+    fn validate_symmetry(&self) -> Result<()> {
         for (row, s) in self.symmetry.iter().enumerate() {
             if !(s.tolerance >= 0.0 && s.position.is_finite()) {
                 return Err(WeftError::input(format!(
@@ -282,110 +355,123 @@ impl Model {
                 .expected("a finite position and a tolerance ≥ 0 in m"));
             }
         }
-        self.validate_nodal_thickness()?;
-        self.validate_link_frames()?;
-        self.validate_sliding_links()?;
-        contacts::validate(self)?;
-        validate_analysis(&self.analysis)
+        Ok(())
     }
 
-    /// Nodal thickness: one finite value > 0 per element node, membranes only; initial
-    /// stress: finite, one per membrane element.
-    fn validate_nodal_thickness(&self) -> Result<()> {
+    /// Per-element columns of the element tables, table by table: initial stresses,
+    /// cross-section areas, nodal thicknesses.
+    fn validate_element_columns(&self) -> Result<()> {
         for (kind, b) in &self.elements {
-            if !b.stress0.is_empty() {
-                let file = format!("elements_{}.parquet", kind.name());
-                if !matches!(kind, ElementKind::Tri | ElementKind::Quad)
-                    || b.stress0.len() != b.len()
-                {
-                    return Err(WeftError::input(format!(
-                        "{} elements carry {} initial stresses for {} elements",
-                        kind.name(),
-                        b.stress0.len(),
-                        b.len()
-                    ))
-                    .in_file(file)
-                    .expected(
-                        "initial stress columns s0_11, s0_22, s0_12 on tri and quad tables only",
-                    ));
-                }
-                for (e, s) in b.stress0.iter().enumerate() {
-                    for (c, v) in ["s0_11", "s0_22", "s0_12"].iter().zip(s) {
-                        if !v.is_finite() {
-                            return Err(WeftError::input(format!(
-                                "{} `{}` has initial stress {c} = `{v}`",
-                                kind.name(),
-                                b.id[e]
-                            ))
-                            .in_file(file.clone())
-                            .in_column(*c)
-                            .at_row(e)
-                            .expected("a finite stress in Pa, or null for 0"));
-                        }
-                    }
-                }
-            }
-            if !b.area.is_empty() {
-                let file = format!("elements_{}.parquet", kind.name());
-                if *kind != ElementKind::Truss || b.area.len() != b.len() {
-                    return Err(WeftError::input(format!(
-                        "{} elements carry {} cross-section areas for {} elements",
-                        kind.name(),
-                        b.area.len(),
-                        b.len()
-                    ))
-                    .in_file(file)
-                    .expected("an area column on the truss table only, one per element"));
-                }
-                for (e, &a) in b.area.iter().enumerate() {
-                    if !(a.is_finite() && a > 0.0) {
-                        return Err(WeftError::input(format!(
-                            "truss `{}` has cross-section area `{a}`",
-                            b.id[e]
-                        ))
-                        .in_file(file)
-                        .in_column("area")
-                        .at_row(e)
-                        .expected("an area > 0 in m², or null for the part's area"));
-                    }
-                }
-            }
-            if b.thickness.is_empty() {
-                continue;
-            }
-            let npe = kind.nodes_per_element();
-            let file = format!("elements_{}.parquet", kind.name());
-            if !matches!(kind, ElementKind::Tri | ElementKind::Quad)
-                || b.thickness.len() != npe * b.len()
-            {
-                return Err(WeftError::input(format!(
-                    "{} elements carry {} nodal thicknesses for {} elements",
-                    kind.name(),
-                    b.thickness.len(),
-                    b.len()
-                ))
-                .in_file(file)
-                .expected(
-                    "nodal thickness columns t1… on tri and quad tables only, one per element node",
-                ));
-            }
-            for (k, &t) in b.thickness.iter().enumerate() {
-                if !(t.is_finite() && t >= 0.0) {
-                    return Err(WeftError::input(format!(
-                        "{} `{}` has nodal thickness `{t}` at its node {}",
-                        kind.name(),
-                        b.id[k / npe],
-                        k % npe + 1
-                    ))
-                    .in_file(file)
-                    .in_column(format!("t{}", k % npe + 1))
-                    .at_row(k / npe)
-                    .expected("a thickness ≥ 0 in m (the element's mean > 0), or null for the part's thickness"));
-                }
-            }
+            validate_initial_stress(*kind, b)?;
+            validate_truss_areas(*kind, b)?;
+            validate_nodal_thickness(*kind, b)?;
         }
         Ok(())
     }
+}
+
+/// Initial stress of a block: on membranes only, one finite value per element and
+/// component.
+fn validate_initial_stress(kind: ElementKind, b: &ElementBlock) -> Result<()> {
+    if b.stress0.is_empty() {
+        return Ok(());
+    }
+    let file = format!("elements_{}.parquet", kind.name());
+    if !matches!(kind, ElementKind::Tri | ElementKind::Quad) || b.stress0.len() != b.len() {
+        return Err(WeftError::input(format!(
+            "{} elements carry {} initial stresses for {} elements",
+            kind.name(),
+            b.stress0.len(),
+            b.len()
+        ))
+        .in_file(file)
+        .expected("initial stress columns s0_11, s0_22, s0_12 on tri and quad tables only"));
+    }
+    for (e, s) in b.stress0.iter().enumerate() {
+        for (c, v) in ["s0_11", "s0_22", "s0_12"].iter().zip(s) {
+            if !v.is_finite() {
+                return Err(WeftError::input(format!(
+                    "{} `{}` has initial stress {c} = `{v}`",
+                    kind.name(),
+                    b.id[e]
+                ))
+                .in_file(file.clone())
+                .in_column(*c)
+                .at_row(e)
+                .expected("a finite stress in Pa, or null for 0"));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Cross-section areas of a block: on trusses only, one finite value > 0 per element.
+fn validate_truss_areas(kind: ElementKind, b: &ElementBlock) -> Result<()> {
+    if b.area.is_empty() {
+        return Ok(());
+    }
+    let file = format!("elements_{}.parquet", kind.name());
+    if kind != ElementKind::Truss || b.area.len() != b.len() {
+        return Err(WeftError::input(format!(
+            "{} elements carry {} cross-section areas for {} elements",
+            kind.name(),
+            b.area.len(),
+            b.len()
+        ))
+        .in_file(file)
+        .expected("an area column on the truss table only, one per element"));
+    }
+    for (e, &a) in b.area.iter().enumerate() {
+        if !(a.is_finite() && a > 0.0) {
+            return Err(WeftError::input(format!(
+                "truss `{}` has cross-section area `{a}`",
+                b.id[e]
+            ))
+            .in_file(file)
+            .in_column("area")
+            .at_row(e)
+            .expected("an area > 0 in m², or null for the part's area"));
+        }
+    }
+    Ok(())
+}
+
+/// Nodal thickness of a block: on membranes only, one finite value ≥ 0 per element node.
+fn validate_nodal_thickness(kind: ElementKind, b: &ElementBlock) -> Result<()> {
+    if b.thickness.is_empty() {
+        return Ok(());
+    }
+    let npe = kind.nodes_per_element();
+    let file = format!("elements_{}.parquet", kind.name());
+    if !matches!(kind, ElementKind::Tri | ElementKind::Quad) || b.thickness.len() != npe * b.len() {
+        return Err(WeftError::input(format!(
+            "{} elements carry {} nodal thicknesses for {} elements",
+            kind.name(),
+            b.thickness.len(),
+            b.len()
+        ))
+        .in_file(file)
+        .expected(
+            "nodal thickness columns t1… on tri and quad tables only, one per element node",
+        ));
+    }
+    for (k, &t) in b.thickness.iter().enumerate() {
+        if !(t.is_finite() && t >= 0.0) {
+            return Err(WeftError::input(format!(
+                "{} `{}` has nodal thickness `{t}` at its node {}",
+                kind.name(),
+                b.id[k / npe],
+                k % npe + 1
+            ))
+            .in_file(file)
+            .in_column(format!("t{}", k % npe + 1))
+            .at_row(k / npe)
+            .expected(
+                "a thickness ≥ 0 in m (the element's mean > 0), or null for the part's thickness",
+            ));
+        }
+    }
+    Ok(())
 }
 
 impl Model {
@@ -504,6 +590,167 @@ impl Model {
     }
 }
 
+impl Model {
+    /// Contact definitions: unique ids, then each one's master, slave side and
+    /// coefficients; the messages name contacts.parquet, the column, row and value.
+    fn validate_contacts(&self) -> Result<()> {
+        let mut ids = HashMap::new();
+        for (row, c) in self.contacts.iter().enumerate() {
+            if let Some(first) = ids.insert(c.id, row) {
+                return Err(contact_err(
+                    row,
+                    "contact_id",
+                    format!("duplicate contact id `{}` (first at row {first})", c.id),
+                )
+                .expected("unique contact ids"));
+            }
+            self.validate_contact_master(row, c)?;
+            self.validate_contact_slave(row, c)?;
+            validate_contact_coefficients(row, c)?;
+        }
+        Ok(())
+    }
+
+    /// A contact's master: a part of a kind that forms a surface, with elements.
+    fn validate_contact_master(&self, row: usize, c: &ContactDef) -> Result<()> {
+        let m = self;
+        let Some(mp) = m.parts.get(c.master) else {
+            return Err(contact_err(
+                row,
+                "master_part",
+                format!("master part index {} out of range", c.master),
+            ));
+        };
+        if !contacts::is_surface_kind(mp.kind) {
+            return Err(contact_err(
+                row,
+                "master_part",
+                format!(
+                    "master part `{}` is a {} part and has no faces or segments",
+                    mp.name,
+                    mp.kind.name()
+                ),
+            )
+            .expected("a part of triangles, quads, trusses or beams")
+            .hint("a contact surface is made of membrane faces or of rod segments"));
+        }
+        let has_elements = m
+            .elements
+            .get(&mp.kind)
+            .is_some_and(|b| b.part.contains(&c.master));
+        if !has_elements {
+            return Err(contact_err(
+                row,
+                "master_part",
+                format!(
+                    "master part `{}` has no elements: the surface has no faces",
+                    mp.name
+                ),
+            )
+            .expected("a part with at least one element"));
+        }
+        Ok(())
+    }
+
+    /// A contact's slave side: a part (one that forms a surface too when two-way), or a
+    /// node set of the model (one-way only).
+    fn validate_contact_slave(&self, row: usize, c: &ContactDef) -> Result<()> {
+        let m = self;
+        match &c.slave {
+            Slave::Part(p) => {
+                if m.parts.get(*p).is_none() {
+                    return Err(contact_err(
+                        row,
+                        "slave_part",
+                        format!("slave part index {p} out of range"),
+                    ));
+                }
+                if c.two_way && !contacts::is_surface_kind(m.parts[*p].kind) {
+                    return Err(contact_err(row, "two_way", format!("two-way contact needs a surface on the slave side, but `{}` is a {} part", m.parts[*p].name, m.parts[*p].kind.name()))
+                        .expected("false, or a slave part of triangles, quads, trusses or beams"));
+                }
+            }
+            Slave::Set(s) => {
+                if !m.node_sets.contains_key(s) {
+                    return Err(contact_err(
+                        row,
+                        "slave_set",
+                        format!("node set `{s}` does not exist"),
+                    )
+                    .expected(format!(
+                        "one of the model's node sets: {}",
+                        contacts::names(m.node_sets.keys())
+                    )));
+                }
+                if c.two_way {
+                    return Err(contact_err(
+                        row,
+                        "two_way",
+                        "two-way contact needs a slave part, not a node set".into(),
+                    )
+                    .expected("false with slave_set"));
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+/// A contact's friction coefficients, penalty scale and thicknesses.
+fn validate_contact_coefficients(row: usize, c: &ContactDef) -> Result<()> {
+    for (col, v) in [
+        ("static_friction", c.static_friction),
+        ("dynamic_friction", c.dynamic_friction),
+        ("friction_decay", c.friction_decay),
+    ] {
+        if !(v.is_finite() && v >= 0.0) {
+            return Err(
+                contact_err(row, col, format!("{col} is `{v}`")).expected("a finite value ≥ 0")
+            );
+        }
+    }
+    if c.dynamic_friction > c.static_friction {
+        return Err(contact_err(
+            row,
+            "dynamic_friction",
+            format!(
+                "dynamic_friction {} exceeds static_friction {}",
+                c.dynamic_friction, c.static_friction
+            ),
+        )
+        .expected("μ_d ≤ μ_s")
+        .hint("leave dynamic_friction empty for one coefficient"));
+    }
+    if !(c.penalty_scale.is_finite() && c.penalty_scale > 0.0) {
+        return Err(contact_err(
+            row,
+            "penalty_scale",
+            format!("penalty_scale is `{}`", c.penalty_scale),
+        )
+        .expected("a finite value > 0 (null = 1)"));
+    }
+    for (col, v) in [
+        ("slave_thickness", c.slave_thickness),
+        ("master_thickness", c.master_thickness),
+    ] {
+        if let Some(v) = v {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(contact_err(row, col, format!("{col} is `{v}`"))
+                    .expected("a thickness ≥ 0 in m, or null (from the elements)"));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// An error in a row and column of `contacts.parquet`.
+fn contact_err(row: usize, col: &str, what: String) -> WeftError {
+    WeftError::input(what)
+        .in_file("contacts.parquet")
+        .in_column(col)
+        .at_row(row)
+}
+
 /// A value > 0 that one property needs because of another (a friction slider's
 /// tangential stiffness).
 fn require_pos(p: &Part, col: &str, v: Option<f64>, unit: &str) -> Result<()> {
@@ -533,76 +780,85 @@ pub fn validate_part(p: &Part) -> Result<()> {
     for prop in props::PROPERTIES {
         prop.check(&p.name, p.kind, &p.props)?;
     }
-    let q = &p.props;
     match p.kind {
-        ElementKind::Link => {
-            if let (Some(f), Some(mu)) = (q.slip_force, q.friction) {
-                return Err(WeftError::input(format!(
-                    "part `{}` (link) has both slip_force = `{f}` and friction = `{mu}`",
-                    p.name
-                ))
-                .in_column("friction")
-                .expected("one slip law: a constant slip force or Coulomb friction μ")
-                .hint("leave `slip_force` null to slip at μ·N, or `friction` null to slip at a constant force"));
-            }
-            if q.slip_force.is_some() || q.friction.is_some() {
-                for (c, v) in [("kx", q.kx), ("ky", q.ky)] {
-                    require_pos(
-                        p,
-                        c,
-                        v,
-                        "in N/m (a friction slider needs tangential stiffness)",
-                    )?;
-                }
-            }
-            if q.friction.is_some() {
-                require_pos(
-                    p,
-                    "kz",
-                    q.kz,
-                    "in N/m (Coulomb friction takes its normal force N from the normal spring)",
-                )?;
-            }
-            if q.sliding == Some(true) && q.local_frame == Some(true) {
-                return Err(WeftError::input(format!(
-                    "part `{}` (link) has both sliding and local_frame",
-                    p.name
-                ))
-                .in_column("sliding")
-                .expected("one frame: a sliding link's own (its yarns' tangents where its ends are), or the frame nodes' of `local_frame`")
-                .hint("leave `local_frame` null for sliding links"));
-            }
-            if q.unilateral == Some(true) && q.kz.is_none() && q.cz.is_none() {
-                return Err(WeftError::input(format!(
-                    "part `{}` (link) is unilateral but has no kz or cz",
-                    p.name
-                ))
-                .in_column("unilateral")
-                .expected("a normal spring `kz` (or dashpot `cz`) for the unilateral law to act on")
-                .hint("give `kz`, or leave `unilateral` null"));
-            }
+        ElementKind::Link => validate_link_part(p),
+        ElementKind::Tri | ElementKind::Quad => validate_membrane_part(p),
+        _ => Ok(()),
+    }
+}
+
+/// A link part's properties that involve each other: one slip law, the stiffnesses a
+/// slider needs, one frame, a normal spring or dashpot for the unilateral law.
+fn validate_link_part(p: &Part) -> Result<()> {
+    let q = &p.props;
+    if let (Some(f), Some(mu)) = (q.slip_force, q.friction) {
+        return Err(WeftError::input(format!(
+            "part `{}` (link) has both slip_force = `{f}` and friction = `{mu}`",
+            p.name
+        ))
+        .in_column("friction")
+        .expected("one slip law: a constant slip force or Coulomb friction μ")
+        .hint("leave `slip_force` null to slip at μ·N, or `friction` null to slip at a constant force"));
+    }
+    if q.slip_force.is_some() || q.friction.is_some() {
+        for (c, v) in [("kx", q.kx), ("ky", q.ky)] {
+            require_pos(
+                p,
+                c,
+                v,
+                "in N/m (a friction slider needs tangential stiffness)",
+            )?;
         }
-        ElementKind::Tri | ElementKind::Quad => {
-            let nu = q.poisson_ratio_12.unwrap_or(0.0);
-            // Both moduli are required, hence checked > 0 above.
-            let (e1, e2) = (q.youngs_modulus_1.unwrap(), q.youngs_modulus_2.unwrap());
-            if !(nu.is_finite() && nu * nu * e2 / e1 < 1.0 && nu > -1.0) {
-                return Err(WeftError::input(format!(
-                    "part `{}` has poisson_ratio_12 = `{nu}`",
-                    p.name
-                ))
-                .in_column("poisson_ratio_12")
-                .expected(format!(
-                    "−1 < ν₁₂ and ν₁₂² E₂/E₁ < 1 (here E₂/E₁ = {})",
-                    e2 / e1
-                )));
-            }
-        }
-        _ => {}
+    }
+    if q.friction.is_some() {
+        require_pos(
+            p,
+            "kz",
+            q.kz,
+            "in N/m (Coulomb friction takes its normal force N from the normal spring)",
+        )?;
+    }
+    if q.sliding == Some(true) && q.local_frame == Some(true) {
+        return Err(WeftError::input(format!(
+            "part `{}` (link) has both sliding and local_frame",
+            p.name
+        ))
+        .in_column("sliding")
+        .expected("one frame: a sliding link's own (its yarns' tangents where its ends are), or the frame nodes' of `local_frame`")
+        .hint("leave `local_frame` null for sliding links"));
+    }
+    if q.unilateral == Some(true) && q.kz.is_none() && q.cz.is_none() {
+        return Err(WeftError::input(format!(
+            "part `{}` (link) is unilateral but has no kz or cz",
+            p.name
+        ))
+        .in_column("unilateral")
+        .expected("a normal spring `kz` (or dashpot `cz`) for the unilateral law to act on")
+        .hint("give `kz`, or leave `unilateral` null"));
     }
     Ok(())
 }
 
+/// A membrane part's Poisson's ratio against its two moduli.
+fn validate_membrane_part(p: &Part) -> Result<()> {
+    let q = &p.props;
+    let nu = q.poisson_ratio_12.unwrap_or(0.0);
+    // Both moduli are required, hence checked > 0 first (`validate_part`).
+    let (e1, e2) = (q.youngs_modulus_1.unwrap(), q.youngs_modulus_2.unwrap());
+    if !(nu.is_finite() && nu * nu * e2 / e1 < 1.0 && nu > -1.0) {
+        return Err(
+            WeftError::input(format!("part `{}` has poisson_ratio_12 = `{nu}`", p.name))
+                .in_column("poisson_ratio_12")
+                .expected(format!(
+                    "−1 < ν₁₂ and ν₁₂² E₂/E₁ < 1 (here E₂/E₁ = {})",
+                    e2 / e1
+                )),
+        );
+    }
+    Ok(())
+}
+
+/// The analysis settings: each within its range.
 fn validate_analysis(a: &Analysis) -> Result<()> {
     let err = |col: &str, v: f64, exp: &str| {
         Err(WeftError::input(format!("analysis setting {col} = `{v}`"))
