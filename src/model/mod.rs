@@ -5,6 +5,12 @@
 //! `docs/tables.md`); in memory, elements refer to nodes and parts by index. Generators
 //! build models with [`Model`]'s `add_*` methods; [`Model::validate`] checks every
 //! property and reference and names the offending part, element, node or row.
+//!
+//! The modules: [`kinds`] (the element kinds), [`props`] (part properties, each defined
+//! once), [`types`] (what a model is made of, and [`Model`] with its builders),
+//! [`contacts`] (contact definitions), [`yarn`] (chains of trusses, the sliding links'
+//! windows), [`validate`] (the checks) and [`io`] (one codec per table). This module only
+//! declares them and re-exports their public items; none of them imports from it.
 
 pub mod contacts;
 pub mod io;
