@@ -7,7 +7,7 @@
 //! satisfy for each, what a null means and why, the short aliases `weft-fit` accepts, and
 //! a one-line meaning. Everything that lists part properties is driven by the table:
 //! reading and writing `parts.parquet` ([`read_columns`], [`columns`]), the checks and
-//! their messages ([`Property::check`], used by [`super::validate_part`]), the properties
+//! their messages ([`Property::check`], used by [`super::validate::validate_part`]), the properties
 //! and aliases `weft-fit` accepts ([`fittable`], [`resolve_alias`]), and the
 //! `parts.parquet` section of `docs/tables.md` ([`parts_table_markdown`]; the test
 //! `tests/docs_drift.rs` fails when the two differ, and `WEFT_BLESS=1 cargo test --release
@@ -15,8 +15,7 @@
 //!
 //! The table's order is the column order of `parts.parquet` as written.
 
-use super::ElementKind::{self, Beam, Link, PointMass, Quad, Tri, Truss};
-use super::Part;
+use super::kinds::ElementKind::{self, Beam, Link, PointMass, Quad, Tri, Truss};
 use crate::error::{Result, WeftError};
 use crate::table::{Col, Table};
 
@@ -422,23 +421,23 @@ impl Property {
         }
     }
 
-    /// Check a part's value of this property against the rule for the part's kind.
-    /// Errors name the part, its kind, the column and the value; the caller adds the
-    /// file and row.
-    pub fn check(&self, p: &Part) -> Result<()> {
-        let Some(rule) = self.rule(p.kind) else {
+    /// Check a part's value of this property against the rule for the part's kind:
+    /// `part` is the part's name, `kind` its kind and `props` its properties. Errors name
+    /// the part, its kind, the column and the value; the caller adds the file and row.
+    pub fn check(&self, part: &str, kind: ElementKind, props: &PartProps) -> Result<()> {
+        let Some(rule) = self.rule(kind) else {
             return Ok(());
         };
         let Access::F64 { get, .. } = self.access else {
             return Ok(());
         };
-        let v = get(&p.props);
+        let v = get(props);
         let col = self.name;
         let bad = |x: f64| {
             WeftError::input(format!(
                 "part `{}` ({}) has {col} = `{x}`",
-                p.name,
-                p.kind.name()
+                part,
+                kind.name()
             ))
             .in_column(col)
         };
@@ -447,22 +446,22 @@ impl Property {
             None => s,
         };
         match (rule, v) {
-            (Rule::Required | Rule::RequiredNonNegative, None) => Err(WeftError::input(format!(
-                "part `{}` ({}) has no {col}",
-                p.name,
-                p.kind.name()
-            ))
-            .in_column(col)
-            .expected(format!(
-                "a value {}{}",
-                if rule == Rule::Required {
-                    "> 0"
-                } else {
-                    "≥ 0"
-                },
-                self.in_unit()
-            ))
-            .hint(format!("every {} part needs `{col}`", p.kind.name()))),
+            (Rule::Required | Rule::RequiredNonNegative, None) => {
+                Err(
+                    WeftError::input(format!("part `{}` ({}) has no {col}", part, kind.name()))
+                        .in_column(col)
+                        .expected(format!(
+                            "a value {}{}",
+                            if rule == Rule::Required {
+                                "> 0"
+                            } else {
+                                "≥ 0"
+                            },
+                            self.in_unit()
+                        ))
+                        .hint(format!("every {} part needs `{col}`", kind.name())),
+                )
+            }
             (Rule::Required | Rule::Positive, Some(x)) if !(x > 0.0 && x.is_finite()) => {
                 Err(bad(x).expected(or_null(format!("a value > 0{}", self.in_unit()))))
             }

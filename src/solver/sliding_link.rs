@@ -75,7 +75,7 @@ use crate::model::ElementKind;
 /// slide three spacings past each other (the yarn-level reference's crossings under
 /// the nose rim slid 2.7 mm at a 1 mm spacing by 50 µs, measured), and an anchor needs
 /// the chord beyond its segment.
-pub const HALF: usize = 4;
+pub use crate::model::yarn::HALF;
 /// Nodes of a window.
 pub const WIN: usize = 2 * HALF + 1;
 /// Return-mapping passes per step: the first is exact on straight segments under a
