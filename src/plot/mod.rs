@@ -22,7 +22,7 @@ use crate::error::{Result, WeftError};
 use crate::model::io::read_model;
 use crate::table::Table;
 
-static FONT: &[u8] = include_bytes!("../assets/fonts/DejaVuSans.ttf");
+static FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
 
 /// One figure, as `weft-plot`'s flags give it.
 #[derive(Debug, Clone)]
