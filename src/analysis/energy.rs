@@ -45,7 +45,8 @@ use crate::model::{ElementKind, Model};
 use crate::solver::beam::Rotations;
 use crate::solver::family::Build;
 use crate::solver::Families;
-use crate::table::{batch, write_table, Col, Provenance, Table};
+use crate::table::history::History;
+use crate::table::{batch, write_table, Col, Provenance};
 
 /// What a region holds.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -497,23 +498,11 @@ pub fn read_history(
     m: &Model,
     history: &Path,
 ) -> Result<(Vec<f64>, Vec<Vec<[f64; 3]>>, Vec<Vec<[f64; 3]>>)> {
-    let h = Table::read(history)?;
-    let cols = "t, node_id, ux, uy, uz, vx, vy, vz";
-    let t = h.f64("t", cols)?;
-    let ids = h.i64("node_id", cols)?;
-    let c: Vec<Vec<f64>> = super::COMPONENTS
-        .iter()
-        .map(|n| h.f64(n, cols))
-        .collect::<Result<_>>()?;
+    let h = History::read(history)?;
     // Energies sum squares: a value whose square overflows would give inf, named nowhere;
-    // NaN marks a node the history lacks below, so none may come from the file.
-    for (k, col) in c.iter().enumerate() {
-        if let Some(r) = col.iter().position(|x| x.is_nan() || x.abs() > 1e150) {
-            return Err(h
-                .value_error(super::COMPONENTS[k], r, format!("value `{:e}`", col[r]))
-                .expected("a finite value, |value| < 1e150 (its square must not overflow)"));
-        }
-    }
+    // NaN marks a node the history lacks below, so none may come from the file (the
+    // table layer refuses non-finite values).
+    h.refuse_overflowing_squares("a finite value, |value| < 1e150 (its square must not overflow)")?;
     let index: HashMap<i64, usize> = m
         .node_id
         .iter()
@@ -521,36 +510,23 @@ pub fn read_history(
         .map(|(i, &id)| (id, i))
         .collect();
     let nn = m.num_nodes();
-    let mut times: Vec<f64> = vec![];
     let mut u: Vec<Vec<[f64; 3]>> = vec![];
     let mut v: Vec<Vec<[f64; 3]>> = vec![];
-    for r in 0..t.len() {
-        if times.last() != Some(&t[r]) {
-            if let Some(&last) = times.last() {
-                if t[r].is_nan() || t[r] <= last {
-                    return Err(h
-                        .value_error("t", r, format!("time `{}` after `{last}`", t[r]))
-                        .expected("rows ordered by time, as weft-simulate writes them"));
-                }
-            }
-            times.push(t[r]);
+    let times = h.by_time(|k, r| {
+        if k == u.len() {
             u.push(vec![[f64::NAN; 3]; nn]);
             v.push(vec![[f64::NAN; 3]; nn]);
         }
-        let i = *index.get(&ids[r]).ok_or_else(|| {
-            h.value_error("node_id", r, format!("node `{}`", ids[r]))
+        let i = *index.get(&h.node_id[r]).ok_or_else(|| {
+            h.value_error("node_id", r, format!("node `{}`", h.node_id[r]))
                 .expected("a node of the model (nodes.parquet)")
                 .hint("is this the history of a run of this model?")
         })?;
-        let k = times.len() - 1;
-        u[k][i] = [c[0][r], c[1][r], c[2][r]];
-        v[k][i] = [c[3][r], c[4][r], c[5][r]];
-    }
-    if times.is_empty() {
-        return Err(WeftError::input("the history has no rows")
-            .in_file(history)
-            .hint("was the run interrupted? rerun weft-simulate"));
-    }
+        let c = h.row(r);
+        u[k][i] = [c[0], c[1], c[2]];
+        v[k][i] = [c[3], c[4], c[5]];
+        Ok(())
+    })?;
     // A node must be there at every time or never.
     for (i, id) in m.node_id.iter().enumerate() {
         let first = u[0][i][0].is_finite();

@@ -25,11 +25,10 @@ use std::path::{Path, PathBuf};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use crate::analysis::COMPONENTS;
 use crate::error::{Result, WeftError};
 use crate::model::io::read_model;
 use crate::model::ElementKind;
-use crate::table::Table;
+use crate::table::history::{History, COMPONENTS};
 
 /// Each membrane face (and line element) is drawn as SUBDIVISION × SUBDIVISION pieces
 /// (SUBDIVISION for a line) with interpolated values; 3 keeps a coarse mesh's colours
@@ -167,19 +166,8 @@ fn view(name: &str) -> Result<([usize; 3], f64, (&'static str, &'static str))> {
 /// The history sample nearest `time` of every node listed in the table: (time drawn,
 /// node id → [ux, uy, uz, vx, vy, vz]).
 fn sample(path: &Path, time: f64) -> Result<(f64, HashMap<i64, [f64; 6]>)> {
-    let h = Table::read(path)?;
-    const COLS: &str = "t, node_id, ux, uy, uz, vx, vy, vz";
-    let t = h.f64("t", COLS)?;
-    let ids = h.i64("node_id", COLS)?;
-    let cols: Vec<Vec<f64>> = COMPONENTS
-        .iter()
-        .map(|c| h.f64(c, COLS))
-        .collect::<Result<_>>()?;
-    if t.is_empty() {
-        return Err(WeftError::input("the history has no rows")
-            .in_file(path)
-            .hint("was the run interrupted? rerun weft-simulate"));
-    }
+    let h = History::read(path)?;
+    let t = &h.t;
     let (t0, t1) = t
         .iter()
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| {
@@ -201,7 +189,7 @@ fn sample(path: &Path, time: f64) -> Result<(f64, HashMap<i64, [f64; 6]>)> {
         .expect("non-empty");
     let mut out = HashMap::new();
     for r in (0..t.len()).filter(|&r| t[r] == best) {
-        out.insert(ids[r], std::array::from_fn(|c| cols[c][r]));
+        out.insert(h.node_id[r], h.row(r));
     }
     Ok((best, out))
 }
