@@ -7,8 +7,8 @@
 //! - [`lsdyna`]: an LS-DYNA keyword `.k` deck (checked structurally here; LS-DYNA is not
 //!   available to the tests).
 //!
-//! What the two decks share is in [`common`]; what either refuses is one list of model
-//! features in [`unsupported`], each format giving its own reasons.
+//! What the two decks share is in `common.rs`; what either refuses is one list of model
+//! features in `unsupported.rs`, each format giving its own reasons.
 //!
 //! Both use SI units (m, kg, s, N, Pa) as weft does, and write the deck beside the target
 //! and rename it into place. The time step of a CalculiX deck is fixed and divides the

@@ -74,16 +74,6 @@ impl History {
         &self.table.path
     }
 
-    /// Rows (output times × nodes).
-    pub fn len(&self) -> usize {
-        self.t.len()
-    }
-
-    /// Never: a history without rows is refused on reading.
-    pub fn is_empty(&self) -> bool {
-        self.t.is_empty()
-    }
-
     /// The six components of row `r`.
     pub fn row(&self, r: usize) -> [f64; 6] {
         std::array::from_fn(|c| self.values[c][r])
