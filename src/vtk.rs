@@ -35,10 +35,10 @@ use std::collections::HashMap;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use crate::analysis::COMPONENTS;
 use crate::error::{Result, WeftError};
 use crate::model::io::read_model;
 use crate::model::{ElementKind, Model, ProjectileShape, ProjectileSpec};
+use crate::table::history::History;
 use crate::table::{Provenance, Table};
 
 /// Settings of one `vtk` run.
@@ -180,33 +180,15 @@ fn vtu(g: Grid) -> String {
 type Samples = Vec<(f64, HashMap<i64, [f64; 6]>)>;
 
 fn read_history(path: &Path) -> Result<Samples> {
-    let h = Table::read(path)?;
-    const COLS: &str = "t, node_id, ux, uy, uz, vx, vy, vz";
-    let t = h.f64("t", COLS)?;
-    let ids = h.i64("node_id", COLS)?;
-    let cols: Vec<Vec<f64>> = COMPONENTS
-        .iter()
-        .map(|c| h.f64(c, COLS))
-        .collect::<Result<_>>()?;
+    let h = History::read(path)?;
     let mut out: Samples = vec![];
-    for r in 0..t.len() {
-        match out.last() {
-            Some((last, _)) if *last == t[r] => {}
-            Some((last, _)) if t[r] < *last => {
-                return Err(h
-                    .value_error("t", r, format!("time `{}` after `{last}`", t[r]))
-                    .expected("rows ordered by time, as weft-simulate writes them"));
-            }
-            _ => out.push((t[r], HashMap::new())),
+    h.by_time(|k, r| {
+        if k == out.len() {
+            out.push((h.t[r], HashMap::new()));
         }
-        let s = &mut out.last_mut().expect("pushed").1;
-        s.insert(ids[r], std::array::from_fn(|c| cols[c][r]));
-    }
-    if out.is_empty() {
-        return Err(WeftError::input("the history has no rows")
-            .in_file(path)
-            .hint("was the run interrupted? rerun weft-simulate"));
-    }
+        out[k].1.insert(h.node_id[r], h.row(r));
+        Ok(())
+    })?;
     Ok(out)
 }
 

@@ -45,7 +45,8 @@ use crate::model::{ElementKind, Model};
 use crate::solver::beam::Rotations;
 use crate::solver::family::Build;
 use crate::solver::Families;
-use crate::table::{batch, write_table, Col, Provenance, Table};
+use crate::table::history::History;
+use crate::table::{batch, write_table, Col, Provenance};
 
 /// What a region holds.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -214,113 +215,178 @@ pub fn region_energies(
     v: &[Vec<[f64; 3]>],
     history: &Path,
 ) -> Result<RegionEnergies> {
-    let nn = m.num_nodes();
-    // Per region: the parts it takes, or the set's nodes.
-    let mut part_sel: Vec<Option<Vec<bool>>> = vec![];
-    let mut set_sel: Vec<Option<Vec<bool>>> = vec![];
-    let mut any_set = false;
-    let mut needed_parts = vec![false; m.parts.len()];
-    for r in regions {
-        match &r.spec {
-            RegionSpec::Parts(ps) => {
-                let mut keep = vec![false; m.parts.len()];
-                for p in ps {
-                    let i = m.part_index(p).ok_or_else(|| {
-                        WeftError::input(format!("region `{}`: no part `{p}`", r.name))
-                            .expected(format!("a part of the model: {}", part_list(m)))
-                    })?;
-                    keep[i] = true;
-                    needed_parts[i] = true;
-                }
-                part_sel.push(Some(keep));
-                set_sel.push(None);
-            }
-            RegionSpec::Set(s) => {
-                let nodes = m.node_sets.get(s).ok_or_else(|| {
-                    WeftError::input(format!("region `{}`: no node set `{s}`", r.name))
-                        .expected(format!("a node set of the model: {}", m.node_set_names()))
-                })?;
-                let mut sel = vec![false; nn];
-                for &i in nodes {
-                    sel[i] = true;
-                }
-                any_set = true;
-                part_sel.push(None);
-                set_sel.push(Some(sel));
-            }
-            RegionSpec::Box(b) => {
-                let sel: Vec<bool> = m
-                    .coords
-                    .iter()
-                    .map(|x| (0..3).all(|d| x[d] >= b[d][0] && x[d] <= b[d][1]))
-                    .collect();
-                if !sel.contains(&true) {
-                    return Err(WeftError::input(format!(
-                        "region `{}`: no node in the box {b:?}",
-                        r.name
-                    ))
-                    .expected("a box [min, max] along x, y, z holding some nodes")
-                    .hint("check it against the model's coordinates (nodes.parquet)"));
-                }
-                any_set = true;
-                part_sel.push(None);
-                set_sel.push(Some(sel));
-            }
-        }
-    }
-    if any_set {
-        needed_parts.iter_mut().for_each(|x| *x = true);
-    }
+    let sel = Selections::resolve(m, regions)?;
     // Nodes the history holds (finite values at the first sample).
-    let present: Vec<usize> = (0..nn)
+    let present: Vec<usize> = (0..m.num_nodes())
         .filter(|&i| u[0][i].iter().chain(&v[0][i]).all(|x| x.is_finite()))
         .collect();
     let parts: Vec<String> = m
         .parts
         .iter()
         .enumerate()
-        .filter(|(i, p)| needed_parts[*i] && p.kind != ElementKind::PointMass)
+        .filter(|(i, p)| sel.needed_parts[*i] && p.kind != ElementKind::PointMass)
         .map(|(_, p)| p.name.clone())
         .collect();
     let er = ElementResults::new(m, &parts, &present).map_err(|e| {
         e.in_file(history)
             .context("cannot compute the regions' elastic energy")
     })?;
+    let weights = region_weights(m, regions, &sel, &er, &present, history)?;
+    let (kinetic, elastic) = energies_over_time(
+        regions,
+        Nodal {
+            t,
+            u,
+            v,
+            present: &present,
+            path: history,
+        },
+        &er,
+        &weights,
+    )?;
+    Ok(RegionEnergies {
+        names: regions.iter().map(|r| r.name.clone()).collect(),
+        t: t.to_vec(),
+        kinetic,
+        elastic,
+    })
+}
+
+/// What one region takes.
+enum Selection {
+    /// The elements (and their share of the nodal masses) of the parts p with `keep[p]`.
+    Parts(Vec<bool>),
+    /// The nodes i with `nodes[i]` (whole nodal masses, shares of the elements).
+    Nodes(Vec<bool>),
+}
+
+/// The regions resolved against the model.
+struct Selections {
+    /// Per region, in order.
+    of: Vec<Selection>,
+    /// Some region is a node set (or a box): every part's masses are needed.
+    any_set: bool,
+    /// The parts whose elements some region takes (all of them when `any_set`).
+    needed_parts: Vec<bool>,
+}
+
+impl Selections {
+    /// Find each region's parts or nodes in the model.
+    fn resolve(m: &Model, regions: &[Region]) -> Result<Selections> {
+        let nn = m.num_nodes();
+        let mut of = vec![];
+        let mut any_set = false;
+        let mut needed_parts = vec![false; m.parts.len()];
+        for r in regions {
+            match &r.spec {
+                RegionSpec::Parts(ps) => {
+                    let mut keep = vec![false; m.parts.len()];
+                    for p in ps {
+                        let i = m.part_index(p).ok_or_else(|| {
+                            WeftError::input(format!("region `{}`: no part `{p}`", r.name))
+                                .expected(format!("a part of the model: {}", part_list(m)))
+                        })?;
+                        keep[i] = true;
+                        needed_parts[i] = true;
+                    }
+                    of.push(Selection::Parts(keep));
+                }
+                RegionSpec::Set(s) => {
+                    let nodes = m.node_sets.get(s).ok_or_else(|| {
+                        WeftError::input(format!("region `{}`: no node set `{s}`", r.name))
+                            .expected(format!("a node set of the model: {}", m.node_set_names()))
+                    })?;
+                    let mut sel = vec![false; nn];
+                    for &i in nodes {
+                        sel[i] = true;
+                    }
+                    any_set = true;
+                    of.push(Selection::Nodes(sel));
+                }
+                RegionSpec::Box(b) => {
+                    let sel: Vec<bool> = m
+                        .coords
+                        .iter()
+                        .map(|x| (0..3).all(|d| x[d] >= b[d][0] && x[d] <= b[d][1]))
+                        .collect();
+                    if !sel.contains(&true) {
+                        return Err(WeftError::input(format!(
+                            "region `{}`: no node in the box {b:?}",
+                            r.name
+                        ))
+                        .expected("a box [min, max] along x, y, z holding some nodes")
+                        .hint("check it against the model's coordinates (nodes.parquet)"));
+                    }
+                    any_set = true;
+                    of.push(Selection::Nodes(sel));
+                }
+            }
+        }
+        if any_set {
+            needed_parts.iter_mut().for_each(|x| *x = true);
+        }
+        Ok(Selections {
+            of,
+            any_set,
+            needed_parts,
+        })
+    }
+}
+
+/// What a region's energies sum at each sample.
+struct Weights {
+    /// Kinetic: (node, its lumped mass in the region), nodes of mass > 0 only.
+    masses: Vec<(usize, f64)>,
+    /// Elastic: (element of the [`ElementResults`], the share of its energy).
+    shares: Vec<(usize, f64)>,
+}
+
+/// Kinetic masses per region, and the element shares; every node of mass must be in the
+/// history (`present`).
+fn region_weights(
+    m: &Model,
+    regions: &[Region],
+    sel: &Selections,
+    er: &ElementResults,
+    present: &[usize],
+    history: &Path,
+) -> Result<Vec<Weights>> {
+    let nn = m.num_nodes();
     let mut slot = vec![usize::MAX; nn];
     for (j, &i) in present.iter().enumerate() {
         slot[i] = j;
     }
-    // Kinetic masses per region, and the element shares.
-    let all_mass = if any_set {
+    let all_mass = if sel.any_set {
         lumped_masses(m, &vec![true; m.parts.len()])?
     } else {
         vec![]
     };
     let part_index: HashMap<i64, usize> =
         m.parts.iter().enumerate().map(|(i, p)| (p.id, i)).collect();
-    let mut masses: Vec<Vec<(usize, f64)>> = vec![];
-    let mut shares: Vec<Vec<(usize, f64)>> = vec![];
-    for (r, reg) in regions.iter().enumerate() {
-        let (mass, share) = if let Some(keep) = &part_sel[r] {
-            let mass = lumped_masses(m, keep)?;
-            let share: Vec<(usize, f64)> = (0..er.len())
-                .filter(|&e| keep[part_index[&er.element_part_id(e)]])
-                .map(|e| (e, 1.0))
-                .collect();
-            (mass, share)
-        } else {
-            let sel = set_sel[r].as_ref().expect("a set region");
-            let mass: Vec<f64> = (0..nn)
-                .map(|i| if sel[i] { all_mass[i] } else { 0.0 })
-                .collect();
-            let share: Vec<(usize, f64)> = (0..er.len())
-                .filter_map(|e| {
-                    let ns = er.element_nodes(e);
-                    let k = ns.iter().filter(|&&i| sel[i]).count();
-                    (k > 0).then(|| (e, k as f64 / ns.len() as f64))
-                })
-                .collect();
-            (mass, share)
+    let mut out = vec![];
+    for (reg, selection) in regions.iter().zip(&sel.of) {
+        let (mass, share) = match selection {
+            Selection::Parts(keep) => {
+                let mass = lumped_masses(m, keep)?;
+                let share: Vec<(usize, f64)> = (0..er.len())
+                    .filter(|&e| keep[part_index[&er.element_part_id(e)]])
+                    .map(|e| (e, 1.0))
+                    .collect();
+                (mass, share)
+            }
+            Selection::Nodes(sel) => {
+                let mass: Vec<f64> = (0..nn)
+                    .map(|i| if sel[i] { all_mass[i] } else { 0.0 })
+                    .collect();
+                let share: Vec<(usize, f64)> = (0..er.len())
+                    .filter_map(|e| {
+                        let ns = er.element_nodes(e);
+                        let k = ns.iter().filter(|&&i| sel[i]).count();
+                        (k > 0).then(|| (e, k as f64 / ns.len() as f64))
+                    })
+                    .collect();
+                (mass, share)
+            }
         };
         let mut mv = vec![];
         for (i, &mi) in mass.iter().enumerate() {
@@ -337,9 +403,35 @@ pub fn region_energies(
                 mv.push((i, mi));
             }
         }
-        masses.push(mv);
-        shares.push(share);
+        out.push(Weights {
+            masses: mv,
+            shares: share,
+        });
     }
+    Ok(out)
+}
+
+/// A history by model node, as [`read_history`] gives it, with the nodes it holds.
+struct Nodal<'a> {
+    t: &'a [f64],
+    /// `u[k][i]`, `v[k][i]`: model node i at time `t[k]` (NaN where the history lacks it).
+    u: &'a [Vec<[f64; 3]>],
+    v: &'a [Vec<[f64; 3]>],
+    /// The nodes the history holds, in model order.
+    present: &'a [usize],
+    /// The file, named in errors.
+    path: &'a Path,
+}
+
+/// `kinetic[r][k]`, `elastic[r][k]` of each region at each sample; a non-finite one is
+/// refused.
+fn energies_over_time(
+    regions: &[Region],
+    h: Nodal,
+    er: &ElementResults,
+    weights: &[Weights],
+) -> Result<(Vec<Vec<f64>>, Vec<Vec<f64>>)> {
+    let (t, u, v, present) = (h.t, h.u, h.v, h.present);
     // The history restricted to the present nodes, sample by sample.
     let mut kinetic = vec![vec![0.0; t.len()]; regions.len()];
     let mut elastic = vec![vec![0.0; t.len()]; regions.len()];
@@ -355,11 +447,12 @@ pub fn region_energies(
             *x = er.energy(e, &us, &vs).unwrap_or(0.0);
         }
         for r in 0..regions.len() {
-            kinetic[r][k] = masses[r]
+            kinetic[r][k] = weights[r]
+                .masses
                 .iter()
                 .map(|&(i, mi)| 0.5 * mi * v[k][i].iter().map(|c| c * c).sum::<f64>())
                 .sum();
-            elastic[r][k] = shares[r].iter().map(|&(e, w)| w * ee[e]).sum();
+            elastic[r][k] = weights[r].shares.iter().map(|&(e, w)| w * ee[e]).sum();
         }
         for r in 0..regions.len() {
             let (a, b) = (kinetic[r][k], elastic[r][k]);
@@ -368,18 +461,13 @@ pub fn region_energies(
                     "region `{}` has a non-finite energy at t = {:e} s (kinetic {a:e} J, elastic {b:e} J)",
                     regions[r].name, t[k]
                 ))
-                .in_file(history)
+                .in_file(h.path)
                 .expected("finite displacements and velocities of the region's nodes")
                 .hint("a node the history lacks at this time, or a run that broke down"));
             }
         }
     }
-    Ok(RegionEnergies {
-        names: regions.iter().map(|r| r.name.clone()).collect(),
-        t: t.to_vec(),
-        kinetic,
-        elastic,
-    })
+    Ok((kinetic, elastic))
 }
 
 /// The reflection fraction of a pulse in one region.
@@ -497,23 +585,11 @@ pub fn read_history(
     m: &Model,
     history: &Path,
 ) -> Result<(Vec<f64>, Vec<Vec<[f64; 3]>>, Vec<Vec<[f64; 3]>>)> {
-    let h = Table::read(history)?;
-    let cols = "t, node_id, ux, uy, uz, vx, vy, vz";
-    let t = h.f64("t", cols)?;
-    let ids = h.i64("node_id", cols)?;
-    let c: Vec<Vec<f64>> = super::COMPONENTS
-        .iter()
-        .map(|n| h.f64(n, cols))
-        .collect::<Result<_>>()?;
+    let h = History::read(history)?;
     // Energies sum squares: a value whose square overflows would give inf, named nowhere;
-    // NaN marks a node the history lacks below, so none may come from the file.
-    for (k, col) in c.iter().enumerate() {
-        if let Some(r) = col.iter().position(|x| x.is_nan() || x.abs() > 1e150) {
-            return Err(h
-                .value_error(super::COMPONENTS[k], r, format!("value `{:e}`", col[r]))
-                .expected("a finite value, |value| < 1e150 (its square must not overflow)"));
-        }
-    }
+    // NaN marks a node the history lacks below, so none may come from the file (the
+    // table layer refuses non-finite values).
+    h.refuse_overflowing_squares("a finite value, |value| < 1e150 (its square must not overflow)")?;
     let index: HashMap<i64, usize> = m
         .node_id
         .iter()
@@ -521,36 +597,23 @@ pub fn read_history(
         .map(|(i, &id)| (id, i))
         .collect();
     let nn = m.num_nodes();
-    let mut times: Vec<f64> = vec![];
     let mut u: Vec<Vec<[f64; 3]>> = vec![];
     let mut v: Vec<Vec<[f64; 3]>> = vec![];
-    for r in 0..t.len() {
-        if times.last() != Some(&t[r]) {
-            if let Some(&last) = times.last() {
-                if t[r].is_nan() || t[r] <= last {
-                    return Err(h
-                        .value_error("t", r, format!("time `{}` after `{last}`", t[r]))
-                        .expected("rows ordered by time, as weft-simulate writes them"));
-                }
-            }
-            times.push(t[r]);
+    let times = h.by_time(|k, r| {
+        if k == u.len() {
             u.push(vec![[f64::NAN; 3]; nn]);
             v.push(vec![[f64::NAN; 3]; nn]);
         }
-        let i = *index.get(&ids[r]).ok_or_else(|| {
-            h.value_error("node_id", r, format!("node `{}`", ids[r]))
+        let i = *index.get(&h.node_id[r]).ok_or_else(|| {
+            h.value_error("node_id", r, format!("node `{}`", h.node_id[r]))
                 .expected("a node of the model (nodes.parquet)")
                 .hint("is this the history of a run of this model?")
         })?;
-        let k = times.len() - 1;
-        u[k][i] = [c[0][r], c[1][r], c[2][r]];
-        v[k][i] = [c[3][r], c[4][r], c[5][r]];
-    }
-    if times.is_empty() {
-        return Err(WeftError::input("the history has no rows")
-            .in_file(history)
-            .hint("was the run interrupted? rerun weft-simulate"));
-    }
+        let c = h.row(r);
+        u[k][i] = [c[0], c[1], c[2]];
+        v[k][i] = [c[3], c[4], c[5]];
+        Ok(())
+    })?;
     // A node must be there at every time or never.
     for (i, id) in m.node_id.iter().enumerate() {
         let first = u[0][i][0].is_finite();

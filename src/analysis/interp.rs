@@ -6,7 +6,7 @@ use std::collections::HashMap;
 
 use serde::Serialize;
 
-use super::Series;
+use super::series::Series;
 use crate::error::{Result, WeftError};
 use crate::model::{ElementKind, Model};
 

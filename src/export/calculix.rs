@@ -36,11 +36,26 @@
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 
-use super::{law_samples, num, refuse, Report};
+use super::common::{fixed_translations, law_samples, node_lines, num, output_nodes, Report};
+use super::unsupported::{check, Refusals, Unsupported};
 use crate::error::Result;
 use crate::model::{ElementKind, Model};
 
 const FORMAT: &str = "CalculiX";
+
+/// What this deck cannot reproduce, in the order looked for, with CalculiX's reasons.
+const REFUSED: &Refusals = &[
+    (Unsupported::Beams, "CalculiX's B31 beams run in explicit dynamics but give wrong answers there (they are expanded into C3D8I bricks, which are wrong in explicit); measured with ccx 2.20"),
+    (Unsupported::Membranes, "CalculiX's M3D membranes are expanded into C3D8I bricks, wrong in explicit dynamics; S4R shells run correctly in-plane but add a bending stiffness weft's membranes do not have (measured with ccx 2.20)"),
+    (Unsupported::LinkDashpots, "CalculiX's DASHPOTA elements are silently ignored in explicit dynamics (measured with ccx 2.20)"),
+    (Unsupported::LinkSlider, "CalculiX has no elastic-perfectly-plastic discrete element"),
+    (Unsupported::LinkSliding, "a link whose ends move along its yarns has no discrete-element counterpart (it would be a contact between beams)"),
+    (Unsupported::Projectiles, "a rigid projectile in penalty contact has no CalculiX explicit counterpart here"),
+    (Unsupported::Contacts, "not exported (CalculiX's contact in explicit dynamics is not checked against weft's)"),
+    (Unsupported::Ties, "they would be *EQUATION constraints; not exported"),
+    (Unsupported::Formed, "CalculiX cannot start from displaced positions with the strains of that state"),
+    (Unsupported::MassScaling, "the added masses are weft's; run without mass scaling"),
+];
 
 /// Groups elements with equal constants into one ELSET (ccx takes one constant per set).
 #[derive(Default)]
@@ -59,92 +74,60 @@ fn bits(x: f64) -> u64 {
     x.to_bits()
 }
 
-/// What a model holds that this deck cannot reproduce, as an error.
-fn check(m: &Model) -> Result<()> {
-    let kind = |k: ElementKind| m.block(k).is_some();
-    if kind(ElementKind::Beam) {
-        return Err(refuse(FORMAT, "beam elements", "CalculiX's B31 beams run in explicit dynamics but give wrong answers there (they are expanded into C3D8I bricks, which are wrong in explicit); measured with ccx 2.20"));
-    }
-    for k in [ElementKind::Tri, ElementKind::Quad] {
-        if kind(k) {
-            return Err(refuse(FORMAT, &format!("membrane elements ({})", k.name()), "CalculiX's M3D membranes are expanded into C3D8I bricks, wrong in explicit dynamics; S4R shells run correctly in-plane but add a bending stiffness weft's membranes do not have (measured with ccx 2.20)"));
-        }
-    }
-    if let Some(b) = m.block(ElementKind::Link) {
-        for e in 0..b.len() {
-            let part = &m.parts[b.part[e]];
-            let p = &part.props;
-            if [p.cx, p.cy, p.cz]
-                .iter()
-                .any(|c| c.is_some_and(|c| c > 0.0))
-            {
-                return Err(refuse(FORMAT, &format!("the dashpots of link part `{}`", part.name), "CalculiX's DASHPOTA elements are silently ignored in explicit dynamics (measured with ccx 2.20)"));
-            }
-            if p.slip_force.is_some() {
-                return Err(refuse(
-                    FORMAT,
-                    &format!("the friction slider of link part `{}`", part.name),
-                    "CalculiX has no elastic-perfectly-plastic discrete element",
-                ));
-            }
-            if p.sliding == Some(true) {
-                return Err(refuse(
-                    FORMAT,
-                    &format!("the sliding ends of link part `{}`", part.name),
-                    "a link whose ends move along its yarns has no discrete-element counterpart (it would be a contact between beams)",
-                ));
-            }
-        }
-    }
-    if !m.projectiles.is_empty() {
-        return Err(refuse(
-            FORMAT,
-            "projectiles",
-            "a rigid projectile in penalty contact has no CalculiX explicit counterpart here",
-        ));
-    }
-    if !m.contacts.is_empty() {
-        return Err(refuse(
-            FORMAT,
-            "contacts between parts",
-            "not exported (CalculiX's contact in explicit dynamics is not checked against weft's)",
-        ));
-    }
-    if !m.ties.is_empty() {
-        return Err(refuse(
-            FORMAT,
-            "tied interfaces",
-            "they would be *EQUATION constraints; not exported",
-        ));
-    }
-    if !m.initial_displacement.is_empty() {
-        return Err(refuse(
-            FORMAT,
-            "a formed model (initial displacements ux0, uy0, uz0)",
-            "CalculiX cannot start from displaced positions with the strains of that state",
-        ));
-    }
-    if m.analysis.target_time_step.is_some() {
-        return Err(refuse(
-            FORMAT,
-            "mass scaling (target_time_step)",
-            "the added masses are weft's; run without mass scaling",
-        ));
-    }
-    Ok(())
+/// The float of a bit pattern from [`bits`] (the same value, bit for bit).
+fn value(b: u64) -> f64 {
+    f64::from_bits(b)
 }
 
-/// The deck and what it holds.
+/// The deck being written, and what it holds so far.
+struct Deck {
+    s: String,
+    r: Report,
+    /// The next free element id (SPRING2 and MASS elements come after weft's own).
+    next_id: i64,
+    /// Lumped nodal masses [kg]: the trusses' halves and the point masses.
+    mass: Vec<f64>,
+}
+
+/// The deck and what it holds: a list of sections, in deck order.
 pub fn deck(m: &Model, dt: f64, nsub: u64, provenance: &str) -> Result<(String, Report)> {
-    check(m)?;
-    let mut r = Report {
-        dt,
-        increments_per_output: nsub,
-        end_time: m.analysis.end_time,
-        nodes: m.num_nodes(),
-        ..Default::default()
+    check(m, FORMAT, REFUSED)?;
+    let mut d = Deck {
+        s: String::new(),
+        r: Report {
+            dt,
+            increments_per_output: nsub,
+            end_time: m.analysis.end_time,
+            nodes: m.num_nodes(),
+            ..Default::default()
+        },
+        next_id: m
+            .elements
+            .values()
+            .flat_map(|b| b.id.iter().copied())
+            .max()
+            .unwrap_or(0)
+            + 1,
+        mass: vec![0.0; m.num_nodes()],
     };
-    let mut s = String::new();
+    header(&mut d.s, dt, provenance);
+    d.s.push_str("*NODE, NSET=NALL\n");
+    node_lines(&mut d.s, m);
+    trusses(m, &mut d);
+    links(m, &mut d);
+    masses(m, &mut d);
+    damping(m, &mut d.s);
+    boundary(m, &mut d);
+    initial_velocities(m, &mut d);
+    amplitudes(m, dt, &mut d.s);
+    output_set(m, &mut d);
+    step(m, dt, nsub, &mut d);
+    Ok((d.s, d.r))
+}
+
+/// Comment lines (what wrote the deck, the units and step, the provenance) and the
+/// heading.
+fn header(s: &mut String, dt: f64, provenance: &str) {
     let _ = writeln!(
         s,
         "** CalculiX deck written by weft {} (weft-export --format calculix)",
@@ -166,33 +149,17 @@ pub fn deck(m: &Model, dt: f64, nsub: u64, provenance: &str) -> Result<(String, 
     );
     let _ = writeln!(s, "** weft.provenance: {provenance}");
     let _ = writeln!(s, "*HEADING\nweft model, explicit dynamics");
-    s.push_str("*NODE, NSET=NALL\n");
-    for (i, x) in m.coords.iter().enumerate() {
-        let _ = writeln!(
-            s,
-            "{}, {}, {}, {}",
-            m.node_id[i],
-            num(x[0]),
-            num(x[1]),
-            num(x[2])
-        );
-    }
-    let mut next_id = m
-        .elements
-        .values()
-        .flat_map(|b| b.id.iter().copied())
-        .max()
-        .unwrap_or(0)
-        + 1;
-    let mut mass = vec![0.0; m.num_nodes()];
+}
+
+/// Trusses as SPRINGA elements: linear sets by k, nonlinear ones by (k, L, L − L₀,
+/// tension-only); their masses lumped, half on each end.
+fn trusses(m: &Model, d: &mut Deck) {
     let dist = |a: usize, b: usize| {
         let (p, q) = (m.coords[a], m.coords[b]);
         ((q[0] - p[0]).powi(2) + (q[1] - p[1]).powi(2) + (q[2] - p[2]).powi(2)).sqrt()
     };
-    // Trusses: linear SPRINGA sets by k, nonlinear ones by (k, L, L − L₀, tension-only).
     let mut linear: Sets<u64> = Sets::default();
     let mut nonlinear: Sets<(u64, u64, u64, bool)> = Sets::default();
-    let mut consts: BTreeMap<u64, f64> = BTreeMap::new();
     if let Some(b) = m.block(ElementKind::Truss) {
         for e in 0..b.len() {
             let (a, c) = (b.nodes[2 * e], b.nodes[2 * e + 1]);
@@ -205,51 +172,55 @@ pub fn deck(m: &Model, dt: f64, nsub: u64, provenance: &str) -> Result<(String, 
             let l = dist(a, c);
             let l0 = l / (1.0 + p.prestrain.unwrap_or(0.0));
             let k = ym * area / l0;
-            mass[a] += 0.5 * rho * area * l;
-            mass[c] += 0.5 * rho * area * l;
+            d.mass[a] += 0.5 * rho * area * l;
+            d.mass[c] += 0.5 * rho * area * l;
             let line = format!("{}, {}, {}", b.id[e], m.node_id[a], m.node_id[c]);
             let tension_only = p.tension_only.unwrap_or(false);
             if l != l0 || tension_only {
-                for v in [k, l, l - l0] {
-                    consts.insert(bits(v), v);
-                }
                 nonlinear.add((bits(k), bits(l), bits(l - l0), tension_only), line);
             } else {
-                consts.insert(bits(k), k);
                 linear.add(bits(k), line);
             }
         }
-        r.written.push(("SPRINGA (trusses)".into(), b.len()));
+        d.r.written.push(("SPRINGA (trusses)".into(), b.len()));
     }
+    let s = &mut d.s;
     for (n, (k, lines)) in linear.sets.iter().enumerate() {
         let _ = writeln!(s, "*ELEMENT, TYPE=SPRINGA, ELSET=TRUSS{}", n + 1);
         s.push_str(&lines.join("\n"));
-        let _ = writeln!(s, "\n*SPRING, ELSET=TRUSS{}\n\n{}", n + 1, num(consts[k]));
+        let _ = writeln!(s, "\n*SPRING, ELSET=TRUSS{}\n\n{}", n + 1, num(value(*k)));
     }
-    for (n, ((k, l, d, tension_only), lines)) in nonlinear.sets.iter().enumerate() {
-        let (k, l, d) = (consts[k], consts[l], consts[d]);
+    for (n, (&(k, l, dl, tension_only), lines)) in nonlinear.sets.iter().enumerate() {
         let _ = writeln!(s, "*ELEMENT, TYPE=SPRINGA, ELSET=PRETRUSS{}", n + 1);
         s.push_str(&lines.join("\n"));
         let _ = writeln!(s, "\n*SPRING, ELSET=PRETRUSS{}, NONLINEAR\n", n + 1);
-        // (force, elongation) pairs, elongation ascending.
-        let f = |e: f64| {
-            let v = k * (e + d);
-            if *tension_only {
-                v.max(0.0)
-            } else {
-                v
-            }
-        };
-        let mut es = vec![-0.9 * l];
-        if *tension_only && -d > -0.9 * l && -d < l {
-            es.push(-d);
-        }
-        es.push(l);
-        for e in es {
-            let _ = writeln!(s, "{}, {}", num(f(e)), num(e));
-        }
+        nonlinear_law(s, value(k), value(l), value(dl), tension_only);
     }
-    // Links: one SPRING2 per axis with a spring, sets by (axis, k).
+}
+
+/// The (force, elongation) pairs of a prestrained or tension-only truss, elongation
+/// ascending: F = k(e + d), d = L − L₀ (0 below −d when tension-only), over −0.9 L … L.
+fn nonlinear_law(s: &mut String, k: f64, l: f64, d: f64, tension_only: bool) {
+    let f = |e: f64| {
+        let v = k * (e + d);
+        if tension_only {
+            v.max(0.0)
+        } else {
+            v
+        }
+    };
+    let mut es = vec![-0.9 * l];
+    if tension_only && -d > -0.9 * l && -d < l {
+        es.push(-d);
+    }
+    es.push(l);
+    for e in es {
+        let _ = writeln!(s, "{}, {}", num(f(e)), num(e));
+    }
+}
+
+/// Links: one SPRING2 per axis with a spring, sets by (axis, k).
+fn links(m: &Model, d: &mut Deck) {
     let mut springs: Sets<(usize, u64)> = Sets::default();
     if let Some(b) = m.block(ElementKind::Link) {
         let mut count = 0;
@@ -259,18 +230,18 @@ pub fn deck(m: &Model, dt: f64, nsub: u64, provenance: &str) -> Result<(String, 
             for (axis, k) in [p.kx, p.ky, p.kz].into_iter().enumerate() {
                 let k = k.unwrap_or(0.0);
                 if k > 0.0 {
-                    consts.insert(bits(k), k);
                     springs.add(
                         (axis, bits(k)),
-                        format!("{next_id}, {}, {}", m.node_id[a], m.node_id[c]),
+                        format!("{}, {}, {}", d.next_id, m.node_id[a], m.node_id[c]),
                     );
-                    next_id += 1;
+                    d.next_id += 1;
                     count += 1;
                 }
             }
         }
-        r.written.push(("SPRING2 (link axes)".into(), count));
+        d.r.written.push(("SPRING2 (link axes)".into(), count));
     }
+    let s = &mut d.s;
     for (n, ((axis, k), lines)) in springs.sets.iter().enumerate() {
         let _ = writeln!(s, "*ELEMENT, TYPE=SPRING2, ELSET=LINK{}", n + 1);
         s.push_str(&lines.join("\n"));
@@ -280,47 +251,40 @@ pub fn deck(m: &Model, dt: f64, nsub: u64, provenance: &str) -> Result<(String, 
             n + 1,
             axis + 1,
             axis + 1,
-            num(consts[k])
+            num(value(*k))
         );
     }
-    // Masses: trusses' lumped halves and point masses, one MASS element per node.
+}
+
+/// Masses: trusses' lumped halves and point masses, one MASS element per node, sets by
+/// mass.
+fn masses(m: &Model, d: &mut Deck) {
     if let Some(b) = m.block(ElementKind::PointMass) {
         for e in 0..b.len() {
-            mass[b.nodes[e]] += m.parts[b.part[e]].props.mass.unwrap_or(0.0);
+            d.mass[b.nodes[e]] += m.parts[b.part[e]].props.mass.unwrap_or(0.0);
         }
     }
     let mut masses: Sets<u64> = Sets::default();
     let mut count = 0;
-    for (i, &mi) in mass.iter().enumerate() {
+    for (i, &mi) in d.mass.iter().enumerate() {
         if mi > 0.0 {
-            consts.insert(bits(mi), mi);
-            masses.add(bits(mi), format!("{next_id}, {}", m.node_id[i]));
-            next_id += 1;
+            masses.add(bits(mi), format!("{}, {}", d.next_id, m.node_id[i]));
+            d.next_id += 1;
             count += 1;
         }
     }
-    r.written.push(("MASS (nodal masses)".into(), count));
+    d.r.written.push(("MASS (nodal masses)".into(), count));
+    let s = &mut d.s;
     for (n, (mv, lines)) in masses.sets.iter().enumerate() {
         let _ = writeln!(s, "*ELEMENT, TYPE=MASS, ELSET=MASS{}", n + 1);
         s.push_str(&lines.join("\n"));
-        let _ = writeln!(s, "\n*MASS, ELSET=MASS{}\n{}", n + 1, num(consts[mv]));
+        let _ = writeln!(s, "\n*MASS, ELSET=MASS{}\n{}", n + 1, num(value(*mv)));
     }
-    // Boundary conditions: fixed translations and symmetry planes.
-    let mut fixed = vec![[false; 3]; m.num_nodes()];
-    for (i, f) in &m.constraints {
-        for d in 0..3 {
-            fixed[*i][d] |= f[d];
-        }
-    }
-    for sp in &m.symmetry {
-        for (i, x) in m.coords.iter().enumerate() {
-            if (x[sp.normal] - sp.position).abs() <= sp.tolerance {
-                fixed[i][sp.normal] = true;
-            }
-        }
-    }
-    // Mass-proportional damping f = −α m v: Rayleigh damping C = αM (ccx applies it to
-    // the whole model; it warns that the material has no elastic constants).
+}
+
+/// Mass-proportional damping f = −α m v: Rayleigh damping C = αM (ccx applies it to
+/// the whole model; it warns that the material has no elastic constants).
+fn damping(m: &Model, s: &mut String) {
     if m.analysis.mass_damping != 0.0 {
         let _ = writeln!(
             s,
@@ -328,31 +292,42 @@ pub fn deck(m: &Model, dt: f64, nsub: u64, provenance: &str) -> Result<(String, 
             num(m.analysis.mass_damping)
         );
     }
+}
+
+/// Boundary conditions: fixed translations and symmetry planes.
+fn boundary(m: &Model, d: &mut Deck) {
     let mut bc = String::new();
     let mut nbc = 0;
-    for (i, f) in fixed.iter().enumerate() {
-        for (d, _) in f.iter().enumerate().filter(|p| *p.1) {
-            let _ = writeln!(bc, "{}, {}, {}", m.node_id[i], d + 1, d + 1);
+    for (i, f) in fixed_translations(m).iter().enumerate() {
+        for (dof, _) in f.iter().enumerate().filter(|p| *p.1) {
+            let _ = writeln!(bc, "{}, {}, {}", m.node_id[i], dof + 1, dof + 1);
             nbc += 1;
         }
     }
     if nbc > 0 {
-        s.push_str("*BOUNDARY\n");
-        s.push_str(&bc);
+        d.s.push_str("*BOUNDARY\n");
+        d.s.push_str(&bc);
     }
-    r.written
+    d.r.written
         .push(("*BOUNDARY (fixed translations)".into(), nbc));
+}
+
+/// Initial velocities, one line per non-zero component.
+fn initial_velocities(m: &Model, d: &mut Deck) {
     if !m.initial_velocities.is_empty() {
-        s.push_str("*INITIAL CONDITIONS, TYPE=VELOCITY\n");
+        d.s.push_str("*INITIAL CONDITIONS, TYPE=VELOCITY\n");
         for (i, v) in &m.initial_velocities {
-            for (d, vd) in v.iter().enumerate().filter(|p| *p.1 != 0.0) {
-                let _ = writeln!(s, "{}, {}, {}", m.node_id[*i], d + 1, num(*vd));
+            for (dof, vd) in v.iter().enumerate().filter(|p| *p.1 != 0.0) {
+                let _ = writeln!(d.s, "{}, {}, {}", m.node_id[*i], dof + 1, num(*vd));
             }
         }
     }
-    r.written
+    d.r.written
         .push(("initial velocities".into(), m.initial_velocities.len()));
-    // Load amplitudes, one per load.
+}
+
+/// Load amplitudes, one per load: the law's samples, four pairs a line.
+fn amplitudes(m: &Model, dt: f64, s: &mut String) {
     let end = m.analysis.end_time;
     for l in &m.loads {
         let _ = writeln!(s, "*AMPLITUDE, NAME=A{}", l.id);
@@ -365,28 +340,24 @@ pub fn deck(m: &Model, dt: f64, nsub: u64, provenance: &str) -> Result<(String, 
             let _ = writeln!(s, "{}", row.join(", "));
         }
     }
-    // Output nodes: the history sets, or every node.
-    let out_nodes: Vec<usize> = if m.analysis.history_sets.is_empty() {
-        (0..m.num_nodes()).collect()
-    } else {
-        let mut v: Vec<usize> = m
-            .analysis
-            .history_sets
-            .iter()
-            .filter_map(|n| m.node_sets.get(n))
-            .flatten()
-            .copied()
-            .collect();
-        v.sort_unstable();
-        v.dedup();
-        v
-    };
-    r.output_nodes = out_nodes.len();
-    s.push_str("*NSET, NSET=NOUT\n");
+}
+
+/// The printed nodes as the node set NOUT: the history sets, or every node.
+fn output_set(m: &Model, d: &mut Deck) {
+    let out_nodes = output_nodes(m);
+    d.r.output_nodes = out_nodes.len();
+    d.s.push_str("*NSET, NSET=NOUT\n");
     for chunk in out_nodes.chunks(8) {
         let ids: Vec<String> = chunk.iter().map(|&i| m.node_id[i].to_string()).collect();
-        let _ = writeln!(s, "{}", ids.join(", "));
+        let _ = writeln!(d.s, "{}", ids.join(", "));
     }
+}
+
+/// The explicit step: its increments, the loads, and the printing of U at NOUT every
+/// `nsub` increments.
+fn step(m: &Model, dt: f64, nsub: u64, d: &mut Deck) {
+    let end = m.analysis.end_time;
+    let s = &mut d.s;
     let steps = (end / dt).round() as u64;
     let _ = writeln!(s, "*STEP, NLGEOM, INC={}", steps + 10);
     let _ = writeln!(
@@ -399,14 +370,13 @@ pub fn deck(m: &Model, dt: f64, nsub: u64, provenance: &str) -> Result<(String, 
     );
     for l in &m.loads {
         let lines: Vec<String> = (0..3)
-            .filter(|&d| l.force[d] != 0.0)
-            .map(|d| format!("{}, {}, {}", m.node_id[l.node], d + 1, num(l.force[d])))
+            .filter(|&dof| l.force[dof] != 0.0)
+            .map(|dof| format!("{}, {}, {}", m.node_id[l.node], dof + 1, num(l.force[dof])))
             .collect();
         if !lines.is_empty() {
             let _ = writeln!(s, "*CLOAD, AMPLITUDE=A{}\n{}", l.id, lines.join("\n"));
         }
     }
-    r.written.push(("*CLOAD (loads)".into(), m.loads.len()));
+    d.r.written.push(("*CLOAD (loads)".into(), m.loads.len()));
     let _ = writeln!(s, "*NODE PRINT, NSET=NOUT, FREQUENCY={nsub}\nU\n*END STEP");
-    Ok((s, r))
 }

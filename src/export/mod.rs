@@ -7,13 +7,20 @@
 //! - [`lsdyna`]: an LS-DYNA keyword `.k` deck (checked structurally here; LS-DYNA is not
 //!   available to the tests).
 //!
+//! What the two decks share is in `common.rs`; what either refuses is one list of model
+//! features in `unsupported.rs`, each format giving its own reasons.
+//!
 //! Both use SI units (m, kg, s, N, Pa) as weft does, and write the deck beside the target
 //! and rename it into place. The time step of a CalculiX deck is fixed and divides the
 //! output interval (ccx prints every n-th increment); run weft with the same
 //! `--time-step` to compare the two step for step.
 
 pub mod calculix;
+mod common;
 pub mod lsdyna;
+mod unsupported;
+
+pub use common::{law_samples, num, Report};
 
 use std::path::{Path, PathBuf};
 
@@ -44,26 +51,6 @@ pub struct Config {
     /// Time step [s]; None: weft's own (stable step × safety, or the model's fixed step),
     /// lowered to divide the output interval.
     pub time_step: Option<f64>,
-}
-
-/// What an export wrote.
-#[derive(Debug, Clone, Default)]
-pub struct Report {
-    /// Time step of the deck [s] and increments per output sample.
-    pub dt: f64,
-    pub increments_per_output: u64,
-    pub end_time: f64,
-    pub nodes: usize,
-    /// Cards written: (what, count), e.g. ("SPRINGA (trusses)", 200).
-    pub written: Vec<(String, usize)>,
-    /// Nodes whose displacements the deck prints.
-    pub output_nodes: usize,
-}
-
-/// Refusal: the model holds something the format cannot reproduce faithfully.
-pub(crate) fn refuse(format: &str, what: &str, why: &str) -> WeftError {
-    WeftError::input(format!("cannot export {what} to {format}: {why}"))
-        .hint("export a model without it (the deck would not be the same model), or compare it in weft alone")
 }
 
 /// Write the deck for `c`.
@@ -106,16 +93,6 @@ pub fn time_step(m: &Model, asked: Option<f64>) -> Result<(f64, u64)> {
     Ok((dt, n as u64))
 }
 
-/// A number as CalculiX and LS-DYNA read it: at most 20 characters (ccx reads fields of
-/// 20), 14 significant digits.
-pub fn num(x: f64) -> String {
-    if x == 0.0 {
-        "0.".into()
-    } else {
-        format!("{x:.13e}")
-    }
-}
-
 fn write_atomic(path: &Path, text: &str) -> Result<()> {
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).map_err(|e| WeftError::io(dir, e))?;
@@ -128,65 +105,4 @@ fn write_atomic(path: &Path, text: &str) -> Result<()> {
     let tmp = path.with_file_name(format!(".{name}.tmp-{}", std::process::id()));
     std::fs::write(&tmp, text).map_err(|e| WeftError::io(&tmp, e))?;
     std::fs::rename(&tmp, path).map_err(|e| WeftError::io(path, e))
-}
-
-/// Samples (t, g(t)) of a load's time law on [0, end], for tabulated amplitudes: the
-/// law's corners exactly, and a sine pulse at every step Δt inside it (so that a code
-/// evaluating the load at its steps sees the exact sine; at most `MAX_SAMPLES`, else
-/// evenly).
-pub fn law_samples(law: &crate::model::TimeLaw, end: f64, dt: f64) -> Vec<(f64, f64)> {
-    use crate::model::TimeLaw;
-    const MAX_SAMPLES: usize = 20_000;
-    let mut v: Vec<(f64, f64)> = vec![];
-    // A jump at t0 is a rise over a millionth of a step.
-    let eps = 1e-6 * dt;
-    match law {
-        TimeLaw::SinePulse { start, duration } => {
-            if *start > 0.0 {
-                v.push((0.0, 0.0));
-            }
-            v.push((*start, 0.0));
-            let (k0, k1) = ((start / dt).ceil(), ((start + duration) / dt).floor());
-            if k1 - k0 < MAX_SAMPLES as f64 {
-                for k in k0 as u64..=k1 as u64 {
-                    let t = k as f64 * dt;
-                    v.push((t, law.eval(t)));
-                }
-            } else {
-                for j in 0..=MAX_SAMPLES {
-                    let t = start + duration * j as f64 / MAX_SAMPLES as f64;
-                    v.push((t, law.eval(t)));
-                }
-            }
-            v.push((start + duration, 0.0));
-        }
-        TimeLaw::Step { start } => {
-            if *start > 0.0 {
-                v.push((0.0, 0.0));
-                v.push((start - eps, 0.0));
-            }
-            v.push((start.max(0.0), 1.0));
-        }
-        TimeLaw::Ramp { start, duration } => {
-            if *start > 0.0 {
-                v.push((0.0, 0.0));
-            }
-            v.push((*start, 0.0));
-            v.push((start + duration, 1.0));
-        }
-        TimeLaw::Tabulated { curve, .. } => {
-            if curve.t[0] > 0.0 {
-                v.push((0.0, curve.value[0]));
-            }
-            v.extend(curve.t.iter().copied().zip(curve.value.iter().copied()));
-        }
-    }
-    // Hold the last value to beyond the end; keep times strictly increasing.
-    let last = v.last().map_or(0.0, |p| p.1);
-    let tl = v.last().map_or(0.0, |p| p.0);
-    if tl < end * 1.01 {
-        v.push((end * 1.01 + dt, last));
-    }
-    v.dedup_by(|b, a| b.0 <= a.0);
-    v
 }

@@ -25,11 +25,12 @@ use std::path::{Path, PathBuf};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use crate::analysis::COMPONENTS;
+use super::chart::{label, readable, tick};
+
 use crate::error::{Result, WeftError};
 use crate::model::io::read_model;
-use crate::model::ElementKind;
-use crate::table::Table;
+use crate::model::{ElementKind, Model};
+use crate::table::history::{History, COMPONENTS};
 
 /// Each membrane face (and line element) is drawn as SUBDIVISION × SUBDIVISION pieces
 /// (SUBDIVISION for a line) with interpolated values; 3 keeps a coarse mesh's colours
@@ -167,19 +168,8 @@ fn view(name: &str) -> Result<([usize; 3], f64, (&'static str, &'static str))> {
 /// The history sample nearest `time` of every node listed in the table: (time drawn,
 /// node id → [ux, uy, uz, vx, vy, vz]).
 fn sample(path: &Path, time: f64) -> Result<(f64, HashMap<i64, [f64; 6]>)> {
-    let h = Table::read(path)?;
-    const COLS: &str = "t, node_id, ux, uy, uz, vx, vy, vz";
-    let t = h.f64("t", COLS)?;
-    let ids = h.i64("node_id", COLS)?;
-    let cols: Vec<Vec<f64>> = COMPONENTS
-        .iter()
-        .map(|c| h.f64(c, COLS))
-        .collect::<Result<_>>()?;
-    if t.is_empty() {
-        return Err(WeftError::input("the history has no rows")
-            .in_file(path)
-            .hint("was the run interrupted? rerun weft-simulate"));
-    }
+    let h = History::read(path)?;
+    let t = &h.t;
     let (t0, t1) = t
         .iter()
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| {
@@ -201,36 +191,14 @@ fn sample(path: &Path, time: f64) -> Result<(f64, HashMap<i64, [f64; 6]>)> {
         .expect("non-empty");
     let mut out = HashMap::new();
     for r in (0..t.len()).filter(|&r| t[r] == best) {
-        out.insert(ids[r], std::array::from_fn(|c| cols[c][r]));
+        out.insert(h.node_id[r], h.row(r));
     }
     Ok((best, out))
 }
 
 /// Read the models and histories and build the pieces of every panel.
 pub(crate) fn build(a: &FieldFigure) -> anyhow::Result<(Field, FieldReport)> {
-    if a.model.len() != a.history.len() {
-        return Err(WeftError::input(format!(
-            "{} --model and {} --history given; expected one history per model, in the same order",
-            a.model.len(),
-            a.history.len()
-        ))
-        .into());
-    }
-    if a.model.is_empty() {
-        return Err(WeftError::input("no --model given").into());
-    }
-    if !(a.scale.is_finite() && a.scale >= 0.0) {
-        return Err(WeftError::input(format!("--scale {}", a.scale))
-            .expected("a finite magnification ≥ 0")
-            .into());
-    }
-    if let Some((lo, hi)) = a.range {
-        if !(lo.is_finite() && hi.is_finite() && lo < hi) {
-            return Err(WeftError::input(format!("--range {lo}:{hi}"))
-                .expected("MIN:MAX with finite MIN < MAX, in the component's SI unit")
-                .into());
-        }
-    }
+    check_figure(a)?;
     let (comp, unit) = component(&a.component)?;
     let (axes, sign, names) = view(&a.view)?;
     let mut panels = vec![];
@@ -239,100 +207,17 @@ pub(crate) fn build(a: &FieldFigure) -> anyhow::Result<(Field, FieldReport)> {
         missing_nodes: vec![],
         range: (0.0, 0.0),
     };
-    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    let mut seen = Seen {
+        lo: f64::INFINITY,
+        hi: f64::NEG_INFINITY,
+    };
     for (k, (mdir, hpath)) in a.model.iter().zip(&a.history).enumerate() {
-        let m = read_model(mdir)?;
-        let (t, rows) = sample(hpath, a.time)?;
-        let n = m.num_nodes();
-        let mut value: Vec<Option<f64>> = vec![None; n];
-        let mut pos: Vec<[f64; 3]> = (0..n)
-            .map(|i| {
-                let u0 = m.initial_displacement.get(i).copied().unwrap_or([0.0; 3]);
-                std::array::from_fn(|d| m.coords[i][d] + u0[d])
-            })
-            .collect();
-        for i in 0..n {
-            if let Some(r) = rows.get(&m.node_id[i]) {
-                value[i] = Some(match comp {
-                    6 => (r[0] * r[0] + r[1] * r[1] + r[2] * r[2]).sqrt(),
-                    7 => (r[3] * r[3] + r[4] * r[4] + r[5] * r[5]).sqrt(),
-                    c => r[c],
-                });
-                if a.deformed {
-                    for d in 0..3 {
-                        pos[i][d] += a.scale * r[d];
-                    }
-                }
-            }
-        }
-        let faces_total: usize = [ElementKind::Tri, ElementKind::Quad]
-            .iter()
-            .filter_map(|&kd| m.block(kd))
-            .map(|b| b.len())
-            .sum();
-        let div = if faces_total * SUBDIVISION * SUBDIVISION <= MAX_PIECES {
-            SUBDIVISION
-        } else {
-            1
-        };
-        let project = |p: [f64; 3]| (p[axes[0]], p[axes[1]], sign * p[axes[2]]);
-        let mut used = vec![false; n];
-        let mut panel = Panel {
-            label: super::label(&a.label, k, mdir),
-            time: t,
-            faces: vec![],
-            lines: vec![],
-            dots: vec![],
-        };
-        for (&kind, b) in &m.elements {
-            let npe = kind.nodes_per_element();
-            for e in 0..b.len() {
-                let nodes = &b.nodes[npe * e..npe * (e + 1)];
-                for &i in nodes {
-                    used[i] = true;
-                }
-                let x: Vec<(f64, f64, f64)> = nodes.iter().map(|&i| project(pos[i])).collect();
-                let v: Option<Vec<f64>> = nodes.iter().map(|&i| value[i]).collect();
-                match kind {
-                    ElementKind::Quad => quad_pieces(&x, v.as_deref(), div, &mut panel.faces),
-                    ElementKind::Tri => tri_pieces(&x, v.as_deref(), div, &mut panel.faces),
-                    ElementKind::Truss | ElementKind::Link | ElementKind::Beam => {
-                        if (x[0].0 - x[1].0).hypot(x[0].1 - x[1].1) > 0.0 {
-                            line_pieces(&x, v.as_deref(), div, &mut panel.lines)
-                        }
-                    }
-                    ElementKind::PointMass => panel.dots.push(Piece {
-                        pts: vec![(x[0].0, x[0].1)],
-                        depth: x[0].2,
-                        value: v.map(|v| v[0]),
-                    }),
-                }
-            }
-        }
-        for i in (0..n).filter(|&i| used[i]) {
-            if let Some(v) = value[i] {
-                lo = lo.min(v);
-                hi = hi.max(v);
-            }
-        }
-        let missing = (0..n).filter(|&i| used[i] && value[i].is_none()).count();
-        if missing == (0..n).filter(|&i| used[i]).count() {
-            return Err(WeftError::input(format!(
-                "no node of model `{}` has a value at t = {t:e} s",
-                mdir.display()
-            ))
-            .in_file(hpath)
-            .expected("the history of the model's nodes (node ids as in nodes.parquet)")
-            .hint("is this the history of that model? a run with --history-set holds only that set's nodes")
-            .into());
-        }
-        for list in [&mut panel.faces, &mut panel.lines, &mut panel.dots] {
-            list.sort_by(|p, q| p.depth.total_cmp(&q.depth));
-        }
-        report.times.push(t);
+        let (panel, missing) = panel(a, k, (mdir, hpath), comp, (axes, sign), &mut seen)?;
+        report.times.push(panel.time);
         report.missing_nodes.push(missing);
         panels.push(panel);
     }
+    let (lo, hi) = (seen.lo, seen.hi);
     let range = match a.range {
         Some(r) => r,
         None if hi > lo => (lo, hi),
@@ -354,8 +239,8 @@ pub(crate) fn build(a: &FieldFigure) -> anyhow::Result<(Field, FieldReport)> {
     let field = Field {
         panels,
         range,
-        value_unit: super::readable(vmax, unit),
-        length_unit: super::readable(ext, "m"),
+        value_unit: readable(vmax, unit),
+        length_unit: readable(ext, "m"),
         component: match comp {
             6 => "|u|".into(),
             7 => "|v|".into(),
@@ -365,6 +250,166 @@ pub(crate) fn build(a: &FieldFigure) -> anyhow::Result<(Field, FieldReport)> {
         deformed: a.deformed.then_some(a.scale),
     };
     Ok((field, report))
+}
+
+/// The settings' own checks: one history per model, a magnification and a colour range
+/// that make sense.
+fn check_figure(a: &FieldFigure) -> Result<()> {
+    if a.model.len() != a.history.len() {
+        return Err(WeftError::input(format!(
+            "{} --model and {} --history given; expected one history per model, in the same order",
+            a.model.len(),
+            a.history.len()
+        )));
+    }
+    if a.model.is_empty() {
+        return Err(WeftError::input("no --model given"));
+    }
+    if !(a.scale.is_finite() && a.scale >= 0.0) {
+        return Err(
+            WeftError::input(format!("--scale {}", a.scale)).expected("a finite magnification ≥ 0")
+        );
+    }
+    if let Some((lo, hi)) = a.range {
+        if !(lo.is_finite() && hi.is_finite() && lo < hi) {
+            return Err(WeftError::input(format!("--range {lo}:{hi}"))
+                .expected("MIN:MAX with finite MIN < MAX, in the component's SI unit"));
+        }
+    }
+    Ok(())
+}
+
+/// The smallest and largest value drawn so far, over all panels.
+struct Seen {
+    lo: f64,
+    hi: f64,
+}
+
+/// Panel `k`: model `mdir` coloured by the sample of `hpath` nearest the figure's time,
+/// and the number of element nodes without a value; `seen` widened by the values of the
+/// element nodes. A panel with no value at all is refused.
+fn panel(
+    a: &FieldFigure,
+    k: usize,
+    (mdir, hpath): (&Path, &Path),
+    comp: usize,
+    (axes, sign): ([usize; 3], f64),
+    seen: &mut Seen,
+) -> Result<(Panel, usize)> {
+    let m = read_model(mdir)?;
+    let (t, rows) = sample(hpath, a.time)?;
+    let n = m.num_nodes();
+    let (value, pos) = nodal_values(a, &m, &rows, comp);
+    let project = |p: [f64; 3]| (p[axes[0]], p[axes[1]], sign * p[axes[2]]);
+    let mut panel = Panel {
+        label: label(&a.label, k, mdir),
+        time: t,
+        faces: vec![],
+        lines: vec![],
+        dots: vec![],
+    };
+    let used = element_pieces(&m, &pos, &value, project, &mut panel);
+    for i in (0..n).filter(|&i| used[i]) {
+        if let Some(v) = value[i] {
+            seen.lo = seen.lo.min(v);
+            seen.hi = seen.hi.max(v);
+        }
+    }
+    let missing = (0..n).filter(|&i| used[i] && value[i].is_none()).count();
+    if missing == (0..n).filter(|&i| used[i]).count() {
+        return Err(WeftError::input(format!(
+            "no node of model `{}` has a value at t = {t:e} s",
+            mdir.display()
+        ))
+        .in_file(hpath)
+        .expected("the history of the model's nodes (node ids as in nodes.parquet)")
+        .hint("is this the history of that model? a run with --history-set holds only that set's nodes"));
+    }
+    for list in [&mut panel.faces, &mut panel.lines, &mut panel.dots] {
+        list.sort_by(|p, q| p.depth.total_cmp(&q.depth));
+    }
+    Ok((panel, missing))
+}
+
+/// Per model node, the drawn value (None: not in the sample) and position: X + u₀, plus
+/// `scale`·u on the deformed mesh.
+fn nodal_values(
+    a: &FieldFigure,
+    m: &Model,
+    rows: &HashMap<i64, [f64; 6]>,
+    comp: usize,
+) -> (Vec<Option<f64>>, Vec<[f64; 3]>) {
+    let n = m.num_nodes();
+    let mut value: Vec<Option<f64>> = vec![None; n];
+    let mut pos: Vec<[f64; 3]> = (0..n)
+        .map(|i| {
+            let u0 = m.initial_displacement.get(i).copied().unwrap_or([0.0; 3]);
+            std::array::from_fn(|d| m.coords[i][d] + u0[d])
+        })
+        .collect();
+    for i in 0..n {
+        if let Some(r) = rows.get(&m.node_id[i]) {
+            value[i] = Some(match comp {
+                6 => (r[0] * r[0] + r[1] * r[1] + r[2] * r[2]).sqrt(),
+                7 => (r[3] * r[3] + r[4] * r[4] + r[5] * r[5]).sqrt(),
+                c => r[c],
+            });
+            if a.deformed {
+                for d in 0..3 {
+                    pos[i][d] += a.scale * r[d];
+                }
+            }
+        }
+    }
+    (value, pos)
+}
+
+/// Every element as pieces of `panel` (faces, lines, dots), in element-table order, seen
+/// through `project`; the nodes of the elements, marked.
+fn element_pieces(
+    m: &Model,
+    pos: &[[f64; 3]],
+    value: &[Option<f64>],
+    project: impl Fn([f64; 3]) -> (f64, f64, f64),
+    panel: &mut Panel,
+) -> Vec<bool> {
+    let faces_total: usize = [ElementKind::Tri, ElementKind::Quad]
+        .iter()
+        .filter_map(|&kd| m.block(kd))
+        .map(|b| b.len())
+        .sum();
+    let div = if faces_total * SUBDIVISION * SUBDIVISION <= MAX_PIECES {
+        SUBDIVISION
+    } else {
+        1
+    };
+    let mut used = vec![false; m.num_nodes()];
+    for (&kind, b) in &m.elements {
+        let npe = kind.nodes_per_element();
+        for e in 0..b.len() {
+            let nodes = &b.nodes[npe * e..npe * (e + 1)];
+            for &i in nodes {
+                used[i] = true;
+            }
+            let x: Vec<(f64, f64, f64)> = nodes.iter().map(|&i| project(pos[i])).collect();
+            let v: Option<Vec<f64>> = nodes.iter().map(|&i| value[i]).collect();
+            match kind {
+                ElementKind::Quad => quad_pieces(&x, v.as_deref(), div, &mut panel.faces),
+                ElementKind::Tri => tri_pieces(&x, v.as_deref(), div, &mut panel.faces),
+                ElementKind::Truss | ElementKind::Link | ElementKind::Beam => {
+                    if (x[0].0 - x[1].0).hypot(x[0].1 - x[1].1) > 0.0 {
+                        line_pieces(&x, v.as_deref(), div, &mut panel.lines)
+                    }
+                }
+                ElementKind::PointMass => panel.dots.push(Piece {
+                    pts: vec![(x[0].0, x[0].1)],
+                    depth: x[0].2,
+                    value: v.map(|v| v[0]),
+                }),
+            }
+        }
+    }
+    used
 }
 
 /// Bilinear pieces of a quad (nodes counter-clockwise).
@@ -538,8 +583,8 @@ where
             .y_desc(format!("{} [{ul}]", f.axes.1))
             .label_style(("sans-serif", 15))
             .axis_desc_style(("sans-serif", 17))
-            .x_label_formatter(&|v| super::tick(*v))
-            .y_label_formatter(&|v| super::tick(*v))
+            .x_label_formatter(&|v| tick(*v))
+            .y_label_formatter(&|v| tick(*v))
             .draw()
             .map_err(err)?;
         let sc = |pts: &[(f64, f64)]| -> Vec<(f64, f64)> {
@@ -598,7 +643,7 @@ where
         .y_desc(format!("{} [{uv}]", f.component))
         .label_style(("sans-serif", 15))
         .axis_desc_style(("sans-serif", 17))
-        .y_label_formatter(&|v| super::tick(*v))
+        .y_label_formatter(&|v| tick(*v))
         .draw()
         .map_err(err)?;
     root.present().map_err(err)?;
@@ -607,6 +652,6 @@ where
 
 /// A time in a readable unit.
 fn time(t: f64) -> String {
-    let (f, u) = super::readable(t.abs(), "s");
-    format!("{} {u}", super::tick(t * f))
+    let (f, u) = readable(t.abs(), "s");
+    format!("{} {u}", tick(t * f))
 }

@@ -4,161 +4,17 @@
 pub mod energy;
 pub mod error;
 pub mod interp;
+pub mod series;
 pub mod wavespeed;
 
 pub use interp::{interpolation, match_ids, Matching, Pairing};
+pub use series::{
+    components, read_nodes, read_nodes_of, read_series, read_series_of, Series, COMPONENTS,
+};
 
 use std::collections::HashMap;
-use std::path::Path;
 
 use crate::error::{Result, WeftError};
-use crate::model::io::read_model;
-use crate::table::Table;
-
-/// Time series of the nodes of one node set, read from a history table.
-#[derive(Debug, Clone)]
-pub struct Series {
-    pub t: Vec<f64>,
-    pub node_id: Vec<i64>,
-    /// Initial positions of the nodes [m].
-    pub x0: Vec<[f64; 3]>,
-    /// `values[k][j][c]`: component c (ux, uy, uz, vx, vy, vz) of node j at sample k.
-    pub values: Vec<Vec<[f64; 6]>>,
-}
-
-/// Component names of `history.parquet`, in `Series::values` order.
-pub const COMPONENTS: [&str; 6] = ["ux", "uy", "uz", "vx", "vy", "vz"];
-
-/// Parse a list like `ux,uy` into component indices.
-pub fn components(list: &str) -> Result<Vec<usize>> {
-    list.split(',')
-        .map(|c| {
-            let c = c.trim();
-            COMPONENTS.iter().position(|n| *n == c).ok_or_else(|| {
-                WeftError::input(format!("unknown component `{c}`"))
-                    .expected("some of ux, uy, uz, vx, vy, vz, comma-separated")
-            })
-        })
-        .collect()
-}
-
-/// Read the nodes of `set` (in set order) from a model folder and its history table.
-pub fn read_series(model: &Path, history: &Path, set: &str) -> Result<Series> {
-    read_series_of(model, history, set, &[0, 1, 2, 3, 4, 5])
-}
-
-/// [`read_series`] needing only components `needed` (0..6 = ux … vz): a history without
-/// the others (a displacement-only table) reads with them NaN.
-pub fn read_series_of(model: &Path, history: &Path, set: &str, needed: &[usize]) -> Result<Series> {
-    let m = read_model(model)?;
-    let nodes = m.node_sets.get(set).ok_or_else(|| {
-        WeftError::input(format!(
-            "model `{}` has no node set `{set}`",
-            model.display()
-        ))
-        .expected(format!("one of {}", m.node_set_names()))
-    })?;
-    read_nodes_of(&m, history, nodes, &format!("of set `{set}`"), needed)
-}
-
-/// Read the history of model nodes `nodes` (indices, in that order) from a history
-/// table; `what` names them in errors (e.g. "of set `axis_x`").
-pub fn read_nodes(
-    m: &crate::model::Model,
-    history: &Path,
-    nodes: &[usize],
-    what: &str,
-) -> Result<Series> {
-    read_nodes_of(m, history, nodes, what, &[0, 1, 2, 3, 4, 5])
-}
-
-/// [`read_nodes`] needing only components `needed`; absent others read NaN.
-pub fn read_nodes_of(
-    m: &crate::model::Model,
-    history: &Path,
-    nodes: &[usize],
-    what: &str,
-    needed: &[usize],
-) -> Result<Series> {
-    let h = Table::read(history)?;
-    let cols_text = format!(
-        "t, node_id, {}",
-        needed
-            .iter()
-            .map(|&c| COMPONENTS[c])
-            .collect::<Vec<_>>()
-            .join(", ")
-    );
-    let t = h.f64("t", &cols_text)?;
-    let ids = h.i64("node_id", &cols_text)?;
-    let cols: Vec<Vec<f64>> = COMPONENTS
-        .iter()
-        .enumerate()
-        .map(|(k, c)| {
-            if needed.contains(&k) || h.has(c) {
-                h.f64(c, &cols_text)
-            } else {
-                Ok(vec![f64::NAN; t.len()])
-            }
-        })
-        .collect::<Result<_>>()?;
-    // T sums squares: a value whose square overflows would give T = NaN, named nowhere.
-    for (c, col) in cols.iter().enumerate() {
-        if let Some(r) = col.iter().position(|x| x.abs() > 1e150) {
-            return Err(h
-                .value_error(COMPONENTS[c], r, format!("value `{:e}`", col[r]))
-                .expected("|value| < 1e150 (its square must not overflow)"));
-        }
-    }
-    let want: HashMap<i64, usize> = nodes
-        .iter()
-        .enumerate()
-        .map(|(j, &i)| (m.node_id[i], j))
-        .collect();
-    let mut times: Vec<f64> = vec![];
-    let mut values: Vec<Vec<[f64; 6]>> = vec![];
-    let mut seen = vec![0usize; nodes.len()];
-    for r in 0..t.len() {
-        if times.last() != Some(&t[r]) {
-            if let Some(&last) = times.last() {
-                if t[r] < last {
-                    return Err(h
-                        .value_error("t", r, format!("time `{}` after `{last}`", t[r]))
-                        .expected("rows ordered by time, as weft-simulate writes them"));
-                }
-            }
-            times.push(t[r]);
-            values.push(vec![[f64::NAN; 6]; nodes.len()]);
-        }
-        if let Some(&j) = want.get(&ids[r]) {
-            let k = times.len() - 1;
-            values[k][j] = std::array::from_fn(|c| cols[c][r]);
-            seen[j] += 1;
-        }
-    }
-    if times.is_empty() {
-        return Err(WeftError::input("the history has no rows")
-            .in_file(history)
-            .hint("was the run interrupted? rerun weft-simulate"));
-    }
-    if let Some(j) = (0..nodes.len()).find(|&j| seen[j] != times.len()) {
-        return Err(WeftError::input(format!(
-            "node `{}` {what} has {} of {} samples in the history",
-            m.node_id[nodes[j]],
-            seen[j],
-            times.len()
-        ))
-        .in_file(history)
-        .expected("every node of the set at every output time")
-        .hint("write the history of this set: weft-simulate --history-set NAME (or all nodes)"));
-    }
-    Ok(Series {
-        t: times,
-        node_id: nodes.iter().map(|&i| m.node_id[i]).collect(),
-        x0: nodes.iter().map(|&i| m.coords[i]).collect(),
-        values,
-    })
-}
 
 /// First time |y| reaches `level`, linearly interpolated; `None` if never.
 pub fn arrival(t: &[f64], y: &[f64], level: f64) -> Option<f64> {

@@ -11,6 +11,10 @@
 //! Provenance (tool, version, stage, parameters, input hashes) is stored as JSON in the
 //! Parquet key-value metadata under `weft.provenance`, and under `PANDAS_ATTRS` so that
 //! pandas exposes it as `df.attrs["weft"]`.
+//!
+//! [`history`]: the reader of `history.parquet`, shared by every stage that takes one.
+
+pub mod history;
 
 use std::fs::File;
 use std::path::{Path, PathBuf};
