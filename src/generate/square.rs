@@ -17,7 +17,9 @@ use serde::Serialize;
 
 use crate::error::{Result, WeftError};
 use crate::generate::grid::rectangle;
-use crate::generate::zones::{tie_to_hole, Coarse};
+use crate::generate::pulse::resolve_pulse;
+pub use crate::generate::pulse::STEPS_PER_PULSE;
+use crate::generate::surround::{tie_to_hole, Coarse};
 use crate::model::{Analysis, ElementKind, Load, Model, PartProps, TimeLaw};
 
 /// Where the square is loaded.
@@ -27,27 +29,6 @@ pub enum LoadCase {
     Tension,
     Shear,
     Transverse,
-}
-
-/// Steps per load pulse: the stable step of these coarse models would sample the paper's
-/// pulse (T_F = T/2 spans N/2 cells) with about five steps, too few for the response and
-/// for the energy account (the trapezoidal work is then off by ~(π/5)²/12 ≈ 3 %).
-pub const STEPS_PER_PULSE: f64 = 40.0;
-
-/// Choose a time step that resolves the pulse when the stable step does not.
-pub(crate) fn resolve_pulse(m: &mut Model) -> Result<()> {
-    let t_f = m.loads.iter().find_map(|l| match l.law {
-        TimeLaw::SinePulse { duration, .. } => Some(duration),
-        _ => None,
-    });
-    if let Some(t_f) = t_f {
-        let stable = crate::solver::Solver::new(m)?.stable;
-        let dt = t_f / STEPS_PER_PULSE;
-        if dt < stable.dt {
-            m.analysis.time_step = Some(dt);
-        }
-    }
-    Ok(())
 }
 
 /// Common parameters of the square models.

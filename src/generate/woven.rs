@@ -708,7 +708,7 @@ pub fn woven(p: &WovenBandParams) -> Result<(Model, WovenInfo)> {
 
 /// Ties the quarter patch's yarn ends into a graded membrane (see [`Surround`]).
 fn surround(m: &mut Model, p: &WovenBandParams, s: &Surround, info: &WovenInfo) -> Result<()> {
-    use crate::generate::zones::{coarse_membrane, graded_lines, tie_to_hole, MembraneProps};
+    use crate::generate::surround::{coarse_membrane, graded_lines, tie_to_hole, MembraneProps};
     if !p.quarter {
         return Err(WeftError::input("--membrane-length with --full".to_string())
             .expected("a quarter patch: a full patch's yarn ends lie at the crimp's crests, off the membrane's plane")
