@@ -9,4 +9,5 @@ pub mod square;
 pub mod surround;
 pub mod weave;
 pub mod woven;
+pub mod woven_reduced;
 pub mod zones;
