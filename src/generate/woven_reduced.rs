@@ -9,7 +9,8 @@ use serde::Serialize;
 
 use crate::error::{Result, WeftError};
 use crate::generate::surround::{
-    centre_line_sets, coarse_membrane, graded_lines, hold_outer_edge, tie_to_hole, MembraneProps,
+    centre_line_sets, coarse_membrane, graded_lines, hold_outer_edge, tie_to_hole, Coarse,
+    MembraneProps,
 };
 use crate::model::{Analysis, ElementKind, Model, PartProps, ProjectileShape, ProjectileSpec};
 
@@ -298,29 +299,138 @@ impl WovenParams {
     }
 }
 
+/// The reduced woven model: the patch's yarns and links inside the graded membrane tied
+/// to the patch's boundary, the projectile, the node sets and the analysis; relaxed
+/// before the start when [`PretensionStart::Relaxed`].
 pub fn woven_reduced(p: &WovenParams) -> Result<Model> {
     p.check()?;
     let membrane = p.membrane();
-    let ends = p.interface == Interface::BandEnds;
-    let (n, x0) = if p.quarter {
-        (p.yarns / 2, 0.0)
-    } else {
-        (p.yarns, -0.5 * p.yarns as f64 * p.spacing)
-    };
-    // The membrane's hole: the last crossing line, or half a spacing past it (band ends,
-    // where the membrane's first cells are p/2 wide, as around the yarn-level patch).
-    let (c, hc) = if ends {
-        ((n as f64 + 0.5) * p.spacing, 0.5 * p.spacing)
-    } else {
-        (0.5 * p.yarns as f64 * p.spacing, p.spacing)
-    };
-    let pos = graded_lines(c, hc, 0.5 * p.length, p.growth)?;
+    let layout = Layout::new(p);
+    let pos = graded_lines(layout.c, layout.hc, 0.5 * p.length, p.growth)?;
     let mut m = Model::default();
-    let w = n + 1;
+    let yarns = add_yarn_nodes(&mut m, p, &layout);
+    let parts = add_parts(&mut m, p);
+    add_yarns_and_links(&mut m, p, &layout, &yarns, &parts);
+    let coarse = coarse_membrane(&mut m, &pos, p.quarter, layout.c, &membrane, 1_000_000);
+    if p.pretension_strain != 0.0 && p.pretension_start == PretensionStart::Balanced {
+        prestress_membrane(&mut m, p, &membrane);
+    }
+    let interface = tie_boundary(&mut m, &layout, &yarns, &coarse)?;
+    hold_outer_edge(&mut m, &coarse, p.quarter, p.length);
+    add_projectile(&mut m, p);
+    m.node_sets.insert("reference".into(), yarns.warp.clone());
+    m.node_sets.insert("interface".into(), interface);
+    centre_line_sets(&mut m, &yarns.warp, layout.c);
+    m.analysis = Analysis {
+        end_time: p.end_time,
+        output_interval: p.output_interval,
+        dt_safety: p.dt_safety,
+        ..Default::default()
+    };
+    m.validate()?;
+    if p.pretension_strain != 0.0 && p.pretension_start == PretensionStart::Relaxed {
+        relax_start(&mut m, p)?;
+    }
+    Ok(m)
+}
+
+/// Where the reduced patch's crossing lines and the membrane's hole lie.
+struct Layout {
+    /// The last crossing line's index n: crossing lines k = 0 … n each way (n = N/2 in a
+    /// quarter, N in a full model).
+    n: usize,
+    /// The first crossing line's coordinate x₀ (0 in a quarter, −Np/2 in a full model);
+    /// line k lies at x₀ + kp.
+    x0: f64,
+    /// Band ends ([`Interface::BandEnds`]): the yarns run on past the last crossing line
+    /// to their ends on the membrane's edge.
+    ends: bool,
+    /// The membrane's hole: its half-size c and the size h_c of the membrane's first cells.
+    c: f64,
+    hc: f64,
+}
+
+impl Layout {
+    fn new(p: &WovenParams) -> Layout {
+        let ends = p.interface == Interface::BandEnds;
+        let (n, x0) = if p.quarter {
+            (p.yarns / 2, 0.0)
+        } else {
+            (p.yarns, -0.5 * p.yarns as f64 * p.spacing)
+        };
+        // The membrane's hole: the last crossing line, or half a spacing past it (band ends,
+        // where the membrane's first cells are p/2 wide, as around the yarn-level patch).
+        let (c, hc) = if ends {
+            ((n as f64 + 0.5) * p.spacing, 0.5 * p.spacing)
+        } else {
+            (0.5 * p.yarns as f64 * p.spacing, p.spacing)
+        };
+        Layout { n, x0, ends, c, hc }
+    }
+
+    /// Crossings per line, n + 1.
+    fn w(&self) -> usize {
+        self.n + 1
+    }
+
+    /// The along-index at which a yarn's last element ends: the last crossing n, or with
+    /// band ends n + 1 (the yarn's end on the membrane's edge).
+    fn last(&self) -> usize {
+        if self.ends {
+            self.n + 1
+        } else {
+            self.n
+        }
+    }
+
+    /// Halved: the yarns on a symmetry plane, and (crossing interface) those on the
+    /// interface lines; with band ends the last crossing line is a full yarn.
+    fn on_line(&self, k: usize) -> bool {
+        k == 0 || (k == self.n && !self.ends)
+    }
+}
+
+/// The warp lies over the weft where (i + j) is even (plain weave).
+fn warp_on_top(i: usize, j: usize) -> bool {
+    (i + j).is_multiple_of(2)
+}
+
+/// The yarns' nodes: warp and weft at each crossing (i, j), index j(n + 1) + i, and with
+/// band ends the warp j's end at (c, jp) and the weft i's at (ip, c).
+struct YarnNodes {
+    warp: Vec<usize>,
+    weft: Vec<usize>,
+    warp_end: Vec<usize>,
+    weft_end: Vec<usize>,
+    /// The last crossing line's index n.
+    n: usize,
+}
+
+impl YarnNodes {
+    /// The warp j's node at i (i = n + 1: its end).
+    fn warp_at(&self, i: usize, j: usize) -> usize {
+        if i > self.n {
+            self.warp_end[j]
+        } else {
+            self.warp[j * (self.n + 1) + i]
+        }
+    }
+
+    /// The weft i's node at j (j = n + 1: its end).
+    fn weft_at(&self, i: usize, j: usize) -> usize {
+        if j > self.n {
+            self.weft_end[i]
+        } else {
+            self.weft[j * (self.n + 1) + i]
+        }
+    }
+}
+
+/// The warp and weft nodes at every crossing, crimped ±a alternately, and the band ends.
+fn add_yarn_nodes(m: &mut Model, p: &WovenParams, l: &Layout) -> YarnNodes {
+    let (n, w, c, ends, x0) = (l.n, l.w(), l.c, l.ends, l.x0);
     let mut warp = vec![];
     let mut weft = vec![];
-    // The warp lies over the weft where (i + j) is even (plain weave).
-    let warp_on_top = |i: usize, j: usize| (i + j).is_multiple_of(2);
     for j in 0..=n {
         for i in 0..=n {
             let (x, y) = (x0 + i as f64 * p.spacing, x0 + j as f64 * p.spacing);
@@ -348,9 +458,37 @@ pub fn woven_reduced(p: &WovenParams) -> Result<Model> {
             weft_end.push(m.add_node(first + 1 + (w + k) as i64, [t, c, 0.0]));
         }
     }
-    // Yarn nodes along the warp j (i = n + 1: its end) and the weft i (j = n + 1).
-    let warp_at = |i: usize, j: usize| if i > n { warp_end[j] } else { warp[j * w + i] };
-    let weft_at = |i: usize, j: usize| if j > n { weft_end[i] } else { weft[j * w + i] };
+    YarnNodes {
+        warp,
+        weft,
+        warp_end,
+        weft_end,
+        n,
+    }
+}
+
+/// The patch's parts: full and half yarns; the links, and in a quarter model those on a
+/// symmetry plane (half) and the centre crossing (a quarter).
+struct ReducedParts {
+    yarn: usize,
+    half_yarn: usize,
+    link: usize,
+    half_link: usize,
+    quarter_link: usize,
+}
+
+impl ReducedParts {
+    /// The link part of the crossing (i, j).
+    fn link_at(&self, quarter: bool, i: usize, j: usize) -> usize {
+        match (quarter && i == 0, quarter && j == 0) {
+            (true, true) => self.quarter_link,
+            (true, false) | (false, true) => self.half_link,
+            _ => self.link,
+        }
+    }
+}
+
+fn add_parts(m: &mut Model, p: &WovenParams) -> ReducedParts {
     let yarn = m.add_part(
         1,
         "yarns",
@@ -397,11 +535,40 @@ pub fn woven_reduced(p: &WovenParams) -> Result<Model> {
             ..m.parts[yarn].props.clone()
         },
     );
-    // In a quarter model, what lies on a symmetry plane is shared with the neighbouring
-    // quarter: the links on one plane get half, the centre link a quarter of their
-    // stiffness, damping and slip force (the friction coefficient is a ratio: the halved
-    // normal stiffness halves N and so the slip force).
-    let scaled = |f: f64, base: &PartProps| PartProps {
+    let (half_link, quarter_link) = if p.quarter {
+        let lp = m.parts[link].props.clone();
+        (
+            m.add_part(
+                4,
+                "crossings_on_symmetry",
+                ElementKind::Link,
+                scaled_link(0.5, &lp),
+            ),
+            m.add_part(
+                5,
+                "centre_crossing",
+                ElementKind::Link,
+                scaled_link(0.25, &lp),
+            ),
+        )
+    } else {
+        (link, link)
+    };
+    ReducedParts {
+        yarn,
+        half_yarn,
+        link,
+        half_link,
+        quarter_link,
+    }
+}
+
+/// In a quarter model, what lies on a symmetry plane is shared with the neighbouring
+/// quarter: the links on one plane get half, the centre link a quarter of their
+/// stiffness, damping and slip force (the friction coefficient is a ratio: the halved
+/// normal stiffness halves N and so the slip force).
+fn scaled_link(f: f64, base: &PartProps) -> PartProps {
+    PartProps {
         kx: base.kx.map(|v| v * f),
         ky: base.ky.map(|v| v * f),
         kz: base.kz.map(|v| v * f),
@@ -410,117 +577,138 @@ pub fn woven_reduced(p: &WovenParams) -> Result<Model> {
         cz: base.cz.map(|v| v * f),
         slip_force: base.slip_force.map(|v| v * f),
         ..base.clone()
-    };
-    let (half_link, quarter_link) = if p.quarter {
-        let lp = m.parts[link].props.clone();
-        (
-            m.add_part(
-                4,
-                "crossings_on_symmetry",
-                ElementKind::Link,
-                scaled(0.5, &lp),
-            ),
-            m.add_part(5, "centre_crossing", ElementKind::Link, scaled(0.25, &lp)),
-        )
-    } else {
-        (link, link)
-    };
-    // Halved: the yarns on a symmetry plane, and (crossing interface) those on the
-    // interface lines; with band ends the last crossing line is a full yarn.
-    let on_line = |k: usize| k == 0 || (k == n && !ends);
-    let last = if ends { n + 1 } else { n };
+    }
+}
+
+/// The yarns' trusses and the crossings' links, numbered crossing by crossing: the warp
+/// element leaving (i, j), the weft element, the link.
+fn add_yarns_and_links(
+    m: &mut Model,
+    p: &WovenParams,
+    l: &Layout,
+    y: &YarnNodes,
+    parts: &ReducedParts,
+) {
+    let (n, last) = (l.n, l.last());
     let mut eid = 1;
     for j in 0..=n {
         for i in 0..=n {
-            let k = j * w + i;
             if i < last {
                 m.add_element(
                     eid,
-                    if on_line(j) { half_yarn } else { yarn },
-                    &[warp_at(i, j), warp_at(i + 1, j)],
+                    if l.on_line(j) {
+                        parts.half_yarn
+                    } else {
+                        parts.yarn
+                    },
+                    &[y.warp_at(i, j), y.warp_at(i + 1, j)],
                 );
                 eid += 1;
             }
             if j < last {
                 m.add_element(
                     eid,
-                    if on_line(i) { half_yarn } else { yarn },
-                    &[weft_at(i, j), weft_at(i, j + 1)],
+                    if l.on_line(i) {
+                        parts.half_yarn
+                    } else {
+                        parts.yarn
+                    },
+                    &[y.weft_at(i, j), y.weft_at(i, j + 1)],
                 );
                 eid += 1;
             }
-            let lk = match (p.quarter && i == 0, p.quarter && j == 0) {
-                (true, true) => quarter_link,
-                (true, false) | (false, true) => half_link,
-                _ => link,
-            };
-            // Node 1 the lower yarn, node 2 the upper: the link's normal points from
-            // node 1 to node 2, so that d_z < 0 presses them together (the unilateral
-            // spring and Coulomb friction read it).
-            let pair = if warp_on_top(i, j) {
-                [weft[k], warp[k]]
-            } else {
-                [warp[k], weft[k]]
-            };
-            if p.local_frame {
-                // The frame: e₁ along the warp (the chord of its neighbours at i ∓ 1), the
-                // normal ⟂ the weft (neighbours at j ∓ 1). At k = 0 (a symmetry plane, or
-                // the interface of a full model) the chord to k + 2, at the same crimp
-                // height: the mirrored neighbour's chord, level as symmetry asks (a
-                // one-sided chord to k + 1 would tilt the normal by 2a/p and read the
-                // crimp's pressure as a pull there, measured); at k = n the chord to n − 1
-                // (those crossings are tied to the membrane), or with band ends the chord
-                // from n − 1 to the band's end.
-                let chord = |k: usize| match k {
-                    0 => (0, 2.min(last)),
-                    k if k == last => (k - 1, k),
-                    k => (k - 1, k + 1),
-                };
-                let ((ia, ib), (ja, jb)) = (chord(i), chord(j));
-                m.add_link_with_frame(
-                    eid,
-                    lk,
-                    &pair,
-                    [
-                        warp_at(ia, j),
-                        warp_at(ib, j),
-                        weft_at(i, ja),
-                        weft_at(i, jb),
-                    ],
-                );
-            } else {
-                m.add_element(eid, lk, &pair);
-            }
+            add_link(m, p, l, y, eid, parts.link_at(p.quarter, i, j), (i, j));
             eid += 1;
         }
     }
-    let coarse = coarse_membrane(&mut m, &pos, p.quarter, c, &membrane, 1_000_000);
-    if p.pretension_strain != 0.0 && p.pretension_start == PretensionStart::Balanced {
-        // The membrane carries the yarns' tension per unit width as a uniform initial
-        // stress in both directions: in equilibrium with the yarn ends tied to its hole
-        // (a yarn of tension E A ε₀ per strip of width p; half yarns on the lines).
-        let s0 = p.pretension_per_width() / membrane.thickness;
-        let b = m
-            .elements
-            .get_mut(&ElementKind::Quad)
-            .expect("the coarse membrane");
-        b.stress0 = vec![[s0, s0, 0.0]; b.len()];
+}
+
+/// The link `eid` of part `part` at the crossing (i, j), in the crossing's frame with
+/// `local_frame`.
+fn add_link(
+    m: &mut Model,
+    p: &WovenParams,
+    l: &Layout,
+    y: &YarnNodes,
+    eid: i64,
+    part: usize,
+    (i, j): (usize, usize),
+) {
+    let k = j * l.w() + i;
+    // Node 1 the lower yarn, node 2 the upper: the link's normal points from
+    // node 1 to node 2, so that d_z < 0 presses them together (the unilateral
+    // spring and Coulomb friction read it).
+    let pair = if warp_on_top(i, j) {
+        [y.weft[k], y.warp[k]]
+    } else {
+        [y.warp[k], y.weft[k]]
+    };
+    if !p.local_frame {
+        m.add_element(eid, part, &pair);
+        return;
     }
-    // Every yarn node on the patch boundary (the yarn ends and the nodes of the yarns
-    // that run along it) is tied to the membrane edge it lies on.
-    let on_boundary: Vec<usize> = warp
+    // The frame: e₁ along the warp (the chord of its neighbours at i ∓ 1), the
+    // normal ⟂ the weft (neighbours at j ∓ 1). At k = 0 (a symmetry plane, or
+    // the interface of a full model) the chord to k + 2, at the same crimp
+    // height: the mirrored neighbour's chord, level as symmetry asks (a
+    // one-sided chord to k + 1 would tilt the normal by 2a/p and read the
+    // crimp's pressure as a pull there, measured); at k = n the chord to n − 1
+    // (those crossings are tied to the membrane), or with band ends the chord
+    // from n − 1 to the band's end.
+    let last = l.last();
+    let chord = |k: usize| match k {
+        0 => (0, 2.min(last)),
+        k if k == last => (k - 1, k),
+        k => (k - 1, k + 1),
+    };
+    let ((ia, ib), (ja, jb)) = (chord(i), chord(j));
+    m.add_link_with_frame(
+        eid,
+        part,
+        &pair,
+        [
+            y.warp_at(ia, j),
+            y.warp_at(ib, j),
+            y.weft_at(i, ja),
+            y.weft_at(i, jb),
+        ],
+    );
+}
+
+/// The balanced start: the membrane carries the yarns' tension per unit width as a
+/// uniform initial stress in both directions, in equilibrium with the yarn ends tied to
+/// its hole (a yarn of tension E A ε₀ per strip of width p; half yarns on the lines).
+fn prestress_membrane(m: &mut Model, p: &WovenParams, membrane: &MembraneProps) {
+    let s0 = p.pretension_per_width() / membrane.thickness;
+    let b = m
+        .elements
+        .get_mut(&ElementKind::Quad)
+        .expect("the coarse membrane");
+    b.stress0 = vec![[s0, s0, 0.0]; b.len()];
+}
+
+/// Every yarn node on the patch boundary (the yarn ends and the nodes of the yarns
+/// that run along it) is tied to the membrane edge it lies on; returns the tied nodes.
+fn tie_boundary(m: &mut Model, l: &Layout, y: &YarnNodes, coarse: &Coarse) -> Result<Vec<usize>> {
+    let c = l.c;
+    let on_boundary: Vec<usize> = y
+        .warp
         .iter()
-        .chain(weft.iter())
-        .chain(warp_end.iter())
-        .chain(weft_end.iter())
+        .chain(y.weft.iter())
+        .chain(y.warp_end.iter())
+        .chain(y.weft_end.iter())
         .copied()
         .filter(|&n| {
             let x = m.coords[n];
             (x[0].abs() - c).abs() < 1e-12 || (x[1].abs() - c).abs() < 1e-12
         })
         .collect();
-    let interface = tie_to_hole(&mut m, &coarse, &on_boundary)?;
-    hold_outer_edge(&mut m, &coarse, p.quarter, p.length);
+    tie_to_hole(m, coarse, &on_boundary)
+}
+
+/// The rigid projectile at the centre, its tip just above the crimp (a quarter of its
+/// mass in a quarter model).
+fn add_projectile(m: &mut Model, p: &WovenParams) {
     let share = if p.quarter { 0.25 } else { 1.0 };
     m.projectiles.push(ProjectileSpec {
         id: 1,
@@ -536,20 +724,6 @@ pub fn woven_reduced(p: &WovenParams) -> Result<Model> {
         friction: p.projectile_friction,
         segment_contact: true,
     });
-    m.node_sets.insert("reference".into(), warp.clone());
-    m.node_sets.insert("interface".into(), interface);
-    centre_line_sets(&mut m, &warp, c);
-    m.analysis = Analysis {
-        end_time: p.end_time,
-        output_interval: p.output_interval,
-        dt_safety: p.dt_safety,
-        ..Default::default()
-    };
-    m.validate()?;
-    if p.pretension_strain != 0.0 && p.pretension_start == PretensionStart::Relaxed {
-        relax_start(&mut m, p)?;
-    }
-    Ok(m)
 }
 
 /// The relaxed start: relax a copy of the model (no projectile, link sliders stuck) and
@@ -590,37 +764,7 @@ fn relax_start(m: &mut Model, p: &WovenParams) -> Result<()> {
         .expected("an equilibrium of the crimped crossings under the pretension")
         .hint("check --crimp and --k-z, or start with --pretension-start balanced"));
     }
-    // A unilateral link found pulling at the equilibrium would let go at the start.
-    if let Some(b) = m.block(ElementKind::Link) {
-        // The solver's three link families keep the table's order within each.
-        let el = &solver.op.el;
-        let (plain, framed, sliding) = (&el.link, &el.framed_link, &el.sliding_link);
-        let (mut ip, mut ifr, mut isl) = (0, 0, 0);
-        for e in 0..b.len() {
-            let props = &m.parts[b.part[e]].props;
-            let f = if props.sliding == Some(true) {
-                isl += 1;
-                sliding.normal_spring_force(isl - 1, &solver.state.x)
-            } else if props.local_frame == Some(true) {
-                ifr += 1;
-                framed.normal_spring_force(ifr - 1, &solver.state.x)
-            } else {
-                ip += 1;
-                plain.normal_spring_force(ip - 1, &solver.state.x)
-            };
-            if props.unilateral != Some(true) {
-                continue;
-            }
-            if f < -RELAX_FORCE_TOLERANCE * tension {
-                return Err(WeftError::input(format!(
-                    "unilateral link `{}` pulls its yarns together with {:.3e} N at the relaxed equilibrium",
-                    b.id[e], -f
-                ))
-                .expected("every unilateral link in compression at the pretensioned equilibrium")
-                .hint("a crossing whose yarns separate under the pretension: use two-way links, or --pretension-start balanced"));
-            }
-        }
-    }
+    check_unilateral_links(m, &solver, tension)?;
     m.initial_displacement = solver
         .state
         .x
@@ -629,4 +773,40 @@ fn relax_start(m: &mut Model, p: &WovenParams) -> Result<()> {
         .map(|(x, x0)| [x[0] - x0[0], x[1] - x0[1], x[2] - x0[2]])
         .collect();
     m.validate()
+}
+
+/// A unilateral link found pulling at the equilibrium would let go at the start.
+fn check_unilateral_links(m: &Model, solver: &crate::solver::Solver, tension: f64) -> Result<()> {
+    let Some(b) = m.block(ElementKind::Link) else {
+        return Ok(());
+    };
+    // The solver's three link families keep the table's order within each.
+    let el = &solver.op.el;
+    let (plain, framed, sliding) = (&el.link, &el.framed_link, &el.sliding_link);
+    let (mut ip, mut ifr, mut isl) = (0, 0, 0);
+    for e in 0..b.len() {
+        let props = &m.parts[b.part[e]].props;
+        let f = if props.sliding == Some(true) {
+            isl += 1;
+            sliding.normal_spring_force(isl - 1, &solver.state.x)
+        } else if props.local_frame == Some(true) {
+            ifr += 1;
+            framed.normal_spring_force(ifr - 1, &solver.state.x)
+        } else {
+            ip += 1;
+            plain.normal_spring_force(ip - 1, &solver.state.x)
+        };
+        if props.unilateral != Some(true) {
+            continue;
+        }
+        if f < -RELAX_FORCE_TOLERANCE * tension {
+            return Err(WeftError::input(format!(
+                "unilateral link `{}` pulls its yarns together with {:.3e} N at the relaxed equilibrium",
+                b.id[e], -f
+            ))
+            .expected("every unilateral link in compression at the pretensioned equilibrium")
+            .hint("a crossing whose yarns separate under the pretension: use two-way links, or --pretension-start balanced"));
+        }
+    }
+    Ok(())
 }
