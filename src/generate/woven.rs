@@ -35,6 +35,8 @@
 //! The yarns start stress-free in this geometric crimp; `weft-form` (`crate::form`) forms
 //! the weave by contact equilibrium under a residual tension.
 
+use std::collections::BTreeMap;
+
 use serde::Serialize;
 
 use crate::error::{Result, WeftError};
@@ -386,14 +388,105 @@ pub fn chain_touching_amplitude(t: f64, p: f64, per_spacing: usize) -> f64 {
 /// The yarn-level patch and what was derived.
 pub fn woven(p: &WovenBandParams) -> Result<(Model, WovenInfo)> {
     check(p)?;
-    let lens = Lenticular::new(p.width, p.thickness);
-    // Offsets across the band and the trapezoid area of the nodal profile.
-    let na = p.across;
-    let (offs, t_node, scale) = lens.band(na);
-    let t_centre = t_node[na / 2];
-    let chain = p.yarn_model == YarnModel::Chain;
+    let section = Section::new(p);
+    let amp = crimp_amplitude(p, &section)?;
+    // Layer pitch: a layer spans ±(a + t_c/2) about its mid-plane.
+    let pitch = 2.0 * amp + section.t_centre + p.layer_gap;
+    if p.layers > 1 && p.layer_gap <= 0.0 {
+        return Err(
+            WeftError::input("layers touch: --layer-gap is 0".to_string())
+                .expected("a gap > 0 between layers"),
+        );
+    }
+    let crimp = crimp_of(amp, p.spacing);
+    let weave = Weave::new(p, section, amp);
+    let mut m = Model::default();
+    let mut built = Built::new();
+    for layer in 0..p.layers {
+        add_layer(&mut m, &weave, layer, -(layer as f64) * pitch, &mut built);
+    }
+    add_contacts(&mut m, p, &weave.section, &built.parts);
+    if p.quarter {
+        for normal in [0, 1] {
+            m.symmetry.push(SymmetryPlane {
+                normal,
+                position: 0.0,
+                tolerance: 1e-9,
+            });
+        }
+    }
+    add_projectile(&mut m, p, &weave.section, built.top);
+    insert_sets(&mut m, built);
+    m.analysis = Analysis {
+        end_time: p.end_time,
+        output_interval: p.output_interval,
+        dt_safety: p.dt_safety,
+        history_sets: vec![
+            "axis_x".into(),
+            "axis_x_weft".into(),
+            "diagonal".into(),
+            "diagonal_weft".into(),
+        ],
+        ..Analysis::default()
+    };
+    let area = weave.section.lens.area();
+    let info = WovenInfo {
+        thickness_scale: weave.section.scale,
+        crimp_amplitude: amp,
+        crimp,
+        area,
+        areal_density: 2.0 * p.density * area * (1.0 + crimp) / p.spacing,
+        contact_thickness: weave.section.t_centre,
+    };
+    if let Some(s) = &p.surround {
+        surround(&mut m, p, s, &info)?;
+    }
+    m.validate()?;
+    Ok((m, info))
+}
+
+/// The band's cross-section as the mesh carries it.
+struct Section {
+    lens: Lenticular,
+    /// Quads across the width (`across`).
+    na: usize,
+    /// Offsets of the nodes across the band from its centre line, and their nodal
+    /// thicknesses scaled by `scale` = A/A_h (see [`Lenticular::band`]).
+    offs: Vec<f64>,
+    t_node: Vec<f64>,
+    scale: f64,
+    /// The (scaled) centre thickness t_c: the chains' contact thickness too.
+    t_centre: f64,
+    /// Truss chains instead of bands.
+    chain: bool,
+}
+
+impl Section {
+    fn new(p: &WovenBandParams) -> Section {
+        let lens = Lenticular::new(p.width, p.thickness);
+        // Offsets across the band and the trapezoid area of the nodal profile.
+        let na = p.across;
+        let (offs, t_node, scale) = lens.band(na);
+        let t_centre = t_node[na / 2];
+        Section {
+            lens,
+            na,
+            offs,
+            t_node,
+            scale,
+            t_centre,
+            chain: p.yarn_model == YarnModel::Chain,
+        }
+    }
+}
+
+/// The crimp amplitude a: the given one, which must be at least t_c/2, or by default the
+/// one at which crossing yarns just touch (bands: t_c/2 + 1 nm; chains:
+/// [`chain_touching_amplitude`]).
+fn crimp_amplitude(p: &WovenBandParams, s: &Section) -> Result<f64> {
+    let t_centre = s.t_centre;
     let amp = p.crimp_amplitude.unwrap_or_else(|| {
-        if chain {
+        if s.chain {
             chain_touching_amplitude(t_centre, p.spacing, p.per_spacing)
         } else {
             0.5 * t_centre + 1e-9
@@ -407,59 +500,125 @@ pub fn woven(p: &WovenBandParams) -> Result<(Model, WovenInfo)> {
         .expected("a ≥ t_c/2: crossing yarns would start inside each other")
         .hint("leave --crimp-amplitude out for yarns that just touch"));
     }
-    // Layer pitch: a layer spans ±(a + t_c/2) about its mid-plane.
-    let pitch = 2.0 * amp + t_centre + p.layer_gap;
-    if p.layers > 1 && p.layer_gap <= 0.0 {
-        return Err(
-            WeftError::input("layers touch: --layer-gap is 0".to_string())
-                .expected("a gap > 0 between layers"),
-        );
-    }
-    let k_c = std::f64::consts::PI * amp / p.spacing;
-    // Crimp of z = a cos(πx/p): ∫₀^p √(1 + k² sin²) dx / p − 1, by Simpson's rule.
-    let crimp = {
-        let n = 2000;
-        let f = |x: f64| (1.0 + (k_c * (std::f64::consts::PI * x).sin()).powi(2)).sqrt();
-        let s: f64 = (0..=n)
-            .map(|i| {
-                let w = if i == 0 || i == n {
-                    1.0
-                } else if i % 2 == 1 {
-                    4.0
-                } else {
-                    2.0
-                };
-                w * f(i as f64 / n as f64)
-            })
-            .sum();
-        s / (3.0 * n as f64) - 1.0
-    };
+    Ok(amp)
+}
 
-    let mut m = Model::default();
-    let (first, last) = if p.quarter {
-        (0i64, p.yarns as i64 - 1)
-    } else {
-        (-(p.yarns as i64) / 2, p.yarns as i64 / 2 - 1)
-    };
-    // Yarn centre lines at j·p (quarter) or (j + ½)·p (full, no yarn on x = 0).
-    let centre = |j: i64| {
-        if p.quarter {
-            j as f64 * p.spacing
+/// Crimp of z = a cos(πx/p): ∫₀^p √(1 + k² sin²) dx / p − 1, by Simpson's rule.
+fn crimp_of(amp: f64, spacing: f64) -> f64 {
+    let k_c = std::f64::consts::PI * amp / spacing;
+    let n = 2000;
+    let f = |x: f64| (1.0 + (k_c * (std::f64::consts::PI * x).sin()).powi(2)).sqrt();
+    let s: f64 = (0..=n)
+        .map(|i| {
+            let w = if i == 0 || i == n {
+                1.0
+            } else if i % 2 == 1 {
+                4.0
+            } else {
+                2.0
+            };
+            w * f(i as f64 / n as f64)
+        })
+        .sum();
+    s / (3.0 * n as f64) - 1.0
+}
+
+/// What every yarn is built from: the parameters, the band's section, the crimp
+/// amplitude, and where the yarns lie.
+struct Weave<'a> {
+    p: &'a WovenBandParams,
+    section: Section,
+    amp: f64,
+    /// The yarns' indices j = first … last of each family.
+    first: i64,
+    last: i64,
+    /// The yarns run from `lo` to `hi` along their length, in `n_along` elements.
+    lo: f64,
+    hi: f64,
+    n_along: usize,
+    /// Along-index of each crossing: the other family's yarn centre lines.
+    crossing_at: BTreeMap<usize, i64>,
+}
+
+impl<'a> Weave<'a> {
+    fn new(p: &'a WovenBandParams, section: Section, amp: f64) -> Weave<'a> {
+        let (first, last) = if p.quarter {
+            (0i64, p.yarns as i64 - 1)
         } else {
-            (j as f64 + 0.5) * p.spacing
+            (-(p.yarns as i64) / 2, p.yarns as i64 / 2 - 1)
+        };
+        let (lo, hi) = if p.quarter {
+            (0.0, (p.yarns as f64 - 0.5) * p.spacing)
+        } else {
+            (
+                -(p.yarns as f64) * 0.5 * p.spacing,
+                p.yarns as f64 * 0.5 * p.spacing,
+            )
+        };
+        let n_along = ((hi - lo) / p.spacing * p.per_spacing as f64).round() as usize;
+        let crossing_at = (first..=last)
+            .map(|jj| {
+                (
+                    ((yarn_centre(p, jj) - lo) / p.spacing * p.per_spacing as f64).round() as usize,
+                    jj,
+                )
+            })
+            .collect();
+        Weave {
+            p,
+            section,
+            amp,
+            first,
+            last,
+            lo,
+            hi,
+            n_along,
+            crossing_at,
         }
-    };
-    let sign = |j: i64| if j.rem_euclid(2) == 0 { 1.0 } else { -1.0 };
-    let (lo, hi) = if p.quarter {
-        (0.0, (p.yarns as f64 - 0.5) * p.spacing)
+    }
+
+    /// The centre line of yarn j (see [`yarn_centre`]).
+    fn centre(&self, j: i64) -> f64 {
+        yarn_centre(self.p, j)
+    }
+
+    /// The across-indices k0 ..= k1 of yarn j's nodes: all of a band's, the upper half of
+    /// a band on a symmetry plane, a chain's centre line.
+    fn across(&self, j: i64) -> (usize, usize) {
+        let (na, chain) = (self.section.na, self.section.chain);
+        // Across offsets: a yarn on a symmetry plane keeps its upper half.
+        let k0 = if chain || (self.p.quarter && j == 0) {
+            na / 2
+        } else {
+            0
+        };
+        let k1 = if chain { na / 2 } else { na };
+        (k0, k1)
+    }
+}
+
+/// Yarn centre lines at j·p (quarter) or (j + ½)·p (full, no yarn on x = 0).
+fn yarn_centre(p: &WovenBandParams, j: i64) -> f64 {
+    if p.quarter {
+        j as f64 * p.spacing
     } else {
-        (
-            -(p.yarns as f64) * 0.5 * p.spacing,
-            p.yarns as f64 * 0.5 * p.spacing,
-        )
-    };
-    let n_along = ((hi - lo) / p.spacing * p.per_spacing as f64).round() as usize;
-    let props = |angle: f64| PartProps {
+        (j as f64 + 0.5) * p.spacing
+    }
+}
+
+/// (−1)^j.
+fn sign(j: i64) -> f64 {
+    if j.rem_euclid(2) == 0 {
+        1.0
+    } else {
+        -1.0
+    }
+}
+
+/// The band quads' properties: orthotropic, the material axis at `angle` (0 for the
+/// warp, π/2 for the weft).
+fn band_props(p: &WovenBandParams, t_centre: f64, angle: f64) -> PartProps {
+    PartProps {
         youngs_modulus_1: Some(p.modulus),
         youngs_modulus_2: Some(p.transverse_modulus),
         shear_modulus_12: Some(p.shear_modulus),
@@ -473,191 +632,251 @@ pub fn woven(p: &WovenBandParams) -> Result<(Model, WovenInfo)> {
         // opt-in only.
         no_compression: Some(p.tension_field),
         ..Default::default()
-    };
-    // Chains: trusses of the band's exact section along its centre line (half of it
-    // for a yarn on a symmetry plane, which carries half a band).
-    let chain_props = PartProps {
+    }
+}
+
+/// Chains: trusses of the band's exact section along its centre line (half of it
+/// for a yarn on a symmetry plane, which carries half a band).
+fn chain_props(p: &WovenBandParams, lens: &Lenticular) -> PartProps {
+    PartProps {
         youngs_modulus: Some(p.modulus),
         density: Some(p.density),
         area: Some(lens.area()),
         tension_only: Some(p.tension_field),
         ..Default::default()
+    }
+}
+
+/// What the yarns leave besides their nodes and elements: each layer's (warp, weft)
+/// parts, the centre-line node sets of the first layer, the yarn-end nodes, the top of
+/// the fabric, and the last node and element ids.
+struct Built {
+    parts: Vec<(usize, usize)>,
+    axis_x: Vec<usize>,
+    axis_x_weft: Vec<usize>,
+    diagonal: Vec<usize>,
+    diagonal_weft: Vec<usize>,
+    edge_nodes: Vec<usize>,
+    top: f64,
+    nid: i64,
+    eid: i64,
+}
+
+impl Built {
+    fn new() -> Built {
+        Built {
+            parts: vec![],
+            axis_x: vec![],
+            axis_x_weft: vec![],
+            diagonal: vec![],
+            diagonal_weft: vec![],
+            edge_nodes: vec![],
+            top: f64::NEG_INFINITY,
+            nid: 0,
+            eid: 0,
+        }
+    }
+}
+
+/// One yarn: its family (0 warp along x, 1 weft along y), index j, part, layer and the
+/// layer's mid-plane height.
+#[derive(Clone, Copy)]
+struct Yarn {
+    fam: usize,
+    j: i64,
+    part: usize,
+    layer: usize,
+    zl: f64,
+}
+
+/// A layer at height `zl`: its warp and weft parts, then every warp yarn and every weft
+/// yarn.
+fn add_layer(m: &mut Model, w: &Weave, layer: usize, zl: f64, b: &mut Built) {
+    let p = w.p;
+    let (kind, warp_props, weft_props) = if w.section.chain {
+        let chain = chain_props(p, &w.section.lens);
+        (ElementKind::Truss, chain.clone(), chain)
+    } else {
+        (
+            ElementKind::Quad,
+            band_props(p, w.section.t_centre, 0.0),
+            band_props(p, w.section.t_centre, std::f64::consts::FRAC_PI_2),
+        )
     };
-    // Along-index of each crossing: the other family's yarn centre lines.
-    let crossing_at: std::collections::BTreeMap<usize, i64> = (first..=last)
-        .map(|jj| {
-            (
-                ((centre(jj) - lo) / p.spacing * p.per_spacing as f64).round() as usize,
-                jj,
-            )
-        })
-        .collect();
-    let (mut nid, mut eid) = (0i64, 0i64);
-    let mut parts = vec![];
-    let mut axis_x = vec![];
-    let mut axis_x_weft = vec![];
-    let mut diagonal = vec![];
-    let mut diagonal_weft = vec![];
-    let mut edge_nodes = vec![];
-    let mut top = f64::NEG_INFINITY;
-    for layer in 0..p.layers {
-        let zl = -(layer as f64) * pitch;
-        let (kind, warp_props, weft_props) = if chain {
-            (ElementKind::Truss, chain_props.clone(), chain_props.clone())
-        } else {
-            (
-                ElementKind::Quad,
-                props(0.0),
-                props(std::f64::consts::FRAC_PI_2),
-            )
-        };
-        let warp = m.add_part(
-            2 * layer as i64 + 1,
-            &format!("warp_{}", layer + 1),
-            kind,
-            warp_props,
-        );
-        let weft = m.add_part(
-            2 * layer as i64 + 2,
-            &format!("weft_{}", layer + 1),
-            kind,
-            weft_props,
-        );
-        parts.push((warp, weft));
-        for (fam, part) in [(0, warp), (1, weft)] {
-            for j in first..=last {
-                let c = centre(j);
-                // Across offsets: a yarn on a symmetry plane keeps its upper half.
-                let k0 = if chain || (p.quarter && j == 0) {
-                    na / 2
-                } else {
-                    0
-                };
-                let k1 = if chain { na / 2 } else { na };
-                let mut idx = vec![vec![usize::MAX; na + 1]; n_along + 1];
-                for i in 0..=n_along {
-                    let s = lo + (hi - lo) * i as f64 / n_along as f64;
-                    // Warp (fam 0) follows (−1)^j a cos(π(x − x₀)/p); weft
-                    // −(−1)^j a cos(π(y − x₀)/p), x₀ a yarn centre line (0 in the quarter,
-                    // p/2 in the full patch), so that the crests lie at the crossings.
-                    let z = zl
-                        + if fam == 0 { sign(j) } else { -sign(j) }
-                            * amp
-                            * (std::f64::consts::PI * (s - centre(0)) / p.spacing).cos();
-                    top = top.max(z + 0.5 * t_centre);
-                    for k in k0..=k1 {
-                        let r = c + offs[k];
-                        let x = if fam == 0 { [s, r, z] } else { [r, s, z] };
-                        nid += 1;
-                        let n = m.add_node(nid, x);
-                        idx[i][k] = n;
-                        let at_edge = (i == n_along) || (!p.quarter && i == 0);
-                        if at_edge {
-                            edge_nodes.push(n);
-                            let hold = match p.edge {
-                                Edge::Clamped => true,
-                                Edge::Pinned => k == na / 2,
-                                Edge::Free => false,
-                            };
-                            if hold {
-                                m.constraints.push((n, [true, true, true]));
-                            }
-                        }
-                    }
-                    // Crossing nodes: the centre-line node at each crossing position.
-                    if let Some(&other) = crossing_at.get(&i) {
-                        if layer == 0 {
-                            let n = idx[i][na / 2];
-                            // The x axis line: the warp j = 0 and the wefts where they cross it.
-                            if fam == 0 && j == 0 {
-                                axis_x.push(n);
-                            }
-                            if fam == 1 && other == 0 {
-                                axis_x_weft.push(n);
-                            }
-                            if other == j {
-                                if fam == 0 {
-                                    diagonal.push(n)
-                                } else {
-                                    diagonal_weft.push(n)
-                                }
-                            }
-                        }
-                    }
-                }
-                if chain {
-                    let half = p.quarter && j == 0;
-                    for i in 0..n_along {
-                        eid += 1;
-                        let ends = [idx[i][na / 2], idx[i + 1][na / 2]];
-                        if half {
-                            m.add_truss_with_area(eid, part, ends, 0.5 * lens.area());
-                        } else {
-                            m.add_element(eid, part, &ends);
-                        }
-                    }
-                    continue;
-                }
-                for i in 0..n_along {
-                    for k in k0..na {
-                        eid += 1;
-                        let q = if fam == 0 {
-                            [idx[i][k], idx[i + 1][k], idx[i + 1][k + 1], idx[i][k + 1]]
-                        } else {
-                            [idx[i][k], idx[i][k + 1], idx[i + 1][k + 1], idx[i + 1][k]]
-                        };
-                        let t = if fam == 0 {
-                            [t_node[k], t_node[k], t_node[k + 1], t_node[k + 1]]
-                        } else {
-                            [t_node[k], t_node[k + 1], t_node[k + 1], t_node[k]]
-                        };
-                        m.add_element_with_thickness(eid, part, &q, &t);
-                    }
-                }
+    let warp = m.add_part(
+        2 * layer as i64 + 1,
+        &format!("warp_{}", layer + 1),
+        kind,
+        warp_props,
+    );
+    let weft = m.add_part(
+        2 * layer as i64 + 2,
+        &format!("weft_{}", layer + 1),
+        kind,
+        weft_props,
+    );
+    b.parts.push((warp, weft));
+    for (fam, part) in [(0, warp), (1, weft)] {
+        for j in w.first..=w.last {
+            let yarn = Yarn {
+                fam,
+                j,
+                part,
+                layer,
+                zl,
+            };
+            let idx = add_yarn_nodes(m, w, yarn, b);
+            if w.section.chain {
+                add_chain_elements(m, w, yarn, &idx, b);
+            } else {
+                add_band_elements(m, w, yarn, &idx, b);
             }
         }
     }
-    // Contact: warp against weft in each layer, and every yarn of a layer against every
-    // yarn of the next; all two-way, with yarn–yarn friction.
+}
+
+/// A yarn's nodes, `idx[i][k]` at along-index i and across-index k (a chain's, and a band's
+/// on a symmetry plane, from k = na/2): the yarn ends held as `edge` says, the crossing
+/// nodes of the first layer gathered into the node sets.
+fn add_yarn_nodes(m: &mut Model, w: &Weave, y: Yarn, b: &mut Built) -> Vec<Vec<usize>> {
+    let (p, s) = (w.p, &w.section);
+    let (na, n_along, j) = (s.na, w.n_along, y.j);
+    let c = w.centre(j);
+    let (k0, k1) = w.across(j);
+    let mut idx = vec![vec![usize::MAX; na + 1]; n_along + 1];
+    for i in 0..=n_along {
+        let sa = w.lo + (w.hi - w.lo) * i as f64 / n_along as f64;
+        // Warp (fam 0) follows (−1)^j a cos(π(x − x₀)/p); weft
+        // −(−1)^j a cos(π(y − x₀)/p), x₀ a yarn centre line (0 in the quarter,
+        // p/2 in the full patch), so that the crests lie at the crossings.
+        let z = y.zl
+            + if y.fam == 0 { sign(j) } else { -sign(j) }
+                * w.amp
+                * (std::f64::consts::PI * (sa - w.centre(0)) / p.spacing).cos();
+        b.top = b.top.max(z + 0.5 * s.t_centre);
+        for k in k0..=k1 {
+            let r = c + s.offs[k];
+            let x = if y.fam == 0 { [sa, r, z] } else { [r, sa, z] };
+            b.nid += 1;
+            let n = m.add_node(b.nid, x);
+            idx[i][k] = n;
+            let at_edge = (i == n_along) || (!p.quarter && i == 0);
+            if at_edge {
+                b.edge_nodes.push(n);
+                let hold = match p.edge {
+                    Edge::Clamped => true,
+                    Edge::Pinned => k == na / 2,
+                    Edge::Free => false,
+                };
+                if hold {
+                    m.constraints.push((n, [true, true, true]));
+                }
+            }
+        }
+        // Crossing nodes: the centre-line node at each crossing position.
+        if let Some(&other) = w.crossing_at.get(&i) {
+            if y.layer == 0 {
+                gather_crossing(b, y, other, idx[i][na / 2]);
+            }
+        }
+    }
+    idx
+}
+
+/// The first layer's crossing node `n` of yarn `y`, where the yarn `other` of the other
+/// family crosses it, into the centre-line node sets.
+fn gather_crossing(b: &mut Built, y: Yarn, other: i64, n: usize) {
+    // The x axis line: the warp j = 0 and the wefts where they cross it.
+    if y.fam == 0 && y.j == 0 {
+        b.axis_x.push(n);
+    }
+    if y.fam == 1 && other == 0 {
+        b.axis_x_weft.push(n);
+    }
+    if other == y.j {
+        if y.fam == 0 {
+            b.diagonal.push(n)
+        } else {
+            b.diagonal_weft.push(n)
+        }
+    }
+}
+
+/// A chain's trusses along the centre-line nodes (half the section on a symmetry plane).
+fn add_chain_elements(m: &mut Model, w: &Weave, y: Yarn, idx: &[Vec<usize>], b: &mut Built) {
+    let na = w.section.na;
+    let half = w.p.quarter && y.j == 0;
+    for i in 0..w.n_along {
+        b.eid += 1;
+        let ends = [idx[i][na / 2], idx[i + 1][na / 2]];
+        if half {
+            m.add_truss_with_area(b.eid, y.part, ends, 0.5 * w.section.lens.area());
+        } else {
+            m.add_element(b.eid, y.part, &ends);
+        }
+    }
+}
+
+/// A band's quads with their nodal thicknesses.
+fn add_band_elements(m: &mut Model, w: &Weave, y: Yarn, idx: &[Vec<usize>], b: &mut Built) {
+    let (na, t_node) = (w.section.na, &w.section.t_node);
+    let (k0, _) = w.across(y.j);
+    for i in 0..w.n_along {
+        for k in k0..na {
+            b.eid += 1;
+            let q = if y.fam == 0 {
+                [idx[i][k], idx[i + 1][k], idx[i + 1][k + 1], idx[i][k + 1]]
+            } else {
+                [idx[i][k], idx[i][k + 1], idx[i + 1][k + 1], idx[i + 1][k]]
+            };
+            let t = if y.fam == 0 {
+                [t_node[k], t_node[k], t_node[k + 1], t_node[k + 1]]
+            } else {
+                [t_node[k], t_node[k + 1], t_node[k + 1], t_node[k]]
+            };
+            m.add_element_with_thickness(b.eid, y.part, &q, &t);
+        }
+    }
+}
+
+/// Contact: warp against weft in each layer, and every yarn of a layer against every
+/// yarn of the next; all two-way, with yarn–yarn friction.
+fn add_contacts(m: &mut Model, p: &WovenBandParams, s: &Section, parts: &[(usize, usize)]) {
     let mut cid = 0;
     let mut contact = |m: &mut Model, a: usize, b: usize| {
         cid += 1;
         let mut c = ContactDef::new(cid, Slave::Part(a), b).with_friction(p.friction);
         c.two_way = true;
-        if chain {
+        if s.chain {
             // The band's centre thickness: unformed crossings just touch, as the bands'.
-            c.slave_thickness = Some(t_centre);
-            c.master_thickness = Some(t_centre);
+            c.slave_thickness = Some(s.t_centre);
+            c.master_thickness = Some(s.t_centre);
         }
         m.contacts.push(c);
     };
     for l in 0..p.layers {
         let (w, f) = parts[l];
-        contact(&mut m, f, w);
+        contact(m, f, w);
         if l + 1 < p.layers {
             let (w2, f2) = parts[l + 1];
             for a in [w, f] {
                 for b in [w2, f2] {
-                    contact(&mut m, b, a);
+                    contact(m, b, a);
                 }
             }
         }
     }
-    if p.quarter {
-        for normal in [0, 1] {
-            m.symmetry.push(SymmetryPlane {
-                normal,
-                position: 0.0,
-                tolerance: 1e-9,
-            });
-        }
-    }
+}
+
+/// The projectile above the fabric's `top`, on the centre (a quarter of its mass in a
+/// quarter model).
+fn add_projectile(m: &mut Model, p: &WovenBandParams, s: &Section, top: f64) {
     let share = if p.quarter { 0.25 } else { 1.0 };
     // The projectile meets the chains' nodes, which carry no contact thickness of their
     // own: its nose grows by t_c/2 (the sum of the nose and a yarn's contact radius, the
     // Minkowski sum, so that it meets the yarns' surfaces where the bands' would), and
     // its tip sits t_c/2 lower (the same nose centre).
-    let grow = if chain { 0.5 * t_centre } else { 0.0 };
+    let grow = if s.chain { 0.5 * s.t_centre } else { 0.0 };
     m.projectiles.push(ProjectileSpec {
         id: 1,
         shape: p.projectile_shape,
@@ -670,40 +889,19 @@ pub fn woven(p: &WovenBandParams) -> Result<(Model, WovenInfo)> {
         prescribed_velocity: false,
         contact_stiffness: None,
         friction: p.projectile_friction,
-        segment_contact: !chain,
+        segment_contact: !s.chain,
     });
-    m.node_sets.insert("axis_x".into(), axis_x);
-    m.node_sets.insert("axis_x_weft".into(), axis_x_weft);
-    m.node_sets.insert("diagonal".into(), diagonal);
-    m.node_sets.insert("diagonal_weft".into(), diagonal_weft);
+}
+
+/// The node sets `axis_x`, `axis_x_weft`, `diagonal`, `diagonal_weft` and `edge`.
+fn insert_sets(m: &mut Model, b: Built) {
+    m.node_sets.insert("axis_x".into(), b.axis_x);
+    m.node_sets.insert("axis_x_weft".into(), b.axis_x_weft);
+    m.node_sets.insert("diagonal".into(), b.diagonal);
+    m.node_sets.insert("diagonal_weft".into(), b.diagonal_weft);
+    let mut edge_nodes = b.edge_nodes;
     edge_nodes.sort_unstable();
     m.node_sets.insert("edge".into(), edge_nodes);
-    m.analysis = Analysis {
-        end_time: p.end_time,
-        output_interval: p.output_interval,
-        dt_safety: p.dt_safety,
-        history_sets: vec![
-            "axis_x".into(),
-            "axis_x_weft".into(),
-            "diagonal".into(),
-            "diagonal_weft".into(),
-        ],
-        ..Analysis::default()
-    };
-    let area = lens.area();
-    let info = WovenInfo {
-        thickness_scale: scale,
-        crimp_amplitude: amp,
-        crimp,
-        area,
-        areal_density: 2.0 * p.density * area * (1.0 + crimp) / p.spacing,
-        contact_thickness: t_centre,
-    };
-    if let Some(s) = &p.surround {
-        surround(&mut m, p, s, &info)?;
-    }
-    m.validate()?;
-    Ok((m, info))
 }
 
 /// Ties the quarter patch's yarn ends into a graded membrane (see [`Surround`]).
