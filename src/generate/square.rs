@@ -32,7 +32,7 @@ pub enum LoadCase {
 }
 
 /// Common parameters of the square models.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Square {
     /// Side L [m].
     pub length: f64,
@@ -48,6 +48,22 @@ pub struct Square {
     pub end_time: Option<f64>,
     /// Output interval [s]; `None`: end time / 100.
     pub output_interval: Option<f64>,
+}
+
+impl Default for Square {
+    /// The paper's §4 square: L = 0.1 m, N = 10 cells per side, a tension of F = 100 N
+    /// (the times from the model's own material).
+    fn default() -> Self {
+        Square {
+            length: 0.1,
+            cells: 10,
+            load_case: LoadCase::Tension,
+            force: 100.0,
+            period: None,
+            end_time: None,
+            output_interval: None,
+        }
+    }
 }
 
 fn positive(name: &str, v: f64, unit: &str) -> Result<()> {
@@ -172,6 +188,23 @@ pub struct GirderParams {
     /// Rigid joints: hold the rotations of the clamped nodes too (a built-in edge). Off, the
     /// clamp holds translations only, like the membrane's clamp (which has no rotations).
     pub clamp_rotations: bool,
+}
+
+impl Default for GirderParams {
+    /// The paper's §4 steel girder on the default [`Square`]: E = 1.5·10¹¹ Pa,
+    /// ρ = 7800 kg/m³, b = h = L/(10N), rigid joints, a built-in clamp, half edge rods.
+    fn default() -> Self {
+        GirderParams {
+            square: Square::default(),
+            youngs_modulus: 1.5e11,
+            density: 7800.0,
+            rod_width: None,
+            rod_thickness: None,
+            rigid: true,
+            full_edge_rods: false,
+            clamp_rotations: true,
+        }
+    }
 }
 
 impl GirderParams {
@@ -365,6 +398,115 @@ impl MembraneParams {
     }
 }
 
+/// `membrane` as asked for (the flags of `weft-weave membrane`): the membrane's properties
+/// and the girder zone's left `None` follow from the others in [`MembraneOptions::resolve`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct MembraneOptions {
+    pub square: Square,
+    /// E = E₁ = E₂ [Pa] and ν₁₂.
+    pub youngs_modulus: f64,
+    pub poisson_ratio: f64,
+    /// G [Pa], s [m], ρ [kg/m³]; `None`: those of the closed-form equivalent of the
+    /// girder ([`MembraneParams::paper_default`], or with a girder zone
+    /// [`GirderZone::equivalent`] of the zone's girder).
+    pub shear_modulus: Option<f64>,
+    pub thickness: Option<f64>,
+    pub density: Option<f64>,
+    /// The paper's combined model (Fig. 5b): a girder zone at the centre of the square.
+    pub girder_zone: Option<GirderZoneOptions>,
+}
+
+impl Default for MembraneOptions {
+    /// [`MembraneParams::paper_default`] on the default [`Square`].
+    fn default() -> Self {
+        let d = MembraneParams::paper_default(Square::default());
+        MembraneOptions {
+            square: d.square,
+            youngs_modulus: d.youngs_modulus,
+            poisson_ratio: d.poisson_ratio,
+            shear_modulus: None,
+            thickness: None,
+            density: None,
+            girder_zone: None,
+        }
+    }
+}
+
+impl MembraneOptions {
+    /// The membrane's parameters: what is `None` taken from the closed-form equivalent of
+    /// the girder, the zone's girder where there is one (s = b²/a, ρ = ρ_g(2 − b/a),
+    /// G = E(b/a)²/2 with a = L/N_g), the paper's default girder otherwise.
+    pub fn resolve(&self) -> MembraneParams {
+        let mut d = MembraneParams::paper_default(self.square.clone());
+        let l = self.square.length;
+        let zone = self
+            .girder_zone
+            .as_ref()
+            .map(|z| z.resolve(l, self.youngs_modulus));
+        if let Some(z) = &zone {
+            (d.thickness, d.density, d.shear_modulus) = z.equivalent(l);
+        }
+        MembraneParams {
+            youngs_modulus: self.youngs_modulus,
+            poisson_ratio: self.poisson_ratio,
+            shear_modulus: self.shear_modulus.unwrap_or(d.shear_modulus),
+            thickness: self.thickness.unwrap_or(d.thickness),
+            density: self.density.unwrap_or(d.density),
+            girder_zone: zone,
+            ..d
+        }
+    }
+}
+
+/// The girder zone as asked for (`membrane --girder-cells` and the zone's flags); what is
+/// `None` follows from the square in [`GirderZoneOptions::resolve`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct GirderZoneOptions {
+    /// Girder cells per side of the whole square, N_g.
+    pub cells: usize,
+    /// Side of the zone L_m [m]; `None`: L/2.
+    pub length: Option<f64>,
+    /// The rods' E [Pa]; `None`: the membrane's.
+    pub youngs_modulus: Option<f64>,
+    /// The rods' ρ_g [kg/m³].
+    pub density: f64,
+    /// Rod width = thickness b [m]; `None`: L/(10 N_g).
+    pub rod_width: Option<f64>,
+    /// Rigid joints (beams) or pinned joints (trusses).
+    pub rigid: bool,
+}
+
+impl GirderZoneOptions {
+    /// A zone of N_g = `cells` girder cells per side, its rods the default girder's
+    /// ([`GirderParams::default`]: ρ_g, rigid joints), the rest following the square.
+    pub fn new(cells: usize) -> GirderZoneOptions {
+        let g = GirderParams::default();
+        GirderZoneOptions {
+            cells,
+            length: None,
+            youngs_modulus: None,
+            density: g.density,
+            rod_width: None,
+            rigid: g.rigid,
+        }
+    }
+
+    /// The zone in a square of side `length` whose membrane has the modulus
+    /// `youngs_modulus`.
+    pub fn resolve(&self, length: f64, youngs_modulus: f64) -> GirderZone {
+        GirderZone {
+            length: self.length.unwrap_or(0.5 * length),
+            cells: self.cells,
+            youngs_modulus: self.youngs_modulus.unwrap_or(youngs_modulus),
+            density: self.density,
+            rod_width: self
+                .rod_width
+                .unwrap_or(length / (10.0 * self.cells.max(1) as f64)),
+            rigid: self.rigid,
+        }
+    }
+}
+
 fn membrane_part(p: &MembraneParams) -> PartProps {
     PartProps {
         youngs_modulus_1: Some(p.youngs_modulus),
@@ -513,13 +655,15 @@ impl ZoneGrid {
         let z0 = 0.5 * (l - z.length);
         let (i0, i1) = match (grid_line(z0, am, l), grid_line(z0 + z.length, am, l)) {
             (Some(a), Some(b)) if a >= 1 && b < n => (a, b),
-            _ => return Err(WeftError::input(format!(
+            _ => {
+                return Err(WeftError::input(format!(
                 "the girder zone's edges at x, y = {z0:.6} and {:.6} m are not on the membrane's \
                      grid lines (multiples of L/N_m = {am} m, N_m = --cells = {n})",
                 z0 + z.length
             ))
-            .expected("(L − L_m)/2 a multiple of L/N_m")
-            .hint("with the default L_m = L/2, choose --cells a multiple of 4")),
+                .expected("(L − L_m)/2 a multiple of L/N_m")
+                .hint("with the default L_m = L/2, choose --cells a multiple of 4"))
+            }
         };
         let (g0, g1) = match (grid_line(z0, ag, l), grid_line(z0 + z.length, ag, l)) {
             (Some(a), Some(b)) => (a, b),

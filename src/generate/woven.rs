@@ -151,6 +151,14 @@ pub struct Surround {
     pub thickness: Option<f64>,
 }
 
+impl Default for Surround {
+    /// The paper's §3 ratios around the 60 × 60-yarn reference patch, out to 60 mm
+    /// ([`Surround::paper`]).
+    fn default() -> Self {
+        Surround::paper(0.06)
+    }
+}
+
 impl Surround {
     /// The paper's §3 ratios around a patch, out to `length`.
     pub fn paper(length: f64) -> Surround {

@@ -37,6 +37,13 @@ pub struct SurroundParams {
     pub thickness: Option<f64>,
 }
 
+impl Default for SurroundParams {
+    /// [`SurroundParams::paper`].
+    fn default() -> Self {
+        SurroundParams::paper()
+    }
+}
+
 impl SurroundParams {
     /// The paper's §3 ratios: 0.8, 0.3, 0.0042; ν = 0; s = 2A/p.
     pub fn paper() -> SurroundParams {
@@ -156,6 +163,13 @@ pub struct WovenParams {
     /// Safety factor on the stable step [–], 0 < f ≤ 1 (the model's `dt_safety`; 0.9 by
     /// default): the projectile's contact penalty is κ m*/Δt².
     pub dt_safety: f64,
+}
+
+impl Default for WovenParams {
+    /// [`WovenParams::paper`].
+    fn default() -> Self {
+        WovenParams::paper()
+    }
 }
 
 impl WovenParams {

@@ -53,6 +53,109 @@ pub struct CombinedParams {
     pub output_interval: f64,
 }
 
+/// `combined` as asked for (the flags of `weft-weave combined`): the values left `None`
+/// follow from the others in [`CombinedOptions::resolve`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct CombinedOptions {
+    pub centre: Centre,
+    /// Side of the dense centre zone L_m [m].
+    pub centre_length: f64,
+    /// Cells across the centre zone (even).
+    pub centre_cells: usize,
+    /// Side of the whole model L [m].
+    pub length: f64,
+    /// Coarse cell size at the centre, in centre cells.
+    pub coarsening: usize,
+    /// Growth ratio of the coarse cells.
+    pub growth: f64,
+    pub quarter: bool,
+    /// Girder: E [Pa] (also the membrane's) and ρ [kg/m³].
+    pub youngs_modulus: f64,
+    pub density: f64,
+    /// Girder rod width = thickness b [m]; `None`: a/10, a = L_m/(cells) the centre cell.
+    pub rod_width: Option<f64>,
+    /// Membrane shear modulus G [Pa], thickness s [m], density [kg/m³]; `None`: those of
+    /// the centre girder's closed-form equivalent, E(b/a)²/2, b²/a, ρ(2 − b/a).
+    pub shear_modulus: Option<f64>,
+    pub thickness: Option<f64>,
+    pub membrane_density: Option<f64>,
+    /// Transverse force at the centre [N] (the full model's).
+    pub force: f64,
+    /// Pulse duration T_F [s]; `None`: L_m·√(ρ/E).
+    pub pulse: Option<f64>,
+    /// End time [s]; `None`: L/2·√(ρ/E)·4.
+    pub end_time: Option<f64>,
+    /// Output interval [s]; `None`: end time / 100.
+    pub output_interval: Option<f64>,
+}
+
+impl Default for CombinedOptions {
+    /// A steel girder zone of 20 cells across 20 mm in a quarter of a 0.1 m square, the
+    /// coarse cells two centre cells wide at the zone and growing by 1.25, a 1 N force.
+    fn default() -> Self {
+        CombinedOptions {
+            centre: Centre::Girder,
+            centre_length: 0.02,
+            centre_cells: 20,
+            length: 0.1,
+            coarsening: 2,
+            growth: 1.25,
+            quarter: true,
+            youngs_modulus: 1.5e11,
+            density: 7800.0,
+            rod_width: None,
+            shear_modulus: None,
+            thickness: None,
+            membrane_density: None,
+            force: 1.0,
+            pulse: None,
+            end_time: None,
+            output_interval: None,
+        }
+    }
+}
+
+impl CombinedOptions {
+    /// The parameters, what is `None` derived: the rod width from the centre cell, the
+    /// membrane as the centre girder's closed-form equivalent (ν = 0), the pulse and the
+    /// times from the wave's transit.
+    pub fn resolve(&self) -> CombinedParams {
+        let cell = self.centre_length / self.centre_cells.max(1) as f64;
+        let b = self.rod_width.unwrap_or(cell / 10.0);
+        let c = self.length * 0.5 * (self.density / self.youngs_modulus).sqrt();
+        let end = self.end_time.unwrap_or(4.0 * c);
+        CombinedParams {
+            centre: self.centre,
+            centre_length: self.centre_length,
+            centre_cells: self.centre_cells,
+            length: self.length,
+            coarsening: self.coarsening,
+            growth: self.growth,
+            quarter: self.quarter,
+            youngs_modulus: self.youngs_modulus,
+            density: self.density,
+            rod_width: b,
+            membrane: MembraneProps {
+                youngs_modulus: self.youngs_modulus,
+                poisson_ratio: 0.0,
+                shear_modulus: self
+                    .shear_modulus
+                    .unwrap_or(self.youngs_modulus * (b / cell).powi(2) / 2.0),
+                thickness: self.thickness.unwrap_or(b * b / cell),
+                density: self
+                    .membrane_density
+                    .unwrap_or(self.density * (2.0 - b / cell)),
+            },
+            force: self.force,
+            pulse: self
+                .pulse
+                .unwrap_or(self.centre_length * (self.density / self.youngs_modulus).sqrt()),
+            end_time: end,
+            output_interval: self.output_interval.unwrap_or(end / 100.0),
+        }
+    }
+}
+
 pub fn combined(p: &CombinedParams) -> Result<Model> {
     if p.centre_cells == 0 || p.centre_cells % 2 != 0 {
         return Err(
