@@ -221,8 +221,9 @@ impl GirderParams {
 ///
 /// Each rod is a prism of b × h between joint centres; the b × b crossings would be
 /// counted twice, so the rods carry the density ρ(1 − b/(2a)), which gives the lattice's
-/// areal density ρ·b·h·(2 − b/a)/a exactly (DESIGN.md §8). Rods on the boundary stand for
-/// half a cell: half the modulus and half the density, unless `full_edge_rods`.
+/// areal density ρ·b·h·(2 − b/a)/a exactly (docs/theory.md, "Closed forms used as
+/// oracles"). Rods on the boundary stand for half a cell: half the modulus and half the
+/// density, unless `full_edge_rods`.
 pub fn girder(p: &GirderParams) -> Result<(Model, Vec<String>)> {
     positive("youngs-modulus", p.youngs_modulus, "in Pa")?;
     positive("density", p.density, "in kg/m³")?;
@@ -366,8 +367,9 @@ pub struct GirderZone {
 }
 
 impl GirderZone {
-    /// The membrane that is the closed-form equivalent of this zone's girder (DESIGN.md
-    /// §8, b = h, rigid joints): s = b²/a, ρ = ρ_g(2 − b/a), G = E(b/a)²/2, a = L/N_g.
+    /// The membrane that is the closed-form equivalent of this zone's girder
+    /// (docs/theory.md, "Closed forms used as oracles"; b = h, rigid joints): s = b²/a,
+    /// ρ = ρ_g(2 − b/a), G = E(b/a)²/2, a = L/N_g.
     pub fn equivalent(&self, length: f64) -> (f64, f64, f64) {
         let a = length / self.cells.max(1) as f64;
         let r = self.rod_width / a;
@@ -380,9 +382,9 @@ impl GirderZone {
 }
 
 impl MembraneParams {
-    /// The closed-form equivalent of a rigid-jointed girder with b = h = a/10 (DESIGN.md
-    /// §8): s = b²/a, ρ = ρ_g(2 − b/a), G = E(b/a)²/2, with E = 1.5·10¹¹ Pa,
-    /// ρ_g = 7800 kg/m³, L = 0.1 m, N = 10.
+    /// The closed-form equivalent of a rigid-jointed girder with b = h = a/10
+    /// (docs/theory.md, "Closed forms used as oracles"): s = b²/a, ρ = ρ_g(2 − b/a),
+    /// G = E(b/a)²/2, with E = 1.5·10¹¹ Pa, ρ_g = 7800 kg/m³, L = 0.1 m, N = 10.
     pub fn paper_default(square: Square) -> MembraneParams {
         let a = square.length / square.cells as f64;
         let r = 0.1;

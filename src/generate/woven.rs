@@ -72,7 +72,7 @@ pub enum YarnModel {
 }
 
 /// Parameters of the yarn-level patch; every default is a documented aramid plain weave
-/// (DESIGN.md §9, §12).
+/// (docs/theory.md, "Material data and defaults" and "The yarn-level woven patch").
 #[derive(Debug, Clone, Serialize)]
 pub struct WovenBandParams {
     /// Yarns per side: of the quarter (the middle yarn, on the symmetry plane, counted
@@ -80,7 +80,8 @@ pub struct WovenBandParams {
     pub yarns: usize,
     /// Quarter model with symmetry planes x = 0, y = 0.
     pub quarter: bool,
-    /// Yarn spacing p [m]: 1 mm, the reduced model's (10 yarns/cm; DESIGN §9: ≈ 8.5).
+    /// Yarn spacing p [m]: 1 mm, the reduced model's (10 yarns/cm; docs/theory.md,
+    /// "Material data and defaults": ≈ 8.5).
     pub spacing: f64,
     /// Yarn width w [m] and thickness h [m]: 0.8 mm × 0.124 mm, a lenticular area of
     /// 6.6·10⁻⁸ m², the reduced model's yarn area (190 g/m² with p = 1 mm).
@@ -100,7 +101,7 @@ pub struct WovenBandParams {
     pub transverse_modulus: f64,
     pub shear_modulus: f64,
     pub density: f64,
-    /// Yarn–yarn Coulomb friction (DESIGN §9: 0.1–0.2).
+    /// Yarn–yarn Coulomb friction (docs/theory.md, "Material data and defaults": 0.1–0.2).
     pub friction: f64,
     /// Yarns carry no compressive stress (tension field).
     pub tension_field: bool,
@@ -108,8 +109,8 @@ pub struct WovenBandParams {
     pub layers: usize,
     pub layer_gap: f64,
     pub edge: Edge,
-    /// Projectile: 9 mm, 8 g, round-nosed at 400 m/s (DESIGN §9: 360–430 m/s); friction
-    /// against the yarns.
+    /// Projectile: 9 mm, 8 g, round-nosed at 400 m/s (docs/theory.md, "Material data and
+    /// defaults": 360–430 m/s); friction against the yarns.
     pub projectile_shape: ProjectileShape,
     pub projectile_radius: f64,
     pub projectile_mass: f64,

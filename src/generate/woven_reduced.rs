@@ -173,11 +173,12 @@ impl Default for WovenParams {
 }
 
 impl WovenParams {
-    /// The paper's §5 model (DESIGN.md §1, §9): aramid yarns 1 mm apart (E = 80 GPa,
-    /// ρ = 1440 kg/m³, 190 g/m² together: A = 6.6·10⁻⁸ m² per yarn), links at the fitted
-    /// k_x = k_y = 3.8661·10⁶ N/m, k_z = 5.2448·10⁹ N/m (the paper's N/mm values, its
-    /// exponents corrected), a 9 mm, 8 g flat-nosed projectile at 400 m/s; the equivalent
-    /// membrane from the paper's §3 ratios ([`SurroundParams::paper`]).
+    /// The paper's §5 model (docs/theory.md, "The paper's studies" and "Material data and
+    /// defaults"): aramid yarns 1 mm apart (E = 80 GPa, ρ = 1440 kg/m³, 190 g/m²
+    /// together: A = 6.6·10⁻⁸ m² per yarn), links at the fitted k_x = k_y = 3.8661·10⁶ N/m,
+    /// k_z = 5.2448·10⁹ N/m (the paper's N/mm values, its exponents corrected), a 9 mm, 8 g
+    /// flat-nosed projectile at 400 m/s; the equivalent membrane from the paper's §3
+    /// ratios ([`SurroundParams::paper`]).
     pub fn paper() -> WovenParams {
         WovenParams {
             yarns: 20,
