@@ -15,9 +15,8 @@ use weft::generate::square::{
 };
 use weft::generate::weave::{self, Spec};
 use weft::generate::woven::{Edge, Surround, WovenBandParams, YarnModel};
-use weft::generate::zones::{
-    Centre, CombinedOptions, Interface, PretensionStart, SurroundParams, WovenParams,
-};
+use weft::generate::woven_reduced::{Interface, PretensionStart, SurroundParams, WovenParams};
+use weft::generate::zones::{Centre, CombinedOptions};
 use weft::model::ProjectileShape;
 
 /// Axes of the reduced model's links.
