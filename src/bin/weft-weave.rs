@@ -1,16 +1,23 @@
 //! `weft-weave`: generate canonical models as folders of Parquet tables.
+//!
+//! Each subcommand's flags take their defaults from its generator's parameters
+//! (`Default`) and map onto those parameters in one conversion (`params`, or `options`
+//! where the library derives what a flag left out implies, `resolve`); `run` dispatches.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
 use weft::generate::rod::RodParams;
-use weft::generate::square::{GirderParams, GirderZone, LoadCase, MembraneParams, Square};
-use weft::generate::weave::{self, Spec};
-use weft::generate::zones::{
-    Centre, CombinedParams, Interface, MembraneProps, PretensionStart, SurroundParams, WovenParams,
+use weft::generate::square::{
+    GirderParams, GirderZoneOptions, LoadCase, MembraneOptions, MembraneParams, Square,
 };
+use weft::generate::weave::{self, Spec};
+use weft::generate::woven::{Edge, Surround, WovenBandParams, YarnModel};
+use weft::generate::woven_reduced::{Interface, PretensionStart, SurroundParams, WovenParams};
+use weft::generate::zones::{Centre, CombinedOptions};
+use weft::model::ProjectileShape;
 
 /// Axes of the reduced model's links.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -23,7 +30,17 @@ enum LinkAxes {
     /// the link slips (the yarns slide across each other).
     Sliding,
 }
-use weft::model::ProjectileShape;
+
+impl LinkAxes {
+    /// The axes of `p`'s links.
+    fn of(p: &WovenParams) -> LinkAxes {
+        match (p.local_frame, p.sliding) {
+            (_, true) => LinkAxes::Sliding,
+            (true, false) => LinkAxes::Local,
+            (false, false) => LinkAxes::Global,
+        }
+    }
+}
 
 #[derive(Parser)]
 #[command(
@@ -77,28 +94,28 @@ struct WovenBandArgs {
     /// Yarns per side: of the quarter (the middle yarn counted once) or, with --full, of
     /// the whole patch (even). 60: the paper's 120 × 120 reference; a small patch alone
     /// at 400 m/s, without yarn failure, strains beyond validity within microseconds.
-    #[arg(long, default_value_t = 60)]
+    #[arg(long, default_value_t = WovenBandParams::default().yarns)]
     yarns: usize,
     /// The whole patch instead of the quarter.
     #[arg(long)]
     full: bool,
     /// Yarn spacing p [m].
-    #[arg(long, default_value_t = 1e-3)]
+    #[arg(long, default_value_t = WovenBandParams::default().spacing)]
     spacing: f64,
     /// Yarn width w [m].
-    #[arg(long, default_value_t = 0.8e-3)]
+    #[arg(long, default_value_t = WovenBandParams::default().width)]
     width: f64,
     /// Yarn thickness h [m] (lenticular section: area ≈ (2/3)wh).
-    #[arg(long, default_value_t = 0.124e-3)]
+    #[arg(long, default_value_t = WovenBandParams::default().thickness)]
     thickness: f64,
     /// Crimp amplitude a [m] (default: crossing yarns just touch).
     #[arg(long)]
     crimp_amplitude: Option<f64>,
     /// Quads per spacing along a yarn (even, ≥ 4).
-    #[arg(long, default_value_t = 4)]
+    #[arg(long, default_value_t = WovenBandParams::default().per_spacing)]
     per_spacing: usize,
     /// Quads across a yarn's width (even, ≥ 2).
-    #[arg(long, default_value_t = 2)]
+    #[arg(long, default_value_t = WovenBandParams::default().across)]
     across: usize,
     /// How each yarn is modelled: `band`, the paper's reference (orthotropic membrane
     /// quads across the width, contact on the lenticular band faces), or `chain`, trusses
@@ -106,37 +123,37 @@ struct WovenBandArgs {
     /// thickness as contact thickness (no width: 4–6 × faster; the yarn on a symmetry
     /// plane has half the section; the projectile's nose grows by half that thickness,
     /// its tip as much lower, so that it meets the yarns' surfaces).
-    #[arg(long, value_enum, default_value_t = weft::generate::woven::YarnModel::Band)]
-    yarn_model: weft::generate::woven::YarnModel,
+    #[arg(long, value_enum, default_value_t = WovenBandParams::default().yarn_model)]
+    yarn_model: YarnModel,
     /// Yarn Young's modulus along the yarn [Pa] (aramid, Kevlar 29 class).
-    #[arg(long, default_value_t = 80e9)]
+    #[arg(long, default_value_t = WovenBandParams::default().modulus)]
     modulus: f64,
     /// Yarn modulus across its width [Pa] (a bundle of filaments: small).
-    #[arg(long, default_value_t = 1.6e9)]
+    #[arg(long, default_value_t = WovenBandParams::default().transverse_modulus)]
     transverse_modulus: f64,
     /// Yarn in-plane shear modulus [Pa].
-    #[arg(long, default_value_t = 0.8e9)]
+    #[arg(long, default_value_t = WovenBandParams::default().shear_modulus)]
     shear_modulus: f64,
     /// Yarn density [kg/m³].
-    #[arg(long, default_value_t = 1440.0)]
+    #[arg(long, default_value_t = WovenBandParams::default().density)]
     density: f64,
     /// Yarn–yarn Coulomb friction coefficient.
-    #[arg(long, default_value_t = 0.15)]
+    #[arg(long, default_value_t = WovenBandParams::default().friction)]
     friction: f64,
     /// Yarns carry no compression (tension field; its stress has no potential, so the
     /// energy balance drifts where the yarns are crushed).
     #[arg(long)]
     tension_field: bool,
     /// Fabric layers.
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = WovenBandParams::default().layers)]
     layers: usize,
     /// Clearance between layers [m].
-    #[arg(long, default_value_t = 0.01e-3)]
+    #[arg(long, default_value_t = WovenBandParams::default().layer_gap)]
     layer_gap: f64,
     /// Yarn ends at the patch edge: clamped (all nodes held), pinned (centre-line node
     /// held) or free. Ignored with --membrane-length (the ends are tied).
-    #[arg(long, value_enum, default_value_t = weft::generate::woven::Edge::Clamped)]
-    edge: weft::generate::woven::Edge,
+    #[arg(long, value_enum, default_value_t = WovenBandParams::default().edge)]
+    edge: Edge,
     /// The paper's §3 combined model: tie the quarter patch's yarn ends to a graded
     /// orthotropic membrane around it, out to this half-size [m] (e.g. 0.06, the
     /// 60 × 60-yarn reference's), clamped at its outer edge. Adds the node sets
@@ -144,46 +161,46 @@ struct WovenBandArgs {
     #[arg(long)]
     membrane_length: Option<f64>,
     /// Growth ratio of the membrane's cells (p/2 at the patch) outwards.
-    #[arg(long, default_value_t = 1.2)]
+    #[arg(long, default_value_t = Surround::default().growth)]
     membrane_growth: f64,
     /// Membrane areal density / the patch's (the paper's §3: 0.8).
-    #[arg(long, default_value_t = 0.8)]
+    #[arg(long, default_value_t = Surround::default().density_ratio)]
     membrane_density_ratio: f64,
     /// Membrane E₁ = E₂ / the yarns' E (the paper's §3: 0.3).
-    #[arg(long, default_value_t = 0.3)]
+    #[arg(long, default_value_t = Surround::default().modulus_ratio)]
     membrane_modulus_ratio: f64,
     /// Membrane G₁₂ / its E (the paper's §3: 0.0042).
-    #[arg(long, default_value_t = 0.0042)]
+    #[arg(long, default_value_t = Surround::default().shear_ratio)]
     membrane_shear_ratio: f64,
     /// Membrane thickness [m] (an assumption; default 2A/p per layer, the yarns' section
     /// per unit width of both families).
     #[arg(long)]
     membrane_thickness: Option<f64>,
     /// Projectile nose shape.
-    #[arg(long, value_enum, default_value_t = weft::model::ProjectileShape::Round)]
-    projectile_shape: weft::model::ProjectileShape,
+    #[arg(long, value_enum, default_value_t = WovenBandParams::default().projectile_shape)]
+    projectile_shape: ProjectileShape,
     /// Projectile radius [m].
-    #[arg(long, default_value_t = 4.5e-3)]
+    #[arg(long, default_value_t = WovenBandParams::default().projectile_radius)]
     projectile_radius: f64,
     /// Projectile mass [kg] (of the whole projectile; a quarter model carries a quarter).
-    #[arg(long, default_value_t = 8e-3)]
+    #[arg(long, default_value_t = WovenBandParams::default().projectile_mass)]
     projectile_mass: f64,
     /// Impact velocity [m/s].
-    #[arg(long, default_value_t = 400.0)]
+    #[arg(long, default_value_t = WovenBandParams::default().projectile_velocity)]
     projectile_velocity: f64,
     /// Projectile–yarn friction coefficient.
-    #[arg(long, default_value_t = 0.1)]
+    #[arg(long, default_value_t = WovenBandParams::default().projectile_friction)]
     projectile_friction: f64,
     /// Simulated time [s].
-    #[arg(long, default_value_t = 6e-5)]
+    #[arg(long, default_value_t = WovenBandParams::default().end_time)]
     end_time: f64,
     /// Output interval [s].
-    #[arg(long, default_value_t = 1e-6)]
+    #[arg(long, default_value_t = WovenBandParams::default().output_interval)]
     output_interval: f64,
     /// Safety factor on the stable time step, 0 < f ≤ 1 (analysis.parquet). The step is
     /// set from the undeformed bands; yarns under the nose, which do not fail, stretch
     /// towards 20 % Green strain by 60 µs and stiffen: 0.8 keeps such runs stable.
-    #[arg(long, default_value_t = 0.9)]
+    #[arg(long, default_value_t = WovenBandParams::default().dt_safety)]
     dt_safety: f64,
 }
 
@@ -193,31 +210,31 @@ struct CombinedArgs {
     #[arg(long)]
     out: PathBuf,
     /// Dense centre zone: girder or membrane.
-    #[arg(long, value_enum, default_value_t = Centre::Girder)]
+    #[arg(long, value_enum, default_value_t = CombinedOptions::default().centre)]
     centre: Centre,
     /// Side of the centre zone L_m [m].
-    #[arg(long, default_value_t = 0.02)]
+    #[arg(long, default_value_t = CombinedOptions::default().centre_length)]
     centre_length: f64,
     /// Cells across the centre zone (even).
-    #[arg(long, default_value_t = 20)]
+    #[arg(long, default_value_t = CombinedOptions::default().centre_cells)]
     centre_cells: usize,
     /// Side of the whole model L [m].
-    #[arg(long, default_value_t = 0.1)]
+    #[arg(long, default_value_t = CombinedOptions::default().length)]
     length: f64,
     /// Coarse cell size at the centre zone, in centre cells (divides centre-cells/2).
-    #[arg(long, default_value_t = 2)]
+    #[arg(long, default_value_t = CombinedOptions::default().coarsening)]
     coarsening: usize,
     /// Growth ratio of the coarse cells away from the centre.
-    #[arg(long, default_value_t = 1.25)]
+    #[arg(long, default_value_t = CombinedOptions::default().growth)]
     growth: f64,
     /// Full model instead of the quarter with symmetry planes x = 0, y = 0.
     #[arg(long)]
     full: bool,
     /// Girder Young's modulus E [Pa] (also the membrane's).
-    #[arg(long, default_value_t = 1.5e11)]
+    #[arg(long, default_value_t = CombinedOptions::default().youngs_modulus)]
     youngs_modulus: f64,
     /// Girder density ρ [kg/m³].
-    #[arg(long, default_value_t = 7800.0)]
+    #[arg(long, default_value_t = CombinedOptions::default().density)]
     density: f64,
     /// Girder rod width = thickness b [m] [default: cell size / 10].
     #[arg(long)]
@@ -235,7 +252,7 @@ struct CombinedArgs {
     /// default keeps the girder's local rotations small, where the beam element is exact
     /// to its energy (at 100 N the 0.1 mm rods turn by ~1 rad per cell and the energy
     /// balance degrades to 1.6 %).
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, default_value_t = CombinedOptions::default().force)]
     force: f64,
     /// Pulse duration T_F [s] [default: L_m·√(ρ/E)].
     #[arg(long)]
@@ -254,26 +271,26 @@ struct WovenArgs {
     #[arg(long)]
     out: PathBuf,
     /// Yarns per side of the full patch (even).
-    #[arg(long, default_value_t = 20)]
+    #[arg(long, default_value_t = WovenParams::default().yarns)]
     yarns: usize,
     /// Yarn spacing p [m].
-    #[arg(long, default_value_t = 1e-3)]
+    #[arg(long, default_value_t = WovenParams::default().spacing)]
     spacing: f64,
     /// Yarn Young's modulus [Pa] (aramid).
-    #[arg(long, default_value_t = 80e9)]
+    #[arg(long, default_value_t = WovenParams::default().yarn_modulus)]
     yarn_modulus: f64,
     /// Yarn density [kg/m³].
-    #[arg(long, default_value_t = 1440.0)]
+    #[arg(long, default_value_t = WovenParams::default().yarn_density)]
     yarn_density: f64,
     /// Yarn cross-section area [m²] (190 g/m² fabric at 1 mm spacing).
-    #[arg(long, default_value_t = 6.6e-8)]
+    #[arg(long, default_value_t = WovenParams::default().yarn_area)]
     yarn_area: f64,
     /// Let yarns carry compression too.
     #[arg(long)]
     compressible_yarns: bool,
     /// Yarn pretension as an initial strain ε₀ [–] (the yarns start with the force E·A·ε₀;
     /// see --pretension-start).
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(long, default_value_t = WovenParams::default().pretension_strain)]
     pretension_strain: f64,
     /// How a pretensioned model starts: `balanced` (the membrane around carries the same
     /// tension per width, N = E·A·ε₀/p, as an initial stress N/s: in equilibrium at t = 0
@@ -281,22 +298,22 @@ struct WovenArgs {
     /// dynamic relaxation and written as initial displacements: for --crimp > 0) or
     /// `unbalanced` (only the yarns pre-strained: the membrane is pulled in and rings;
     /// the behaviour before the fix).
-    #[arg(long, value_enum, default_value_t = PretensionStart::Balanced)]
+    #[arg(long, value_enum, default_value_t = WovenParams::default().pretension_start)]
     pretension_start: PretensionStart,
     /// Crimp: z offset of warp and weft at the crossings, ± [m].
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(long, default_value_t = WovenParams::default().crimp)]
     crimp: f64,
     /// Link stiffness k_x = k_y [N/m] (the paper's fitted 3.8661·10³ N/mm).
-    #[arg(long, default_value_t = 3.8661e6)]
+    #[arg(long, default_value_t = WovenParams::default().k_xy)]
     k_xy: f64,
     /// Link stiffness k_z [N/m] (the paper's fitted 5.2448·10⁶ N/mm).
-    #[arg(long, default_value_t = 5.2448e9)]
+    #[arg(long, default_value_t = WovenParams::default().k_z)]
     k_z: f64,
     /// Link dashpots c_x = c_y [N·s/m].
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(long, default_value_t = WovenParams::default().c_xy)]
     c_xy: f64,
     /// Link dashpot c_z [N·s/m].
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(long, default_value_t = WovenParams::default().c_z)]
     c_z: f64,
     /// Link friction slider: tangential slip force [N] [default: none].
     #[arg(long)]
@@ -314,67 +331,67 @@ struct WovenArgs {
     /// (local, and the link's ends are points of the yarns that move along them when the
     /// link slips: the yarns slide across each other; give --link-friction or
     /// --slip-force).
-    #[arg(long, value_enum, default_value_t = LinkAxes::Global)]
+    #[arg(long, value_enum, default_value_t = LinkAxes::of(&WovenParams::default()))]
     link_axes: LinkAxes,
     /// Membrane surround: its surface density over the woven patch's 2ρA/p [–] (the
     /// paper's §3: 0.8).
-    #[arg(long, default_value_t = 0.8)]
+    #[arg(long, default_value_t = WovenParams::default().surround.density_ratio)]
     membrane_density_ratio: f64,
     /// Membrane surround: its Young's modulus over the yarn's [–] (the paper's §3: 0.3).
-    #[arg(long, default_value_t = 0.3)]
+    #[arg(long, default_value_t = WovenParams::default().surround.modulus_ratio)]
     membrane_modulus_ratio: f64,
     /// Membrane surround: its shear modulus over its Young's modulus [–] (the paper's §3:
     /// 0.0042).
-    #[arg(long, default_value_t = 0.0042)]
+    #[arg(long, default_value_t = WovenParams::default().surround.shear_ratio)]
     membrane_shear_ratio: f64,
     /// Membrane surround: Poisson's ratio ν [–].
-    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = WovenParams::default().surround.poisson_ratio, allow_hyphen_values = true)]
     membrane_poisson: f64,
     /// Membrane surround: thickness s [m] (its density follows: ratio × 2ρA/p / s)
     /// [default: 2A/p].
     #[arg(long)]
     membrane_thickness: Option<f64>,
     /// Side of the whole model [m].
-    #[arg(long, default_value_t = 0.1)]
+    #[arg(long, default_value_t = WovenParams::default().length)]
     length: f64,
     /// Growth ratio of the membrane cells away from the patch.
-    #[arg(long, default_value_t = 1.25)]
+    #[arg(long, default_value_t = WovenParams::default().growth)]
     growth: f64,
     /// Where the patch meets the membrane: `crossing` (on the last crossing line x = np,
     /// whose yarns are halved) or `band-ends` (as `woven --membrane-length`: the last
     /// crossing line a full yarn, the rods running on to the membrane at (n + ½)p; quarter
     /// only; for comparing with the yarn-level patch).
-    #[arg(long, value_enum, default_value_t = Interface::Crossing)]
+    #[arg(long, value_enum, default_value_t = WovenParams::default().interface)]
     interface: Interface,
     /// Full model instead of the quarter.
     #[arg(long)]
     full: bool,
     /// Projectile nose: flat, round or sphere.
-    #[arg(long, value_enum, default_value_t = ProjectileShape::Flat)]
+    #[arg(long, value_enum, default_value_t = WovenParams::default().projectile_shape)]
     projectile_shape: ProjectileShape,
     /// Projectile radius [m] (9 mm calibre).
-    #[arg(long, default_value_t = 4.5e-3)]
+    #[arg(long, default_value_t = WovenParams::default().projectile_radius)]
     projectile_radius: f64,
     /// Projectile mass [kg] (a quarter model carries a quarter).
-    #[arg(long, default_value_t = 8e-3)]
+    #[arg(long, default_value_t = WovenParams::default().projectile_mass)]
     projectile_mass: f64,
     /// Impact velocity [m/s].
-    #[arg(long, default_value_t = 400.0)]
+    #[arg(long, default_value_t = WovenParams::default().projectile_velocity)]
     projectile_velocity: f64,
     /// Projectile–yarn Coulomb friction coefficient (the yarn-level `woven` patch's
     /// default is 0.1).
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(long, default_value_t = WovenParams::default().projectile_friction)]
     projectile_friction: f64,
     /// Simulated time [s].
-    #[arg(long, default_value_t = 5e-5)]
+    #[arg(long, default_value_t = WovenParams::default().end_time)]
     end_time: f64,
     /// Output interval [s].
-    #[arg(long, default_value_t = 1e-6)]
+    #[arg(long, default_value_t = WovenParams::default().output_interval)]
     output_interval: f64,
     /// Safety factor on the stable time step, 0 < f ≤ 1 (written to the model's
     /// analysis.parquet; the projectile's contact penalty κ m/Δt² stiffens with a shorter
     /// step).
-    #[arg(long, default_value_t = 0.9)]
+    #[arg(long, default_value_t = WovenParams::default().dt_safety)]
     dt_safety: f64,
 }
 
@@ -384,16 +401,16 @@ struct SquareArgs {
     #[arg(long)]
     out: PathBuf,
     /// Side length L [m].
-    #[arg(long, default_value_t = 0.1)]
+    #[arg(long, default_value_t = Square::default().length)]
     length: f64,
     /// Cells per side N.
-    #[arg(long, default_value_t = 10)]
+    #[arg(long, default_value_t = Square::default().cells)]
     cells: usize,
     /// Load case: tension (+x on the edge x = L), shear (+y on x = L), transverse (+z at the centre).
-    #[arg(long, value_enum, default_value_t = LoadCase::Tension)]
+    #[arg(long, value_enum, default_value_t = Square::default().load_case)]
     load_case: LoadCase,
     /// Total force F [N] (the pulse amplitude; a static solve uses it as the load).
-    #[arg(long, default_value_t = 100.0)]
+    #[arg(long, default_value_t = Square::default().force)]
     force: f64,
     /// Time scale T [s]: pulse duration T/2, default end time T [default: L·√(ρ/E) of this model's material].
     #[arg(long)]
@@ -420,10 +437,22 @@ impl SquareArgs {
     }
 }
 
+/// Joints of a girder's rods.
 #[derive(Clone, Copy, PartialEq, clap::ValueEnum)]
 enum Joints {
     Rigid,
     Pinned,
+}
+
+impl Joints {
+    /// `Rigid` for rigid joints, `Pinned` otherwise.
+    fn of(rigid: bool) -> Joints {
+        if rigid {
+            Joints::Rigid
+        } else {
+            Joints::Pinned
+        }
+    }
 }
 
 #[derive(clap::Args)]
@@ -431,10 +460,10 @@ struct GirderArgs {
     #[command(flatten)]
     square: SquareArgs,
     /// Young's modulus E [Pa].
-    #[arg(long, default_value_t = 1.5e11)]
+    #[arg(long, default_value_t = GirderParams::default().youngs_modulus)]
     youngs_modulus: f64,
     /// Density ρ [kg/m³].
-    #[arg(long, default_value_t = 7800.0)]
+    #[arg(long, default_value_t = GirderParams::default().density)]
     density: f64,
     /// Rod width b, in the plane [m] [default: L/(10N); the paper's range is L/(20N) … L/(8N)].
     #[arg(long)]
@@ -443,7 +472,7 @@ struct GirderArgs {
     #[arg(long)]
     rod_thickness: Option<f64>,
     /// Joints: rigid (beams, shear stiffness E·h·b³/(2a³)) or pinned (trusses, none).
-    #[arg(long, value_enum, default_value_t = Joints::Rigid)]
+    #[arg(long, value_enum, default_value_t = Joints::of(GirderParams::default().rigid))]
     joints: Joints,
     /// Give the boundary rods full properties [default: half the modulus and density, as
     /// half a cell of the lattice, so that the girder matches its equivalent membrane of side L].
@@ -451,14 +480,26 @@ struct GirderArgs {
     full_edge_rods: bool,
     /// Clamp at x = 0: `built-in` holds translations and rotations; `translations` holds the
     /// translations only, as the membrane's clamp does.
-    #[arg(long, value_enum, default_value_t = Clamp::BuiltIn)]
+    #[arg(long, value_enum, default_value_t = Clamp::of(GirderParams::default().clamp_rotations))]
     clamp: Clamp,
 }
 
+/// The girder's clamp at x = 0.
 #[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 enum Clamp {
     BuiltIn,
     Translations,
+}
+
+impl Clamp {
+    /// `BuiltIn` where the clamp holds the rotations too, `Translations` otherwise.
+    fn of(clamp_rotations: bool) -> Clamp {
+        if clamp_rotations {
+            Clamp::BuiltIn
+        } else {
+            Clamp::Translations
+        }
+    }
 }
 
 #[derive(clap::Args)]
@@ -466,10 +507,10 @@ struct MembraneArgs {
     #[command(flatten)]
     square: SquareArgs,
     /// Young's modulus E = E₁ = E₂ [Pa].
-    #[arg(long, default_value_t = 1.5e11)]
+    #[arg(long, default_value_t = MembraneOptions::default().youngs_modulus)]
     youngs_modulus: f64,
     /// Poisson's ratio ν₁₂.
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(long, default_value_t = MembraneOptions::default().poisson_ratio)]
     poisson_ratio: f64,
     /// Shear modulus G [Pa] [default: E(b/a)²/2 = 7.5e8 for b/a = 0.1].
     #[arg(long)]
@@ -497,10 +538,10 @@ struct MembraneArgs {
     #[arg(long, requires = "girder_cells")]
     rod_modulus: Option<f64>,
     /// Girder zone: the rods' density ρ_g [kg/m³].
-    #[arg(long, default_value_t = 7800.0, requires = "girder_cells")]
+    #[arg(long, default_value_t = zone_default().density, requires = "girder_cells")]
     rod_density: f64,
     /// Girder zone: joints rigid (beams) or pinned (trusses).
-    #[arg(long, value_enum, default_value_t = Joints::Rigid, requires = "girder_cells")]
+    #[arg(long, value_enum, default_value_t = Joints::of(zone_default().rigid), requires = "girder_cells")]
     joints: Joints,
 }
 
@@ -510,25 +551,25 @@ struct RodArgs {
     #[arg(long)]
     out: PathBuf,
     /// Rod length L [m].
-    #[arg(long, default_value_t = 0.1)]
+    #[arg(long, default_value_t = RodParams::default().length)]
     length: f64,
     /// Number of truss elements.
-    #[arg(long, default_value_t = 200)]
+    #[arg(long, default_value_t = RodParams::default().elements)]
     elements: usize,
     /// Young's modulus E [Pa] (default: steel, as in the paper's §4).
-    #[arg(long, default_value_t = 1.5e11)]
+    #[arg(long, default_value_t = RodParams::default().youngs_modulus)]
     youngs_modulus: f64,
     /// Density ρ [kg/m³].
-    #[arg(long, default_value_t = 7800.0)]
+    #[arg(long, default_value_t = RodParams::default().density)]
     density: f64,
     /// Cross-section width [m].
-    #[arg(long, default_value_t = 1e-3)]
+    #[arg(long, default_value_t = RodParams::default().width)]
     width: f64,
     /// Cross-section thickness [m].
-    #[arg(long, default_value_t = 1e-3)]
+    #[arg(long, default_value_t = RodParams::default().thickness)]
     thickness: f64,
     /// Pulse amplitude F0 [N] (positive pulls along +x).
-    #[arg(long, default_value_t = 100.0)]
+    #[arg(long, default_value_t = RodParams::default().force)]
     force: f64,
     /// Pulse duration T_F [s] [default: 0.5·L·√(ρ/E)].
     #[arg(long)]
@@ -544,243 +585,340 @@ struct RodArgs {
     tension_only: bool,
 }
 
+/// The girder zone's defaults (`--girder-cells` has none).
+fn zone_default() -> GirderZoneOptions {
+    GirderZoneOptions::new(0)
+}
+
+impl RodArgs {
+    fn params(&self) -> RodParams {
+        RodParams {
+            length: self.length,
+            elements: self.elements,
+            youngs_modulus: self.youngs_modulus,
+            density: self.density,
+            width: self.width,
+            thickness: self.thickness,
+            force: self.force,
+            pulse_duration: self.pulse_duration,
+            end_time: self.end_time,
+            output_interval: self.output_interval,
+            tension_only: self.tension_only,
+        }
+    }
+
+    fn weave(&self) -> anyhow::Result<()> {
+        let p = self.params();
+        let m = weave(&Spec::Rod(p.clone()), &self.out)?;
+        eprintln!(
+            "weft-weave rod: {} nodes, {} trusses, c = {:.1} m/s, T_F = {:.3e} s -> {}",
+            m.num_nodes(),
+            m.num_elements(),
+            p.wave_speed(),
+            p.pulse(),
+            self.out.display()
+        );
+        Ok(())
+    }
+}
+
+impl GirderArgs {
+    fn params(&self) -> GirderParams {
+        GirderParams {
+            square: self.square.square(),
+            youngs_modulus: self.youngs_modulus,
+            density: self.density,
+            rod_width: self.rod_width,
+            rod_thickness: self.rod_thickness,
+            rigid: self.joints == Joints::Rigid,
+            full_edge_rods: self.full_edge_rods,
+            clamp_rotations: self.clamp == Clamp::BuiltIn,
+        }
+    }
+
+    fn weave(&self) -> anyhow::Result<()> {
+        let p = self.params();
+        let m = weave(&Spec::Girder(p.clone()), &self.square.out)?;
+        eprintln!(
+            "weft-weave girder: {} nodes, {} {} rods, b = {:.3e} m, h = {:.3e} m -> {}",
+            m.num_nodes(),
+            m.num_elements(),
+            if p.rigid { "beam" } else { "truss" },
+            p.b(),
+            p.h(),
+            self.square.out.display()
+        );
+        Ok(())
+    }
+}
+
+impl MembraneArgs {
+    fn options(&self) -> MembraneOptions {
+        MembraneOptions {
+            square: self.square.square(),
+            youngs_modulus: self.youngs_modulus,
+            poisson_ratio: self.poisson_ratio,
+            shear_modulus: self.shear_modulus,
+            thickness: self.thickness,
+            density: self.density,
+            girder_zone: self.girder_cells.map(|cells| GirderZoneOptions {
+                cells,
+                length: self.zone_length,
+                youngs_modulus: self.rod_modulus,
+                density: self.rod_density,
+                rod_width: self.rod_width,
+                rigid: self.joints == Joints::Rigid,
+            }),
+        }
+    }
+
+    fn weave(&self) -> anyhow::Result<()> {
+        let p: MembraneParams = self.options().resolve();
+        let m = weave(&Spec::Membrane(p.clone()), &self.square.out)?;
+        eprintln!(
+            "weft-weave membrane: {} nodes, {} elements{}, s = {:.3e} m, ρ = {:.1} kg/m³, G = {:.3e} Pa -> {}",
+            m.num_nodes(),
+            m.num_elements(),
+            if p.girder_zone.is_some() { " (quads and the girder zone's rods)" } else { " (quads)" },
+            p.thickness,
+            p.density,
+            p.shear_modulus,
+            self.square.out.display()
+        );
+        Ok(())
+    }
+}
+
+impl CombinedArgs {
+    fn options(&self) -> CombinedOptions {
+        CombinedOptions {
+            centre: self.centre,
+            centre_length: self.centre_length,
+            centre_cells: self.centre_cells,
+            length: self.length,
+            coarsening: self.coarsening,
+            growth: self.growth,
+            quarter: !self.full,
+            youngs_modulus: self.youngs_modulus,
+            density: self.density,
+            rod_width: self.rod_width,
+            shear_modulus: self.shear_modulus,
+            thickness: self.thickness,
+            membrane_density: self.membrane_density,
+            force: self.force,
+            pulse: self.pulse,
+            end_time: self.end_time,
+            output_interval: self.output_interval,
+        }
+    }
+
+    fn weave(&self) -> anyhow::Result<()> {
+        let p = self.options().resolve();
+        let m = weave(&Spec::Combined(p), &self.out)?;
+        eprintln!(
+            "weft-weave combined: {} nodes, {} elements, {} ties -> {}",
+            m.num_nodes(),
+            m.num_elements(),
+            m.ties.len(),
+            self.out.display()
+        );
+        Ok(())
+    }
+}
+
+impl WovenArgs {
+    fn params(&self) -> WovenParams {
+        WovenParams {
+            yarns: self.yarns,
+            spacing: self.spacing,
+            yarn_modulus: self.yarn_modulus,
+            yarn_density: self.yarn_density,
+            yarn_area: self.yarn_area,
+            tension_only: !self.compressible_yarns,
+            pretension_strain: self.pretension_strain,
+            pretension_start: self.pretension_start,
+            crimp: self.crimp,
+            k_xy: self.k_xy,
+            k_z: self.k_z,
+            c_xy: self.c_xy,
+            c_z: self.c_z,
+            slip_force: self.slip_force,
+            friction: self.link_friction,
+            unilateral: self.unilateral_links,
+            local_frame: self.link_axes == LinkAxes::Local,
+            sliding: self.link_axes == LinkAxes::Sliding,
+            surround: SurroundParams {
+                density_ratio: self.membrane_density_ratio,
+                modulus_ratio: self.membrane_modulus_ratio,
+                shear_ratio: self.membrane_shear_ratio,
+                poisson_ratio: self.membrane_poisson,
+                thickness: self.membrane_thickness,
+            },
+            length: self.length,
+            growth: self.growth,
+            quarter: !self.full,
+            interface: self.interface,
+            projectile_shape: self.projectile_shape,
+            projectile_radius: self.projectile_radius,
+            projectile_mass: self.projectile_mass,
+            projectile_velocity: self.projectile_velocity,
+            projectile_friction: self.projectile_friction,
+            end_time: self.end_time,
+            output_interval: self.output_interval,
+            dt_safety: self.dt_safety,
+        }
+    }
+
+    fn weave(&self) -> anyhow::Result<()> {
+        let p = self.params();
+        let m = weave(&Spec::WovenReduced(p.clone()), &self.out)?;
+        let mp = p.membrane();
+        eprintln!(
+            "weft-weave woven-reduced: {} nodes, {} elements, {} ties; membrane surround ρs = {:.4e} kg/m² ({:.3} × the patch's 2ρA/p = {:.4e}), E = {:.3e} Pa, G = {:.3e} Pa, s = {:.3e} m -> {}",
+            m.num_nodes(),
+            m.num_elements(),
+            m.ties.len(),
+            mp.density * mp.thickness,
+            mp.density * mp.thickness / p.patch_surface_density(),
+            p.patch_surface_density(),
+            mp.youngs_modulus,
+            mp.shear_modulus,
+            mp.thickness,
+            self.out.display()
+        );
+        Ok(())
+    }
+}
+
+impl WovenBandArgs {
+    fn params(&self) -> WovenBandParams {
+        WovenBandParams {
+            yarns: self.yarns,
+            quarter: !self.full,
+            spacing: self.spacing,
+            width: self.width,
+            thickness: self.thickness,
+            crimp_amplitude: self.crimp_amplitude,
+            per_spacing: self.per_spacing,
+            across: self.across,
+            yarn_model: self.yarn_model,
+            modulus: self.modulus,
+            transverse_modulus: self.transverse_modulus,
+            shear_modulus: self.shear_modulus,
+            density: self.density,
+            friction: self.friction,
+            tension_field: self.tension_field,
+            layers: self.layers,
+            layer_gap: self.layer_gap,
+            edge: self.edge,
+            projectile_shape: self.projectile_shape,
+            projectile_radius: self.projectile_radius,
+            projectile_mass: self.projectile_mass,
+            projectile_velocity: self.projectile_velocity,
+            projectile_friction: self.projectile_friction,
+            end_time: self.end_time,
+            output_interval: self.output_interval,
+            dt_safety: self.dt_safety,
+            surround: self.membrane_length.map(|length| Surround {
+                length,
+                growth: self.membrane_growth,
+                density_ratio: self.membrane_density_ratio,
+                modulus_ratio: self.membrane_modulus_ratio,
+                shear_ratio: self.membrane_shear_ratio,
+                thickness: self.membrane_thickness,
+            }),
+        }
+    }
+
+    fn weave(&self) -> anyhow::Result<()> {
+        let m = weave(&Spec::Woven(self.params()), &self.out)?;
+        eprintln!(
+            "weft-weave woven: {} nodes, {} elements, {} contact definitions -> {}",
+            m.num_nodes(),
+            m.num_elements(),
+            m.contacts.len(),
+            self.out.display()
+        );
+        Ok(())
+    }
+}
+
+/// Build the model and write it to `out`, the generator's warnings and notes on stderr.
+fn weave(spec: &Spec, out: &Path) -> weft::error::Result<weft::model::Model> {
+    weave::run(spec, out, &mut |w: &str| match w.strip_prefix("note: ") {
+        Some(n) => eprintln!("note: {n}"),
+        None => eprintln!("warning: {w}"),
+    })
+}
+
 fn main() -> ExitCode {
     weft::cli::main(run)
 }
 
 fn run() -> anyhow::Result<ExitCode> {
     let cli: Cli = weft::cli::parse();
-    let mut warn = |w: &str| match w.strip_prefix("note: ") {
-        Some(n) => eprintln!("note: {n}"),
-        None => eprintln!("warning: {w}"),
-    };
     match cli.model {
-        Model::Girder(a) => {
-            let p = GirderParams {
-                square: a.square.square(),
-                youngs_modulus: a.youngs_modulus,
-                density: a.density,
-                rod_width: a.rod_width,
-                rod_thickness: a.rod_thickness,
-                rigid: a.joints == Joints::Rigid,
-                full_edge_rods: a.full_edge_rods,
-                clamp_rotations: a.clamp == Clamp::BuiltIn,
-            };
-            let m = weave::run(&Spec::Girder(p.clone()), &a.square.out, &mut warn)?;
-            eprintln!(
-                "weft-weave girder: {} nodes, {} {} rods, b = {:.3e} m, h = {:.3e} m -> {}",
-                m.num_nodes(),
-                m.num_elements(),
-                if p.rigid { "beam" } else { "truss" },
-                p.b(),
-                p.h(),
-                a.square.out.display()
-            );
-        }
-        Model::Combined(a) => {
-            let cell = a.centre_length / a.centre_cells.max(1) as f64;
-            let b = a.rod_width.unwrap_or(cell / 10.0);
-            let c = a.length * 0.5 * (a.density / a.youngs_modulus).sqrt();
-            let end = a.end_time.unwrap_or(4.0 * c);
-            let p = CombinedParams {
-                centre: a.centre,
-                centre_length: a.centre_length,
-                centre_cells: a.centre_cells,
-                length: a.length,
-                coarsening: a.coarsening,
-                growth: a.growth,
-                quarter: !a.full,
-                youngs_modulus: a.youngs_modulus,
-                density: a.density,
-                rod_width: b,
-                membrane: MembraneProps {
-                    youngs_modulus: a.youngs_modulus,
-                    poisson_ratio: 0.0,
-                    shear_modulus: a
-                        .shear_modulus
-                        .unwrap_or(a.youngs_modulus * (b / cell).powi(2) / 2.0),
-                    thickness: a.thickness.unwrap_or(b * b / cell),
-                    density: a.membrane_density.unwrap_or(a.density * (2.0 - b / cell)),
-                },
-                force: a.force,
-                pulse: a
-                    .pulse
-                    .unwrap_or(a.centre_length * (a.density / a.youngs_modulus).sqrt()),
-                end_time: end,
-                output_interval: a.output_interval.unwrap_or(end / 100.0),
-            };
-            let m = weave::run(&Spec::Combined(p.clone()), &a.out, &mut warn)?;
-            eprintln!(
-                "weft-weave combined: {} nodes, {} elements, {} ties -> {}",
-                m.num_nodes(),
-                m.num_elements(),
-                m.ties.len(),
-                a.out.display()
-            );
-        }
-        Model::WovenReduced(a) => {
-            let p = WovenParams {
-                yarns: a.yarns,
-                spacing: a.spacing,
-                yarn_modulus: a.yarn_modulus,
-                yarn_density: a.yarn_density,
-                yarn_area: a.yarn_area,
-                tension_only: !a.compressible_yarns,
-                pretension_strain: a.pretension_strain,
-                pretension_start: a.pretension_start,
-                crimp: a.crimp,
-                k_xy: a.k_xy,
-                k_z: a.k_z,
-                c_xy: a.c_xy,
-                c_z: a.c_z,
-                slip_force: a.slip_force,
-                friction: a.link_friction,
-                unilateral: a.unilateral_links,
-                local_frame: a.link_axes == LinkAxes::Local,
-                sliding: a.link_axes == LinkAxes::Sliding,
-                surround: SurroundParams {
-                    density_ratio: a.membrane_density_ratio,
-                    modulus_ratio: a.membrane_modulus_ratio,
-                    shear_ratio: a.membrane_shear_ratio,
-                    poisson_ratio: a.membrane_poisson,
-                    thickness: a.membrane_thickness,
-                },
-                length: a.length,
-                growth: a.growth,
-                quarter: !a.full,
-                interface: a.interface,
-                projectile_shape: a.projectile_shape,
-                projectile_radius: a.projectile_radius,
-                projectile_mass: a.projectile_mass,
-                projectile_velocity: a.projectile_velocity,
-                projectile_friction: a.projectile_friction,
-                end_time: a.end_time,
-                output_interval: a.output_interval,
-                dt_safety: a.dt_safety,
-            };
-            let m = weave::run(&Spec::WovenReduced(p.clone()), &a.out, &mut warn)?;
-            let mp = p.membrane();
-            eprintln!(
-                "weft-weave woven-reduced: {} nodes, {} elements, {} ties; membrane surround ρs = {:.4e} kg/m² ({:.3} × the patch's 2ρA/p = {:.4e}), E = {:.3e} Pa, G = {:.3e} Pa, s = {:.3e} m -> {}",
-                m.num_nodes(),
-                m.num_elements(),
-                m.ties.len(),
-                mp.density * mp.thickness,
-                mp.density * mp.thickness / p.patch_surface_density(),
-                p.patch_surface_density(),
-                mp.youngs_modulus,
-                mp.shear_modulus,
-                mp.thickness,
-                a.out.display()
-            );
-        }
-        Model::Woven(a) => {
-            let p = weft::generate::woven::WovenBandParams {
-                yarns: a.yarns,
-                quarter: !a.full,
-                spacing: a.spacing,
-                width: a.width,
-                thickness: a.thickness,
-                crimp_amplitude: a.crimp_amplitude,
-                per_spacing: a.per_spacing,
-                across: a.across,
-                yarn_model: a.yarn_model,
-                modulus: a.modulus,
-                transverse_modulus: a.transverse_modulus,
-                shear_modulus: a.shear_modulus,
-                density: a.density,
-                friction: a.friction,
-                tension_field: a.tension_field,
-                layers: a.layers,
-                layer_gap: a.layer_gap,
-                edge: a.edge,
-                projectile_shape: a.projectile_shape,
-                projectile_radius: a.projectile_radius,
-                projectile_mass: a.projectile_mass,
-                projectile_velocity: a.projectile_velocity,
-                projectile_friction: a.projectile_friction,
-                end_time: a.end_time,
-                output_interval: a.output_interval,
-                dt_safety: a.dt_safety,
-                surround: a
-                    .membrane_length
-                    .map(|length| weft::generate::woven::Surround {
-                        length,
-                        growth: a.membrane_growth,
-                        density_ratio: a.membrane_density_ratio,
-                        modulus_ratio: a.membrane_modulus_ratio,
-                        shear_ratio: a.membrane_shear_ratio,
-                        thickness: a.membrane_thickness,
-                    }),
-            };
-            let m = weave::run(&Spec::Woven(p), &a.out, &mut warn)?;
-            eprintln!(
-                "weft-weave woven: {} nodes, {} elements, {} contact definitions -> {}",
-                m.num_nodes(),
-                m.num_elements(),
-                m.contacts.len(),
-                a.out.display()
-            );
-        }
-        Model::Membrane(a) => {
-            let mut d = MembraneParams::paper_default(a.square.square());
-            let l = a.square.length;
-            let zone = a.girder_cells.map(|ng| GirderZone {
-                length: a.zone_length.unwrap_or(0.5 * l),
-                cells: ng,
-                youngs_modulus: a.rod_modulus.unwrap_or(a.youngs_modulus),
-                density: a.rod_density,
-                rod_width: a.rod_width.unwrap_or(l / (10.0 * ng.max(1) as f64)),
-                rigid: a.joints == Joints::Rigid,
-            });
-            if let Some(z) = &zone {
-                (d.thickness, d.density, d.shear_modulus) = z.equivalent(l);
-            }
-            let p = MembraneParams {
-                youngs_modulus: a.youngs_modulus,
-                poisson_ratio: a.poisson_ratio,
-                shear_modulus: a.shear_modulus.unwrap_or(d.shear_modulus),
-                thickness: a.thickness.unwrap_or(d.thickness),
-                density: a.density.unwrap_or(d.density),
-                girder_zone: zone,
-                ..d
-            };
-            let m = weave::run(&Spec::Membrane(p.clone()), &a.square.out, &mut warn)?;
-            eprintln!(
-                "weft-weave membrane: {} nodes, {} elements{}, s = {:.3e} m, ρ = {:.1} kg/m³, G = {:.3e} Pa -> {}",
-                m.num_nodes(),
-                m.num_elements(),
-                if p.girder_zone.is_some() { " (quads and the girder zone's rods)" } else { " (quads)" },
-                p.thickness,
-                p.density,
-                p.shear_modulus,
-                a.square.out.display()
-            );
-        }
-        Model::Rod(a) => {
-            let p = RodParams {
-                length: a.length,
-                elements: a.elements,
-                youngs_modulus: a.youngs_modulus,
-                density: a.density,
-                width: a.width,
-                thickness: a.thickness,
-                force: a.force,
-                pulse_duration: a.pulse_duration,
-                end_time: a.end_time,
-                output_interval: a.output_interval,
-                tension_only: a.tension_only,
-            };
-            let m = weave::run(&Spec::Rod(p.clone()), &a.out, &mut warn)?;
-            eprintln!(
-                "weft-weave rod: {} nodes, {} trusses, c = {:.1} m/s, T_F = {:.3e} s -> {}",
-                m.num_nodes(),
-                m.num_elements(),
-                p.wave_speed(),
-                p.pulse(),
-                a.out.display()
-            );
-        }
-    }
+        Model::Rod(a) => a.weave(),
+        Model::Girder(a) => a.weave(),
+        Model::Membrane(a) => a.weave(),
+        Model::Combined(a) => a.weave(),
+        Model::WovenReduced(a) => a.weave(),
+        Model::Woven(a) => a.weave(),
+    }?;
     Ok(ExitCode::SUCCESS)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The subcommand `args` with `--out` and nothing else given.
+    fn parse(args: &[&str]) -> Model {
+        let argv = ["weft-weave"].iter().chain(args).chain(&["--out", "x"]);
+        Cli::try_parse_from(argv).expect("parses").model
+    }
+
+    fn json<T: serde::Serialize>(t: &T) -> serde_json::Value {
+        serde_json::to_value(t).expect("serialises")
+    }
+
+    /// Every flag left out gives the generator's `Default`: the clap defaults and the
+    /// flags without one (the switches) agree with the library's, and `params` maps every
+    /// flag onto its field.
+    #[test]
+    fn flags_left_out_give_the_generators_defaults() {
+        let Model::Rod(a) = parse(&["rod"]) else {
+            panic!()
+        };
+        assert_eq!(json(&a.params()), json(&RodParams::default()));
+        let Model::Girder(a) = parse(&["girder"]) else {
+            panic!()
+        };
+        assert_eq!(json(&a.params()), json(&GirderParams::default()));
+        let Model::Membrane(a) = parse(&["membrane"]) else {
+            panic!()
+        };
+        assert_eq!(a.options(), MembraneOptions::default());
+        let Model::Membrane(a) = parse(&["membrane", "--girder-cells", "8"]) else {
+            panic!()
+        };
+        let zone = a.options().girder_zone;
+        assert_eq!(zone, Some(GirderZoneOptions::new(8)));
+        let Model::Combined(a) = parse(&["combined"]) else {
+            panic!()
+        };
+        assert_eq!(a.options(), CombinedOptions::default());
+        let Model::WovenReduced(a) = parse(&["woven-reduced"]) else {
+            panic!()
+        };
+        assert_eq!(json(&a.params()), json(&WovenParams::default()));
+        let Model::Woven(a) = parse(&["woven"]) else {
+            panic!()
+        };
+        assert_eq!(json(&a.params()), json(&WovenBandParams::default()));
+        let Model::Woven(a) = parse(&["woven", "--membrane-length", "0.06"]) else {
+            panic!()
+        };
+        assert_eq!(json(&a.params().surround), json(&Some(Surround::default())));
+    }
 }

@@ -40,7 +40,8 @@ pub struct CrossingBands {
 
 impl Default for CrossingBands {
     fn default() -> Self {
-        // Aramid-like bands (DESIGN.md §9): 1 mm spacing, 0.6 mm × 0.1 mm.
+        // Aramid-like bands (docs/theory.md, "Material data and defaults"): 1 mm spacing,
+        // 0.6 mm × 0.1 mm.
         CrossingBands {
             bands: 6,
             spacing: 1e-3,

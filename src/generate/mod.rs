@@ -3,8 +3,11 @@
 
 pub mod grid;
 pub mod layers;
+pub mod pulse;
 pub mod rod;
 pub mod square;
+pub mod surround;
 pub mod weave;
 pub mod woven;
+pub mod woven_reduced;
 pub mod zones;

@@ -17,7 +17,9 @@ use serde::Serialize;
 
 use crate::error::{Result, WeftError};
 use crate::generate::grid::rectangle;
-use crate::generate::zones::{tie_to_hole, Coarse};
+use crate::generate::pulse::resolve_pulse;
+pub use crate::generate::pulse::STEPS_PER_PULSE;
+use crate::generate::surround::{tie_to_hole, Coarse};
 use crate::model::{Analysis, ElementKind, Load, Model, PartProps, TimeLaw};
 
 /// Where the square is loaded.
@@ -29,29 +31,8 @@ pub enum LoadCase {
     Transverse,
 }
 
-/// Steps per load pulse: the stable step of these coarse models would sample the paper's
-/// pulse (T_F = T/2 spans N/2 cells) with about five steps, too few for the response and
-/// for the energy account (the trapezoidal work is then off by ~(π/5)²/12 ≈ 3 %).
-pub const STEPS_PER_PULSE: f64 = 40.0;
-
-/// Choose a time step that resolves the pulse when the stable step does not.
-pub(crate) fn resolve_pulse(m: &mut Model) -> Result<()> {
-    let t_f = m.loads.iter().find_map(|l| match l.law {
-        TimeLaw::SinePulse { duration, .. } => Some(duration),
-        _ => None,
-    });
-    if let Some(t_f) = t_f {
-        let stable = crate::solver::Solver::new(m)?.stable;
-        let dt = t_f / STEPS_PER_PULSE;
-        if dt < stable.dt {
-            m.analysis.time_step = Some(dt);
-        }
-    }
-    Ok(())
-}
-
 /// Common parameters of the square models.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Square {
     /// Side L [m].
     pub length: f64,
@@ -67,6 +48,22 @@ pub struct Square {
     pub end_time: Option<f64>,
     /// Output interval [s]; `None`: end time / 100.
     pub output_interval: Option<f64>,
+}
+
+impl Default for Square {
+    /// The paper's §4 square: L = 0.1 m, N = 10 cells per side, a tension of F = 100 N
+    /// (the times from the model's own material).
+    fn default() -> Self {
+        Square {
+            length: 0.1,
+            cells: 10,
+            load_case: LoadCase::Tension,
+            force: 100.0,
+            period: None,
+            end_time: None,
+            output_interval: None,
+        }
+    }
 }
 
 fn positive(name: &str, v: f64, unit: &str) -> Result<()> {
@@ -193,6 +190,23 @@ pub struct GirderParams {
     pub clamp_rotations: bool,
 }
 
+impl Default for GirderParams {
+    /// The paper's §4 steel girder on the default [`Square`]: E = 1.5·10¹¹ Pa,
+    /// ρ = 7800 kg/m³, b = h = L/(10N), rigid joints, a built-in clamp, half edge rods.
+    fn default() -> Self {
+        GirderParams {
+            square: Square::default(),
+            youngs_modulus: 1.5e11,
+            density: 7800.0,
+            rod_width: None,
+            rod_thickness: None,
+            rigid: true,
+            full_edge_rods: false,
+            clamp_rotations: true,
+        }
+    }
+}
+
 impl GirderParams {
     pub fn b(&self) -> f64 {
         self.rod_width
@@ -207,8 +221,9 @@ impl GirderParams {
 ///
 /// Each rod is a prism of b × h between joint centres; the b × b crossings would be
 /// counted twice, so the rods carry the density ρ(1 − b/(2a)), which gives the lattice's
-/// areal density ρ·b·h·(2 − b/a)/a exactly (DESIGN.md §8). Rods on the boundary stand for
-/// half a cell: half the modulus and half the density, unless `full_edge_rods`.
+/// areal density ρ·b·h·(2 − b/a)/a exactly (docs/theory.md, "Closed forms used as
+/// oracles"). Rods on the boundary stand for half a cell: half the modulus and half the
+/// density, unless `full_edge_rods`.
 pub fn girder(p: &GirderParams) -> Result<(Model, Vec<String>)> {
     positive("youngs-modulus", p.youngs_modulus, "in Pa")?;
     positive("density", p.density, "in kg/m³")?;
@@ -352,8 +367,9 @@ pub struct GirderZone {
 }
 
 impl GirderZone {
-    /// The membrane that is the closed-form equivalent of this zone's girder (DESIGN.md
-    /// §8, b = h, rigid joints): s = b²/a, ρ = ρ_g(2 − b/a), G = E(b/a)²/2, a = L/N_g.
+    /// The membrane that is the closed-form equivalent of this zone's girder
+    /// (docs/theory.md, "Closed forms used as oracles"; b = h, rigid joints): s = b²/a,
+    /// ρ = ρ_g(2 − b/a), G = E(b/a)²/2, a = L/N_g.
     pub fn equivalent(&self, length: f64) -> (f64, f64, f64) {
         let a = length / self.cells.max(1) as f64;
         let r = self.rod_width / a;
@@ -366,9 +382,9 @@ impl GirderZone {
 }
 
 impl MembraneParams {
-    /// The closed-form equivalent of a rigid-jointed girder with b = h = a/10 (DESIGN.md
-    /// §8): s = b²/a, ρ = ρ_g(2 − b/a), G = E(b/a)²/2, with E = 1.5·10¹¹ Pa,
-    /// ρ_g = 7800 kg/m³, L = 0.1 m, N = 10.
+    /// The closed-form equivalent of a rigid-jointed girder with b = h = a/10
+    /// (docs/theory.md, "Closed forms used as oracles"): s = b²/a, ρ = ρ_g(2 − b/a),
+    /// G = E(b/a)²/2, with E = 1.5·10¹¹ Pa, ρ_g = 7800 kg/m³, L = 0.1 m, N = 10.
     pub fn paper_default(square: Square) -> MembraneParams {
         let a = square.length / square.cells as f64;
         let r = 0.1;
@@ -380,6 +396,115 @@ impl MembraneParams {
             density: 7800.0 * (2.0 - r),
             square,
             girder_zone: None,
+        }
+    }
+}
+
+/// `membrane` as asked for (the flags of `weft-weave membrane`): the membrane's properties
+/// and the girder zone's left `None` follow from the others in [`MembraneOptions::resolve`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct MembraneOptions {
+    pub square: Square,
+    /// E = E₁ = E₂ [Pa] and ν₁₂.
+    pub youngs_modulus: f64,
+    pub poisson_ratio: f64,
+    /// G [Pa], s [m], ρ [kg/m³]; `None`: those of the closed-form equivalent of the
+    /// girder ([`MembraneParams::paper_default`], or with a girder zone
+    /// [`GirderZone::equivalent`] of the zone's girder).
+    pub shear_modulus: Option<f64>,
+    pub thickness: Option<f64>,
+    pub density: Option<f64>,
+    /// The paper's combined model (Fig. 5b): a girder zone at the centre of the square.
+    pub girder_zone: Option<GirderZoneOptions>,
+}
+
+impl Default for MembraneOptions {
+    /// [`MembraneParams::paper_default`] on the default [`Square`].
+    fn default() -> Self {
+        let d = MembraneParams::paper_default(Square::default());
+        MembraneOptions {
+            square: d.square,
+            youngs_modulus: d.youngs_modulus,
+            poisson_ratio: d.poisson_ratio,
+            shear_modulus: None,
+            thickness: None,
+            density: None,
+            girder_zone: None,
+        }
+    }
+}
+
+impl MembraneOptions {
+    /// The membrane's parameters: what is `None` taken from the closed-form equivalent of
+    /// the girder, the zone's girder where there is one (s = b²/a, ρ = ρ_g(2 − b/a),
+    /// G = E(b/a)²/2 with a = L/N_g), the paper's default girder otherwise.
+    pub fn resolve(&self) -> MembraneParams {
+        let mut d = MembraneParams::paper_default(self.square.clone());
+        let l = self.square.length;
+        let zone = self
+            .girder_zone
+            .as_ref()
+            .map(|z| z.resolve(l, self.youngs_modulus));
+        if let Some(z) = &zone {
+            (d.thickness, d.density, d.shear_modulus) = z.equivalent(l);
+        }
+        MembraneParams {
+            youngs_modulus: self.youngs_modulus,
+            poisson_ratio: self.poisson_ratio,
+            shear_modulus: self.shear_modulus.unwrap_or(d.shear_modulus),
+            thickness: self.thickness.unwrap_or(d.thickness),
+            density: self.density.unwrap_or(d.density),
+            girder_zone: zone,
+            ..d
+        }
+    }
+}
+
+/// The girder zone as asked for (`membrane --girder-cells` and the zone's flags); what is
+/// `None` follows from the square in [`GirderZoneOptions::resolve`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct GirderZoneOptions {
+    /// Girder cells per side of the whole square, N_g.
+    pub cells: usize,
+    /// Side of the zone L_m [m]; `None`: L/2.
+    pub length: Option<f64>,
+    /// The rods' E [Pa]; `None`: the membrane's.
+    pub youngs_modulus: Option<f64>,
+    /// The rods' ρ_g [kg/m³].
+    pub density: f64,
+    /// Rod width = thickness b [m]; `None`: L/(10 N_g).
+    pub rod_width: Option<f64>,
+    /// Rigid joints (beams) or pinned joints (trusses).
+    pub rigid: bool,
+}
+
+impl GirderZoneOptions {
+    /// A zone of N_g = `cells` girder cells per side, its rods the default girder's
+    /// ([`GirderParams::default`]: ρ_g, rigid joints), the rest following the square.
+    pub fn new(cells: usize) -> GirderZoneOptions {
+        let g = GirderParams::default();
+        GirderZoneOptions {
+            cells,
+            length: None,
+            youngs_modulus: None,
+            density: g.density,
+            rod_width: None,
+            rigid: g.rigid,
+        }
+    }
+
+    /// The zone in a square of side `length` whose membrane has the modulus
+    /// `youngs_modulus`.
+    pub fn resolve(&self, length: f64, youngs_modulus: f64) -> GirderZone {
+        GirderZone {
+            length: self.length.unwrap_or(0.5 * length),
+            cells: self.cells,
+            youngs_modulus: self.youngs_modulus.unwrap_or(youngs_modulus),
+            density: self.density,
+            rod_width: self
+                .rod_width
+                .unwrap_or(length / (10.0 * self.cells.max(1) as f64)),
+            rigid: self.rigid,
         }
     }
 }
@@ -440,7 +565,54 @@ fn grid_line(x: f64, a: f64, l: f64) -> Option<usize> {
 /// membrane node coincides with one on the zone's boundary), `axis_x`, `diagonal`,
 /// `loaded_edge` as in the plain square.
 fn membrane_with_girder_zone(p: &MembraneParams, z: &GirderZone) -> Result<Model> {
-    let (n, l) = (p.square.cells, p.square.length);
+    check_zone(p, z)?;
+    let zg = ZoneGrid::new(p, z)?;
+    let mut m = Model::default();
+    let mut ids = NextIds {
+        node: 1,
+        element: 1,
+    };
+    let grid = add_membrane_around_zone(&mut m, p, &zg, &mut ids);
+    let zone = add_zone_girder(&mut m, z, &zg, &mut ids);
+    tie_zone_to_membrane(&mut m, &zg, &grid, &zone)?;
+    let nz = zg.nz;
+    if p.square.load_case == LoadCase::Transverse && nz % 2 != 0 {
+        return Err(WeftError::input(format!(
+            "the girder zone has {nz} cells per side: no node at its centre for the transverse load"
+        ))
+        .expected("an even number of girder cells across the zone")
+        .hint("choose --girder-cells (and --zone-length) so that N_g·L_m/L is even"));
+    }
+    let n = p.square.cells;
+    let g = |i: usize, j: usize| grid[j * (n + 1) + i];
+    clamp_load_analysis(
+        &mut m,
+        &p.square,
+        p.youngs_modulus,
+        p.density,
+        false,
+        &g,
+        zone[nz / 2 * (nz + 1) + nz / 2],
+    )?;
+    insert_zone_sets(&mut m, &zg, &grid, &zone);
+    if p.square.load_case != LoadCase::Transverse {
+        for i in 0..m.num_nodes() {
+            m.constraints.push((i, [false, false, true]));
+        }
+        if z.rigid {
+            for &i in &zone {
+                m.rot_constraints.push((i, [true, true, false]));
+            }
+        }
+    }
+    m.validate()?;
+    resolve_pulse(&mut m)?;
+    Ok(m)
+}
+
+/// The girder zone's own values, each named by its flag.
+fn check_zone(p: &MembraneParams, z: &GirderZone) -> Result<()> {
+    let l = p.square.length;
     positive("length", l, "in m")?;
     positive("zone-length", z.length, "in m")?;
     positive("rod-modulus", z.youngs_modulus, "in Pa")?;
@@ -457,56 +629,113 @@ fn membrane_with_girder_zone(p: &MembraneParams, z: &GirderZone) -> Result<Model
         ))
         .expected("0 < L_m < L: the membrane surrounds the girder zone"));
     }
-    let (am, ag) = (l / n as f64, l / z.cells as f64);
-    let z0 = 0.5 * (l - z.length);
-    let (i0, i1) = match (grid_line(z0, am, l), grid_line(z0 + z.length, am, l)) {
-        (Some(a), Some(b)) if a >= 1 && b < n => (a, b),
-        _ => {
-            return Err(WeftError::input(format!(
+    Ok(())
+}
+
+/// Where the girder zone lies on the membrane's grid and on the girder's.
+struct ZoneGrid {
+    /// Membrane cells per side N_m.
+    n: usize,
+    /// The membrane's cell L/N_m and the girder's L/N_g [m].
+    am: f64,
+    ag: f64,
+    /// The zone's lower edges x = y = z0 [m].
+    z0: f64,
+    /// The zone's edges on the membrane's grid lines i0 and i1.
+    i0: usize,
+    i1: usize,
+    /// Girder cells across the zone.
+    nz: usize,
+}
+
+impl ZoneGrid {
+    /// The zone's edges must lie on both grids' lines, and its rods be narrower than the
+    /// girder's cell.
+    fn new(p: &MembraneParams, z: &GirderZone) -> Result<ZoneGrid> {
+        let (n, l) = (p.square.cells, p.square.length);
+        let (am, ag) = (l / n as f64, l / z.cells as f64);
+        let z0 = 0.5 * (l - z.length);
+        let (i0, i1) = match (grid_line(z0, am, l), grid_line(z0 + z.length, am, l)) {
+            (Some(a), Some(b)) if a >= 1 && b < n => (a, b),
+            _ => {
+                return Err(WeftError::input(format!(
                 "the girder zone's edges at x, y = {z0:.6} and {:.6} m are not on the membrane's \
-                 grid lines (multiples of L/N_m = {am} m, N_m = --cells = {n})",
+                     grid lines (multiples of L/N_m = {am} m, N_m = --cells = {n})",
                 z0 + z.length
             ))
-            .expected("(L − L_m)/2 a multiple of L/N_m")
-            .hint("with the default L_m = L/2, choose --cells a multiple of 4"))
-        }
-    };
-    let (g0, g1) = match (grid_line(z0, ag, l), grid_line(z0 + z.length, ag, l)) {
-        (Some(a), Some(b)) => (a, b),
-        _ => {
+                .expected("(L − L_m)/2 a multiple of L/N_m")
+                .hint("with the default L_m = L/2, choose --cells a multiple of 4"))
+            }
+        };
+        let (g0, g1) = match (grid_line(z0, ag, l), grid_line(z0 + z.length, ag, l)) {
+            (Some(a), Some(b)) => (a, b),
+            _ => {
+                return Err(WeftError::input(format!(
+                    "the girder zone's edges at x, y = {z0:.6} and {:.6} m are not on the girder's \
+                     grid lines (multiples of L/N_g = {ag} m, N_g = --girder-cells = {})",
+                    z0 + z.length,
+                    z.cells
+                ))
+                .expected("(L − L_m)/2 a multiple of L/N_g")
+                .hint("with the default L_m = L/2, choose --girder-cells a multiple of 4"))
+            }
+        };
+        let b = z.rod_width;
+        if b >= ag {
             return Err(WeftError::input(format!(
-                "the girder zone's edges at x, y = {z0:.6} and {:.6} m are not on the girder's \
-                 grid lines (multiples of L/N_g = {ag} m, N_g = --girder-cells = {})",
-                z0 + z.length,
-                z.cells
+                "--rod-width = `{b}` m is not smaller than the girder's cell L/N_g = {ag} m"
             ))
-            .expected("(L − L_m)/2 a multiple of L/N_g")
-            .hint("with the default L_m = L/2, choose --girder-cells a multiple of 4"))
+            .expected("b < L/N_g"));
         }
-    };
-    let nz = g1 - g0;
-    let b = z.rod_width;
-    if b >= ag {
-        return Err(WeftError::input(format!(
-            "--rod-width = `{b}` m is not smaller than the girder's cell L/N_g = {ag} m"
-        ))
-        .expected("b < L/N_g"));
+        Ok(ZoneGrid {
+            n,
+            am,
+            ag,
+            z0,
+            i0,
+            i1,
+            nz: g1 - g0,
+        })
     }
-    let mut m = Model::default();
-    // The membrane's nodes, none strictly inside the zone.
-    let inside = |i: usize, j: usize| i0 < i && i < i1 && i0 < j && j < i1;
+
+    /// The membrane's grid node (i, j) lies strictly inside the zone.
+    fn inside(&self, i: usize, j: usize) -> bool {
+        let (i0, i1) = (self.i0, self.i1);
+        i0 < i && i < i1 && i0 < j && j < i1
+    }
+
+    /// The membrane's grid node (i, j) lies on the zone's edge.
+    fn on_zone_edge(&self, i: usize, j: usize) -> bool {
+        let (i0, i1) = (self.i0, self.i1);
+        (i0..=i1).contains(&i) && (i0..=i1).contains(&j) && !self.inside(i, j)
+    }
+}
+
+/// The next node and element ids.
+struct NextIds {
+    node: i64,
+    element: i64,
+}
+
+/// The membrane's nodes, none strictly inside the zone, and its quads around it; returns
+/// the grid's node indices (`usize::MAX` inside the zone).
+fn add_membrane_around_zone(
+    m: &mut Model,
+    p: &MembraneParams,
+    zg: &ZoneGrid,
+    ids: &mut NextIds,
+) -> Vec<usize> {
+    let (n, am, i0, i1) = (zg.n, zg.am, zg.i0, zg.i1);
     let mut grid = vec![usize::MAX; (n + 1) * (n + 1)];
-    let mut nid = 1i64;
     for j in 0..=n {
         for i in 0..=n {
-            if !inside(i, j) {
-                grid[j * (n + 1) + i] = m.add_node(nid, [i as f64 * am, j as f64 * am, 0.0]);
-                nid += 1;
+            if !zg.inside(i, j) {
+                grid[j * (n + 1) + i] = m.add_node(ids.node, [i as f64 * am, j as f64 * am, 0.0]);
+                ids.node += 1;
             }
         }
     }
     let part = m.add_part(1, "membrane", ElementKind::Quad, membrane_part(p));
-    let mut eid = 1i64;
     for j in 0..n {
         for i in 0..n {
             if (i0..i1).contains(&i) && (i0..i1).contains(&j) {
@@ -514,20 +743,26 @@ fn membrane_with_girder_zone(p: &MembraneParams, z: &GirderZone) -> Result<Model
             }
             let g = |i: usize, j: usize| grid[j * (n + 1) + i];
             m.add_element(
-                eid,
+                ids.element,
                 part,
                 &[g(i, j), g(i + 1, j), g(i + 1, j + 1), g(i, j + 1)],
             );
-            eid += 1;
+            ids.element += 1;
         }
     }
-    // The girder's nodes and rods, as `girder` builds them.
+    grid
+}
+
+/// The girder's nodes and rods inside the zone, as `girder` builds them (the rods on the
+/// zone's edges halved); returns the zone's nodes, row by row.
+fn add_zone_girder(m: &mut Model, z: &GirderZone, zg: &ZoneGrid, ids: &mut NextIds) -> Vec<usize> {
+    let (nz, ag, z0, b) = (zg.nz, zg.ag, zg.z0, z.rod_width);
     let w = nz + 1;
     let mut zone = Vec::with_capacity(w * w);
     for j in 0..=nz {
         for i in 0..=nz {
-            zone.push(m.add_node(nid, [z0 + i as f64 * ag, z0 + j as f64 * ag, 0.0]));
-            nid += 1;
+            zone.push(m.add_node(ids.node, [z0 + i as f64 * ag, z0 + j as f64 * ag, 0.0]));
+            ids.node += 1;
         }
     }
     let (kind, rho) = (
@@ -565,23 +800,33 @@ fn membrane_with_girder_zone(p: &MembraneParams, z: &GirderZone) -> Result<Model
             let edge = |k: usize| k == 0 || k == nz;
             if i < nz {
                 m.add_element(
-                    eid,
+                    ids.element,
                     if edge(j) { half } else { rods },
                     &[gid(i, j), gid(i + 1, j)],
                 );
-                eid += 1;
+                ids.element += 1;
             }
             if j < nz {
                 m.add_element(
-                    eid,
+                    ids.element,
                     if edge(i) { half } else { rods },
                     &[gid(i, j), gid(i, j + 1)],
                 );
-                eid += 1;
+                ids.element += 1;
             }
         }
     }
-    // Tie the zone's boundary to the hole's four sides.
+    zone
+}
+
+/// Tie the zone's boundary to the hole's four sides.
+fn tie_zone_to_membrane(
+    m: &mut Model,
+    zg: &ZoneGrid,
+    grid: &[usize],
+    zone: &[usize],
+) -> Result<()> {
+    let (n, am, i0, i1, nz) = (zg.n, zg.am, zg.i0, zg.i1, zg.nz);
     let side = |axis: usize, k: usize| -> (usize, f64, Vec<usize>) {
         let ns = (i0..=i1)
             .map(|t| {
@@ -598,44 +843,33 @@ fn membrane_with_girder_zone(p: &MembraneParams, z: &GirderZone) -> Result<Model
         hole_sides: vec![side(0, i0), side(0, i1), side(1, i0), side(1, i1)],
         outer: vec![],
     };
+    let gid = |i: usize, j: usize| zone[j * (nz + 1) + i];
     let boundary: Vec<usize> = (0..=nz)
         .flat_map(|j| (0..=nz).map(move |i| (i, j)))
         .filter(|&(i, j)| i == 0 || i == nz || j == 0 || j == nz)
         .map(|(i, j)| gid(i, j))
         .collect();
-    tie_to_hole(&mut m, &hole, &boundary)?;
-    if p.square.load_case == LoadCase::Transverse && nz % 2 != 0 {
-        return Err(WeftError::input(format!(
-            "the girder zone has {nz} cells per side: no node at its centre for the transverse load"
-        ))
-        .expected("an even number of girder cells across the zone")
-        .hint("choose --girder-cells (and --zone-length) so that N_g·L_m/L is even"));
-    }
+    tie_to_hole(m, &hole, &boundary)?;
+    Ok(())
+}
+
+/// Sets: the zone's nodes win where a membrane node coincides with one.
+fn insert_zone_sets(m: &mut Model, zg: &ZoneGrid, grid: &[usize], zone: &[usize]) {
+    let (n, nz) = (zg.n, zg.nz);
     let g = |i: usize, j: usize| grid[j * (n + 1) + i];
-    clamp_load_analysis(
-        &mut m,
-        &p.square,
-        p.youngs_modulus,
-        p.density,
-        false,
-        &g,
-        gid(nz / 2, nz / 2),
-    )?;
-    // Sets: the zone's nodes win where a membrane node coincides with one.
-    let on_zone_edge =
-        |i: usize, j: usize| (i0..=i1).contains(&i) && (i0..=i1).contains(&j) && !inside(i, j);
+    let gid = |i: usize, j: usize| zone[j * (nz + 1) + i];
     let mut reference: Vec<usize> = (0..=n)
         .flat_map(|j| (0..=n).map(move |i| (i, j)))
-        .filter(|&(i, j)| !inside(i, j) && !on_zone_edge(i, j))
+        .filter(|&(i, j)| !zg.inside(i, j) && !zg.on_zone_edge(i, j))
         .map(|(i, j)| g(i, j))
         .collect();
     reference.extend(zone.iter().copied());
     m.node_sets.insert("reference".into(), reference);
-    m.node_sets.insert("centre".into(), zone.clone());
+    m.node_sets.insert("centre".into(), zone.to_vec());
     m.node_sets
         .insert("axis_x".into(), (0..=n).map(|i| g(i, 0)).collect());
     let mut diagonal: Vec<usize> = (0..=n)
-        .filter(|&i| !inside(i, i) && !on_zone_edge(i, i))
+        .filter(|&i| !zg.inside(i, i) && !zg.on_zone_edge(i, i))
         .map(|i| g(i, i))
         .chain((0..=nz).map(|i| gid(i, i)))
         .collect();
@@ -643,17 +877,4 @@ fn membrane_with_girder_zone(p: &MembraneParams, z: &GirderZone) -> Result<Model
     m.node_sets.insert("diagonal".into(), diagonal);
     m.node_sets
         .insert("loaded_edge".into(), (0..=n).map(|j| g(n, j)).collect());
-    if p.square.load_case != LoadCase::Transverse {
-        for i in 0..m.num_nodes() {
-            m.constraints.push((i, [false, false, true]));
-        }
-        if z.rigid {
-            for &i in &zone {
-                m.rot_constraints.push((i, [true, true, false]));
-            }
-        }
-    }
-    m.validate()?;
-    resolve_pulse(&mut m)?;
-    Ok(m)
 }

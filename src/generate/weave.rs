@@ -6,7 +6,8 @@ use std::path::Path;
 use super::rod::{build, RodParams};
 use super::square::{girder, membrane, GirderParams, MembraneParams};
 use super::woven::{woven, WovenBandParams};
-use super::zones::{combined, woven_reduced, CombinedParams, WovenParams};
+use super::woven_reduced::{woven_reduced, WovenParams};
+use super::zones::{combined, CombinedParams};
 use crate::error::Result;
 use crate::model::io::write_model;
 use crate::model::Model;
@@ -24,7 +25,8 @@ pub enum Spec {
 }
 
 impl Spec {
-    /// The subcommand's name: `rod`, `girder`, `membrane`, `combined`, `woven-reduced`.
+    /// The subcommand's name: `rod`, `girder`, `membrane`, `combined`, `woven-reduced`,
+    /// `woven`.
     pub fn name(&self) -> &'static str {
         match self {
             Spec::Rod(_) => "rod",

@@ -1,272 +1,21 @@
-//! Coupled zones: a dense centre (a girder, a fine membrane, or the reduced woven patch)
-//! inside a coarse membrane whose elements grow with distance from the centre, joined by
-//! tied interfaces (the paper's §3–§5 models).
-//!
-//! The coarse membrane is a tensor-product grid of lines: uniform at spacing h_c across
-//! the centre, then growing by the ratio r out to the outer boundary, with the centre
-//! square [−c, c]² left as a hole. Every node of the dense zone on the hole's boundary is
-//! tied to the coarse edge it lies on, so no node hangs without a tie. With quarter
-//! symmetry the model is [0, ·]² with symmetry planes x = 0 and y = 0.
+//! Coupled zones: a dense centre (a girder or a fine membrane) inside the coarse graded
+//! membrane of [`super::surround`], whose elements grow with distance from the centre,
+//! joined by tied interfaces (the paper's §3–§4 models). The reduced woven patch of the
+//! paper's §5, built on the same surround, is in [`super::woven_reduced`], re-exported
+//! here under its old path.
 
 use serde::Serialize;
 
 use crate::error::{Result, WeftError};
-use crate::model::{
-    Analysis, ElementKind, Load, Model, PartProps, ProjectileShape, ProjectileSpec, SymmetryPlane,
-    Tie, TimeLaw,
+use crate::generate::pulse::resolve_pulse;
+use crate::generate::surround::{centre_line_sets, coarse_membrane, hold_outer_edge, tie_to_hole};
+pub use crate::generate::surround::{graded_lines, MembraneProps};
+pub use crate::generate::woven_reduced::{
+    woven_reduced, Interface, PretensionStart, SurroundParams, WovenParams,
 };
+use crate::model::{Analysis, ElementKind, Load, Model, PartProps, TimeLaw};
 
-/// The most mesh lines each way a graded zone may have (10⁶ elements at most).
-const MAX_LINES: usize = 1000;
-
-/// Line positions ≥ 0: uniform h_c up to `c`, then growing by `ratio` to `outer`.
-pub fn graded_lines(c: f64, hc: f64, outer: f64, ratio: f64) -> Result<Vec<f64>> {
-    if !(ratio >= 1.0 && ratio.is_finite()) {
-        return Err(WeftError::input(format!(
-            "the coarse cells' growth ratio (--growth) is {ratio}"
-        ))
-        .expected("a finite ratio ≥ 1 (1: uniform cells)"));
-    }
-    let flags = "the sizes come from --length (the outer size), --centre-length or --spacing \
-                 and --yarns (the centre), and --coarsening";
-    let n = (c / hc).round() as usize;
-    if !(c > 0.0 && c.is_finite() && hc > 0.0) || n == 0 || ((n as f64) * hc - c).abs() > 1e-9 * c {
-        return Err(WeftError::input(format!(
-            "the centre half-size {c} m is not a multiple of the coarse spacing {hc} m"
-        ))
-        .expected("a coarse spacing that divides the centre zone")
-        .hint(flags));
-    }
-    if !(outer > c && outer.is_finite()) {
-        return Err(WeftError::input(format!(
-            "outer half-size {outer} m is not larger than the centre half-size {c} m"
-        ))
-        .expected("outer > centre, finite")
-        .hint(flags));
-    }
-    let mut v: Vec<f64> = (0..=n).map(|k| k as f64 * hc).collect();
-    let (mut x, mut h) = (c, hc);
-    while x + h * ratio < outer - 0.5 * h * ratio {
-        h *= ratio;
-        x += h;
-        v.push(x);
-        if v.len() > MAX_LINES {
-            return Err(WeftError::input(format!(
-                "the graded mesh out to {outer} m would have more than {MAX_LINES} lines \
-                 each way"
-            ))
-            .expected("an outer size a few hundred centre cells across at most")
-            .hint(flags));
-        }
-    }
-    // The last cell ends on the boundary.
-    if (outer - x) > 1e-12 {
-        v.push(outer);
-    }
-    Ok(v)
-}
-
-/// Membrane properties for the coarse zone.
-#[derive(Debug, Clone, Serialize)]
-pub struct MembraneProps {
-    pub youngs_modulus: f64,
-    pub poisson_ratio: f64,
-    pub shear_modulus: f64,
-    pub thickness: f64,
-    pub density: f64,
-}
-
-impl MembraneProps {
-    fn part(&self) -> PartProps {
-        PartProps {
-            youngs_modulus_1: Some(self.youngs_modulus),
-            youngs_modulus_2: Some(self.youngs_modulus),
-            poisson_ratio_12: Some(self.poisson_ratio),
-            shear_modulus_12: Some(self.shear_modulus),
-            thickness: Some(self.thickness),
-            density: Some(self.density),
-            ..Default::default()
-        }
-    }
-}
-
-/// The coarse graded membrane with a hole; returns, for each side of the hole
-/// (x = c, y = c, and for a full model x = −c, y = −c), its boundary nodes ordered along it.
-pub(crate) struct Coarse {
-    /// (fixed coordinate axis, value, nodes ordered by the other coordinate)
-    pub(crate) hole_sides: Vec<(usize, f64, Vec<usize>)>,
-    /// Outer boundary nodes.
-    pub(crate) outer: Vec<usize>,
-}
-
-pub(crate) fn coarse_membrane(
-    m: &mut Model,
-    pos: &[f64],
-    quarter: bool,
-    c: f64,
-    props: &MembraneProps,
-    first_id: i64,
-) -> Coarse {
-    let lines: Vec<f64> = if quarter {
-        pos.to_vec()
-    } else {
-        pos.iter()
-            .rev()
-            .map(|x| -x)
-            .chain(pos[1..].iter().cloned())
-            .collect()
-    };
-    let k = lines.len();
-    let inside = |x: f64| x.abs() < c - 1e-12;
-    let mut used = vec![false; k * k];
-    let mut cells = vec![];
-    for j in 0..k - 1 {
-        for i in 0..k - 1 {
-            let (xm, ym) = (
-                0.5 * (lines[i] + lines[i + 1]),
-                0.5 * (lines[j] + lines[j + 1]),
-            );
-            if inside(xm) && inside(ym) {
-                continue;
-            }
-            cells.push((i, j));
-            for (a, b) in [(i, j), (i + 1, j), (i + 1, j + 1), (i, j + 1)] {
-                used[b * k + a] = true;
-            }
-        }
-    }
-    let mut idx = vec![usize::MAX; k * k];
-    let mut nid = first_id;
-    for j in 0..k {
-        for i in 0..k {
-            if used[j * k + i] {
-                idx[j * k + i] = m.add_node(nid, [lines[i], lines[j], 0.0]);
-                nid += 1;
-            }
-        }
-    }
-    let part = m.add_part(90, "coarse_membrane", ElementKind::Quad, props.part());
-    let mut eid = 1_000_000i64;
-    for (i, j) in cells {
-        m.add_element(
-            eid,
-            part,
-            &[
-                idx[j * k + i],
-                idx[j * k + i + 1],
-                idx[(j + 1) * k + i + 1],
-                idx[(j + 1) * k + i],
-            ],
-        );
-        eid += 1;
-    }
-    let near = |a: f64, b: f64| (a - b).abs() < 1e-9 * c.max(1e-12);
-    let mut hole_sides = vec![];
-    let sides: Vec<(usize, f64)> = if quarter {
-        vec![(0, c), (1, c)]
-    } else {
-        vec![(0, c), (1, c), (0, -c), (1, -c)]
-    };
-    for (axis, v) in sides {
-        let mut ns: Vec<usize> = (0..k * k)
-            .filter(|&q| idx[q] != usize::MAX)
-            .map(|q| idx[q])
-            .filter(|&n| {
-                near(m.coords[n][axis], v)
-                    && m.coords[n][1 - axis].abs() <= c + 1e-12
-                    && (!quarter || m.coords[n][1 - axis] >= -1e-12)
-            })
-            .collect();
-        ns.sort_by(|&a, &b| m.coords[a][1 - axis].total_cmp(&m.coords[b][1 - axis]));
-        hole_sides.push((axis, v, ns));
-    }
-    let lo = lines[0];
-    let hi = lines[k - 1];
-    let outer = (0..k * k)
-        .filter(|&q| idx[q] != usize::MAX)
-        .map(|q| idx[q])
-        .filter(|&n| {
-            let x = m.coords[n];
-            (!quarter && (near(x[0], lo) || near(x[1], lo))) || near(x[0], hi) || near(x[1], hi)
-        })
-        .collect();
-    Coarse { hole_sides, outer }
-}
-
-/// Pin the coarse zone's outer edge; a quarter model gets the symmetry planes x = 0, y = 0.
-fn hold_outer_edge(m: &mut Model, coarse: &Coarse, quarter: bool, length: f64) {
-    for &o in &coarse.outer {
-        m.constraints.push((o, [true, true, true]));
-    }
-    if quarter {
-        for normal in [0, 1] {
-            m.symmetry.push(SymmetryPlane {
-                normal,
-                position: 0.0,
-                tolerance: 1e-9 * length,
-            });
-        }
-    }
-}
-
-/// Tie every listed fine node lying on a hole side to the coarse edge it lies on.
-pub(crate) fn tie_to_hole(m: &mut Model, coarse: &Coarse, fine: &[usize]) -> Result<Vec<usize>> {
-    let mut tied = vec![];
-    for &f in fine {
-        let x = m.coords[f];
-        let mut done = false;
-        for (axis, v, ns) in &coarse.hole_sides {
-            if (x[*axis] - v).abs() > 1e-9 * v.abs().max(1e-12) {
-                continue;
-            }
-            let s = x[1 - axis];
-            let k = ns.windows(2).position(|w| {
-                m.coords[w[0]][1 - axis] <= s + 1e-12 && s <= m.coords[w[1]][1 - axis] + 1e-12
-            });
-            if let Some(k) = k {
-                m.ties.push(Tie {
-                    slave: f,
-                    masters: vec![ns[k], ns[k + 1]],
-                });
-                tied.push(f);
-                done = true;
-                break;
-            }
-        }
-        if !done {
-            return Err(WeftError::input(format!(
-                "node `{}` at {:?} is on no side of the coarse zone's hole",
-                m.node_id[f], x
-            ))
-            .expected("the dense zone's boundary on the coarse grid's hole"));
-        }
-    }
-    Ok(tied)
-}
-
-/// `axis_x` (y = 0) and `diagonal` (x = y), ordered by x: the dense zone's nodes inside
-/// the centre square of half-size c, the coarse zone's beyond it (where both have a node
-/// on the hole boundary, the dense zone's).
-fn centre_line_sets(m: &mut Model, dense: &[usize], c: f64) {
-    let dense_set: std::collections::HashSet<usize> = dense.iter().copied().collect();
-    let cand: Vec<usize> = (0..m.num_nodes())
-        .filter(|&n| {
-            let x = m.coords[n];
-            dense_set.contains(&n) || x[0].abs() > c + 1e-12 || x[1].abs() > c + 1e-12
-        })
-        .collect();
-    let mut set = |name: &str, on: &dyn Fn(&[f64; 3]) -> bool| {
-        let mut v: Vec<usize> = cand.iter().copied().filter(|&n| on(&m.coords[n])).collect();
-        v.sort_by(|&a, &b| m.coords[a][0].total_cmp(&m.coords[b][0]));
-        v.dedup_by(|a, b| (m.coords[*a][0] - m.coords[*b][0]).abs() < 1e-12);
-        m.node_sets.insert(name.into(), v);
-    };
-    set("axis_x", &|x| x[1].abs() < 1e-12 && x[0] >= -1e-12);
-    set("diagonal", &|x| {
-        (x[0] - x[1]).abs() < 1e-12 && x[0] >= -1e-12
-    });
-}
-
+/// The dense centre zone of [`combined`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, clap::ValueEnum)]
 #[serde(rename_all = "lowercase")]
 pub enum Centre {
@@ -302,6 +51,109 @@ pub struct CombinedParams {
     pub pulse: f64,
     pub end_time: f64,
     pub output_interval: f64,
+}
+
+/// `combined` as asked for (the flags of `weft-weave combined`): the values left `None`
+/// follow from the others in [`CombinedOptions::resolve`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct CombinedOptions {
+    pub centre: Centre,
+    /// Side of the dense centre zone L_m [m].
+    pub centre_length: f64,
+    /// Cells across the centre zone (even).
+    pub centre_cells: usize,
+    /// Side of the whole model L [m].
+    pub length: f64,
+    /// Coarse cell size at the centre, in centre cells.
+    pub coarsening: usize,
+    /// Growth ratio of the coarse cells.
+    pub growth: f64,
+    pub quarter: bool,
+    /// Girder: E [Pa] (also the membrane's) and ρ [kg/m³].
+    pub youngs_modulus: f64,
+    pub density: f64,
+    /// Girder rod width = thickness b [m]; `None`: a/10, a = L_m/(cells) the centre cell.
+    pub rod_width: Option<f64>,
+    /// Membrane shear modulus G [Pa], thickness s [m], density [kg/m³]; `None`: those of
+    /// the centre girder's closed-form equivalent, E(b/a)²/2, b²/a, ρ(2 − b/a).
+    pub shear_modulus: Option<f64>,
+    pub thickness: Option<f64>,
+    pub membrane_density: Option<f64>,
+    /// Transverse force at the centre [N] (the full model's).
+    pub force: f64,
+    /// Pulse duration T_F [s]; `None`: L_m·√(ρ/E).
+    pub pulse: Option<f64>,
+    /// End time [s]; `None`: L/2·√(ρ/E)·4.
+    pub end_time: Option<f64>,
+    /// Output interval [s]; `None`: end time / 100.
+    pub output_interval: Option<f64>,
+}
+
+impl Default for CombinedOptions {
+    /// A steel girder zone of 20 cells across 20 mm in a quarter of a 0.1 m square, the
+    /// coarse cells two centre cells wide at the zone and growing by 1.25, a 1 N force.
+    fn default() -> Self {
+        CombinedOptions {
+            centre: Centre::Girder,
+            centre_length: 0.02,
+            centre_cells: 20,
+            length: 0.1,
+            coarsening: 2,
+            growth: 1.25,
+            quarter: true,
+            youngs_modulus: 1.5e11,
+            density: 7800.0,
+            rod_width: None,
+            shear_modulus: None,
+            thickness: None,
+            membrane_density: None,
+            force: 1.0,
+            pulse: None,
+            end_time: None,
+            output_interval: None,
+        }
+    }
+}
+
+impl CombinedOptions {
+    /// The parameters, what is `None` derived: the rod width from the centre cell, the
+    /// membrane as the centre girder's closed-form equivalent (ν = 0), the pulse and the
+    /// times from the wave's transit.
+    pub fn resolve(&self) -> CombinedParams {
+        let cell = self.centre_length / self.centre_cells.max(1) as f64;
+        let b = self.rod_width.unwrap_or(cell / 10.0);
+        let c = self.length * 0.5 * (self.density / self.youngs_modulus).sqrt();
+        let end = self.end_time.unwrap_or(4.0 * c);
+        CombinedParams {
+            centre: self.centre,
+            centre_length: self.centre_length,
+            centre_cells: self.centre_cells,
+            length: self.length,
+            coarsening: self.coarsening,
+            growth: self.growth,
+            quarter: self.quarter,
+            youngs_modulus: self.youngs_modulus,
+            density: self.density,
+            rod_width: b,
+            membrane: MembraneProps {
+                youngs_modulus: self.youngs_modulus,
+                poisson_ratio: 0.0,
+                shear_modulus: self
+                    .shear_modulus
+                    .unwrap_or(self.youngs_modulus * (b / cell).powi(2) / 2.0),
+                thickness: self.thickness.unwrap_or(b * b / cell),
+                density: self
+                    .membrane_density
+                    .unwrap_or(self.density * (2.0 - b / cell)),
+            },
+            force: self.force,
+            pulse: self
+                .pulse
+                .unwrap_or(self.centre_length * (self.density / self.youngs_modulus).sqrt()),
+            end_time: end,
+            output_interval: self.output_interval.unwrap_or(end / 100.0),
+        }
+    }
 }
 
 pub fn combined(p: &CombinedParams) -> Result<Model> {
@@ -431,624 +283,6 @@ pub fn combined(p: &CombinedParams) -> Result<Model> {
         ..Default::default()
     };
     m.validate()?;
-    crate::generate::square::resolve_pulse(&mut m)?;
+    resolve_pulse(&mut m)?;
     Ok(m)
-}
-
-/// The equivalent membrane around the reduced woven patch, from the paper's §3 ratios to
-/// the yarns: the membrane's properties follow the yarn parameters (the woven patch's
-/// surface density 2ρA/p, the yarn modulus E_y).
-#[derive(Debug, Clone, Serialize)]
-pub struct SurroundParams {
-    /// Surface density of the membrane / surface density of the woven patch, ρ_m s/(2ρA/p)
-    /// [–] (the paper's §3: 0.8).
-    pub density_ratio: f64,
-    /// Young's modulus of the membrane / Young's modulus of the yarn, E_m/E_y [–] (the
-    /// paper's §3: 0.3).
-    pub modulus_ratio: f64,
-    /// Shear modulus of the membrane / its Young's modulus, G_m/E_m [–] (the paper's §3:
-    /// 0.0042).
-    pub shear_ratio: f64,
-    /// Poisson's ratio ν of the (isotropic in-plane) membrane [–] (0: the woven patch's
-    /// yarn families do not couple).
-    pub poisson_ratio: f64,
-    /// Membrane thickness s [m]; `None`: 2A/p, the yarns' material spread over the
-    /// spacing (the thickness only sets ρ_m = ratio·(2ρA/p)/s: s ρ_m and s E_m are what
-    /// the membrane's waves see).
-    pub thickness: Option<f64>,
-}
-
-impl SurroundParams {
-    /// The paper's §3 ratios: 0.8, 0.3, 0.0042; ν = 0; s = 2A/p.
-    pub fn paper() -> SurroundParams {
-        SurroundParams {
-            density_ratio: 0.8,
-            modulus_ratio: 0.3,
-            shear_ratio: 0.0042,
-            poisson_ratio: 0.0,
-            thickness: None,
-        }
-    }
-}
-
-/// How a pretensioned reduced model starts.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, clap::ValueEnum)]
-#[serde(rename_all = "lowercase")]
-pub enum PretensionStart {
-    /// In equilibrium: the yarns carry E·A·ε₀ and the surrounding membrane the same
-    /// tension per unit length, N = E·A·ε₀/p in both directions, as an initial stress N/s
-    /// (a uniformly pre-stressed sheet held at its outer edge), so that the yarn ends
-    /// pull on a membrane that pulls back as much. Exact for straight yarns (no crimp).
-    Balanced,
-    /// Balanced, then relaxed: the crimped crossings, which a pretension presses against
-    /// their links, settle by dynamic relaxation (local damping, `Solver::relax`, the
-    /// projectile set aside, the links' sliders held stuck so that the start owes
-    /// nothing to a slip the run would not inherit, and unilateral normals relaxed as
-    /// two-way springs, then checked to be all in compression, where the two laws
-    /// agree: the kink at contact made the damped relaxation chatter without
-    /// converging, measured), and the settled positions become the model's initial
-    /// displacements u₀. For crimped yarns.
-    Relaxed,
-    /// The yarns alone pre-strained (the membrane unstressed): an unbalanced start that
-    /// pulls the membrane in and rings (the behaviour before the fix, kept to compare).
-    Unbalanced,
-}
-
-/// How the relaxed start ([`PretensionStart::Relaxed`]) is stopped. Why these: the
-/// crossings settle in a few hundred steps (their link springs are the model's stiffest
-/// parts, and set the step); the test window of 200 steps and the free rest probe of
-/// 2000 steps (≈ 10 µs at the default model's 5 ns step, long against a crossing's
-/// period ≈ 30 ns) are far longer.
-const RELAX_MAX_STEPS: u64 = 1_000_000;
-const RELAX_CHECK_EVERY: u64 = 200;
-const RELAX_PROBE_STEPS: u64 = 2000;
-/// Residual force ≤ 10⁻⁴ of the yarn tension E·A·ε₀; kinetic energy ≤ 10⁻⁸ of the work
-/// the relaxation took; left alone at rest, no node moves more than 10⁻³ of the crimp.
-const RELAX_FORCE_TOLERANCE: f64 = 1e-4;
-const RELAX_KINETIC_TOLERANCE: f64 = 1e-8;
-const RELAX_CREEP_TOLERANCE: f64 = 1e-3;
-
-/// Where the reduced patch meets its membrane surround.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, clap::ValueEnum)]
-#[serde(rename_all = "kebab-case")]
-pub enum Interface {
-    /// On the last crossing line (x = c = np): the yarns along it are halved (the membrane
-    /// carries the other half of their strip) and its crossings lie flat on the membrane.
-    Crossing,
-    /// As the yarn-level patch tied by `woven --membrane-length`: every crossing line
-    /// 0 … np a full yarn (halved only on a symmetry plane), crimped, and the rods run on
-    /// half a spacing past the last crossing to the membrane's edge at c = (n + ½)p, where
-    /// their ends are tied; the membrane's cells there are p/2 wide. Quarter models only.
-    BandEnds,
-}
-
-/// `woven-reduced`: the reduced woven model of the paper's §5.
-#[derive(Debug, Clone, Serialize)]
-pub struct WovenParams {
-    /// Yarns per side of the full patch (even).
-    pub yarns: usize,
-    /// Yarn spacing p [m].
-    pub spacing: f64,
-    /// Yarn: E [Pa], ρ [kg/m³], cross-section area [m²], tension only.
-    pub yarn_modulus: f64,
-    pub yarn_density: f64,
-    pub yarn_area: f64,
-    pub tension_only: bool,
-    /// Initial yarn strain (pretension) ε₀.
-    pub pretension_strain: f64,
-    /// How a pretensioned model starts (ignored when ε₀ = 0).
-    pub pretension_start: PretensionStart,
-    /// Crimp: z offset ± of warp and weft nodes at the crossings [m].
-    pub crimp: f64,
-    /// Links: k_x = k_y, k_z [N/m], c_x, c_y, c_z [N·s/m], slip force [N] (None: none).
-    pub k_xy: f64,
-    pub k_z: f64,
-    pub c_xy: f64,
-    pub c_z: f64,
-    pub slip_force: Option<f64>,
-    /// Coulomb friction coefficient μ of the links (slip at μ·N, N the normal spring's
-    /// compressive force) [–]; `None`: none. Not with `slip_force`.
-    pub friction: Option<f64>,
-    /// The links' normal spring pushes the yarns apart and never pulls them together.
-    pub unilateral: bool,
-    /// The links act in the crossing's local frame (the two yarn directions and their
-    /// normal, following the fabric) instead of global x, y, z.
-    pub local_frame: bool,
-    /// The links' ends slide along their yarns when the links slip
-    /// ([`crate::solver::sliding_link`]), in the frame of the yarns' tangents there.
-    pub sliding: bool,
-    /// Whole model side [m], coarse membrane growth ratio, quarter symmetry.
-    pub length: f64,
-    pub growth: f64,
-    pub quarter: bool,
-    /// Where the patch meets the membrane.
-    pub interface: Interface,
-    /// The equivalent membrane around the patch, relative to the yarns.
-    pub surround: SurroundParams,
-    /// Projectile: flat-nosed by default.
-    pub projectile_shape: ProjectileShape,
-    pub projectile_radius: f64,
-    pub projectile_mass: f64,
-    pub projectile_velocity: f64,
-    /// Projectile–yarn Coulomb friction μ (0: frictionless, the paper's reduced model).
-    pub projectile_friction: f64,
-    pub end_time: f64,
-    pub output_interval: f64,
-    /// Safety factor on the stable step [–], 0 < f ≤ 1 (the model's `dt_safety`; 0.9 by
-    /// default): the projectile's contact penalty is κ m*/Δt².
-    pub dt_safety: f64,
-}
-
-impl WovenParams {
-    /// The paper's §5 model (DESIGN.md §1, §9): aramid yarns 1 mm apart (E = 80 GPa,
-    /// ρ = 1440 kg/m³, 190 g/m² together: A = 6.6·10⁻⁸ m² per yarn), links at the fitted
-    /// k_x = k_y = 3.8661·10⁶ N/m, k_z = 5.2448·10⁹ N/m (the paper's N/mm values, its
-    /// exponents corrected), a 9 mm, 8 g flat-nosed projectile at 400 m/s; the equivalent
-    /// membrane from the paper's §3 ratios ([`SurroundParams::paper`]).
-    pub fn paper() -> WovenParams {
-        WovenParams {
-            yarns: 20,
-            spacing: 1e-3,
-            yarn_modulus: 80e9,
-            yarn_density: 1440.0,
-            yarn_area: 6.6e-8,
-            tension_only: true,
-            pretension_strain: 0.0,
-            pretension_start: PretensionStart::Balanced,
-            crimp: 0.0,
-            k_xy: 3.8661e6,
-            k_z: 5.2448e9,
-            c_xy: 0.0,
-            c_z: 0.0,
-            slip_force: None,
-            friction: None,
-            unilateral: false,
-            local_frame: false,
-            sliding: false,
-            length: 0.1,
-            growth: 1.25,
-            quarter: true,
-            interface: Interface::Crossing,
-            surround: SurroundParams::paper(),
-            projectile_shape: ProjectileShape::Flat,
-            projectile_radius: 4.5e-3,
-            projectile_mass: 8e-3,
-            projectile_velocity: 400.0,
-            projectile_friction: 0.0,
-            end_time: 5e-5,
-            output_interval: 1e-6,
-            dt_safety: 0.9,
-        }
-    }
-
-    /// Surface density of the woven patch, 2ρA/p [kg/m²]: two yarn families, one yarn of
-    /// section A per spacing p each.
-    pub fn patch_surface_density(&self) -> f64 {
-        2.0 * self.yarn_density * self.yarn_area / self.spacing
-    }
-
-    /// The surrounding membrane's properties from the yarns and the ratios of
-    /// [`SurroundParams`]: s (2A/p unless given), ρ_m = r_ρ (2ρA/p)/s, E_m = r_E E_y,
-    /// G_m = r_G E_m.
-    pub fn membrane(&self) -> MembraneProps {
-        let r = &self.surround;
-        let s = r.thickness.unwrap_or(2.0 * self.yarn_area / self.spacing);
-        let e_m = r.modulus_ratio * self.yarn_modulus;
-        MembraneProps {
-            youngs_modulus: e_m,
-            poisson_ratio: r.poisson_ratio,
-            shear_modulus: r.shear_ratio * e_m,
-            thickness: s,
-            density: r.density_ratio * self.patch_surface_density() / s,
-        }
-    }
-
-    /// Yarn tension per unit width of the patch at the pretension, N = E A ε₀/p [N/m].
-    pub fn pretension_per_width(&self) -> f64 {
-        self.yarn_modulus * self.yarn_area * self.pretension_strain / self.spacing
-    }
-
-    fn check(&self) -> Result<()> {
-        if self.yarns < 2 || !self.yarns.is_multiple_of(2) {
-            return Err(WeftError::input(format!("--yarns = `{}`", self.yarns))
-                .expected("an even number ≥ 2 (a crossing at the centre)"));
-        }
-        if self.interface == Interface::BandEnds && !self.quarter {
-            return Err(
-                WeftError::input("--interface band-ends with --full".to_string())
-                    .expected("a quarter model (the band ends of a full patch lie on both sides)")
-                    .hint("leave out --full, or use --interface crossing"),
-            );
-        }
-        let r = &self.surround;
-        let mut positive = vec![
-            ("spacing", "m", self.spacing),
-            ("yarn-modulus", "Pa", self.yarn_modulus),
-            ("yarn-density", "kg/m³", self.yarn_density),
-            ("yarn-area", "m²", self.yarn_area),
-            ("k-z", "N/m", self.k_z),
-            ("k-xy", "N/m", self.k_xy),
-            ("membrane-density-ratio", "", r.density_ratio),
-            ("membrane-modulus-ratio", "", r.modulus_ratio),
-            ("membrane-shear-ratio", "", r.shear_ratio),
-        ];
-        if let Some(t) = r.thickness {
-            positive.push(("membrane-thickness", "m", t));
-        }
-        for (n, unit, v) in positive {
-            if !(v > 0.0 && v.is_finite()) {
-                return Err(WeftError::input(format!("--{n} = `{v}`")).expected(format!(
-                    "a value > 0{}",
-                    if unit.is_empty() {
-                        String::new()
-                    } else {
-                        format!(" in {unit}")
-                    }
-                )));
-            }
-        }
-        let nu = r.poisson_ratio;
-        if !(nu > -1.0 && nu < 1.0) {
-            return Err(WeftError::input(format!("--membrane-poisson = `{nu}`"))
-                .expected("−1 < ν < 1 (an isotropic membrane, ν² < 1)"));
-        }
-        if !(self.dt_safety > 0.0 && self.dt_safety <= 1.0) {
-            return Err(
-                WeftError::input(format!("--dt-safety = `{}`", self.dt_safety))
-                    .expected("a safety factor 0 < f ≤ 1 on the stable step"),
-            );
-        }
-        let pf = self.projectile_friction;
-        if !(pf >= 0.0 && pf.is_finite()) {
-            return Err(WeftError::input(format!("--projectile-friction = `{pf}`"))
-                .expected("a Coulomb coefficient μ ≥ 0"));
-        }
-        if let Some(mu) = self.friction {
-            if !(mu >= 0.0 && mu.is_finite()) {
-                return Err(WeftError::input(format!("--link-friction = `{mu}`"))
-                    .expected("a Coulomb coefficient μ ≥ 0"));
-            }
-            if let Some(f) = self.slip_force {
-                return Err(WeftError::input(format!(
-                    "--link-friction = `{mu}` and --slip-force = `{f}` together"
-                ))
-                .expected("one slip law: Coulomb friction μ·N or a constant slip force")
-                .hint("drop one of the two"));
-            }
-        }
-        Ok(())
-    }
-}
-
-pub fn woven_reduced(p: &WovenParams) -> Result<Model> {
-    p.check()?;
-    let membrane = p.membrane();
-    let ends = p.interface == Interface::BandEnds;
-    let (n, x0) = if p.quarter {
-        (p.yarns / 2, 0.0)
-    } else {
-        (p.yarns, -0.5 * p.yarns as f64 * p.spacing)
-    };
-    // The membrane's hole: the last crossing line, or half a spacing past it (band ends,
-    // where the membrane's first cells are p/2 wide, as around the yarn-level patch).
-    let (c, hc) = if ends {
-        ((n as f64 + 0.5) * p.spacing, 0.5 * p.spacing)
-    } else {
-        (0.5 * p.yarns as f64 * p.spacing, p.spacing)
-    };
-    let pos = graded_lines(c, hc, 0.5 * p.length, p.growth)?;
-    let mut m = Model::default();
-    let w = n + 1;
-    let mut warp = vec![];
-    let mut weft = vec![];
-    // The warp lies over the weft where (i + j) is even (plain weave).
-    let warp_on_top = |i: usize, j: usize| (i + j).is_multiple_of(2);
-    for j in 0..=n {
-        for i in 0..=n {
-            let (x, y) = (x0 + i as f64 * p.spacing, x0 + j as f64 * p.spacing);
-            let boundary = !ends && ((x.abs() - c).abs() < 1e-12 || (y.abs() - c).abs() < 1e-12);
-            // Plain weave: the warp passes over and under alternately; flat on the boundary.
-            let z = if boundary {
-                0.0
-            } else if warp_on_top(i, j) {
-                p.crimp
-            } else {
-                -p.crimp
-            };
-            warp.push(m.add_node((2 * (j * w + i) + 1) as i64, [x, y, z]));
-            weft.push(m.add_node((2 * (j * w + i) + 2) as i64, [x, y, -z]));
-        }
-    }
-    // Band ends: the warp on y = jp ends at (c, jp), the weft on x = ip at (ip, c), on the
-    // membrane's plane z = 0 (where the yarn-level bands' crimp cos(πx/p) is zero).
-    let (mut warp_end, mut weft_end) = (vec![], vec![]);
-    if ends {
-        let first = 2 * (w * w) as i64;
-        for k in 0..=n {
-            let t = k as f64 * p.spacing;
-            warp_end.push(m.add_node(first + 1 + k as i64, [c, t, 0.0]));
-            weft_end.push(m.add_node(first + 1 + (w + k) as i64, [t, c, 0.0]));
-        }
-    }
-    // Yarn nodes along the warp j (i = n + 1: its end) and the weft i (j = n + 1).
-    let warp_at = |i: usize, j: usize| if i > n { warp_end[j] } else { warp[j * w + i] };
-    let weft_at = |i: usize, j: usize| if j > n { weft_end[i] } else { weft[j * w + i] };
-    let yarn = m.add_part(
-        1,
-        "yarns",
-        ElementKind::Truss,
-        PartProps {
-            youngs_modulus: Some(p.yarn_modulus),
-            density: Some(p.yarn_density),
-            area: Some(p.yarn_area),
-            tension_only: Some(p.tension_only),
-            prestrain: (p.pretension_strain != 0.0).then_some(p.pretension_strain),
-            ..Default::default()
-        },
-    );
-    let link = m.add_part(
-        2,
-        "crossings",
-        ElementKind::Link,
-        PartProps {
-            kx: Some(p.k_xy),
-            ky: Some(p.k_xy),
-            kz: Some(p.k_z),
-            cx: Some(p.c_xy),
-            cy: Some(p.c_xy),
-            cz: Some(p.c_z),
-            slip_force: p.slip_force,
-            friction: p.friction,
-            unilateral: p.unilateral.then_some(true),
-            local_frame: p.local_frame.then_some(true),
-            sliding: p.sliding.then_some(true),
-            ..Default::default()
-        },
-    );
-    // The yarns on the lines that bound the patch carry half a yarn: on a symmetry plane
-    // (x = 0, y = 0 of a quarter) the other half belongs to the neighbouring quarter; on
-    // the interface (x = ±c, y = ±c) the membrane carries the other half (each yarn
-    // stands for a strip of width p, and the membrane starts at the line). Half the
-    // area halves the mass, the axial stiffness and the pretension force alike.
-    let half_yarn = m.add_part(
-        3,
-        "half_yarns",
-        ElementKind::Truss,
-        PartProps {
-            area: Some(0.5 * p.yarn_area),
-            ..m.parts[yarn].props.clone()
-        },
-    );
-    // In a quarter model, what lies on a symmetry plane is shared with the neighbouring
-    // quarter: the links on one plane get half, the centre link a quarter of their
-    // stiffness, damping and slip force (the friction coefficient is a ratio: the halved
-    // normal stiffness halves N and so the slip force).
-    let scaled = |f: f64, base: &PartProps| PartProps {
-        kx: base.kx.map(|v| v * f),
-        ky: base.ky.map(|v| v * f),
-        kz: base.kz.map(|v| v * f),
-        cx: base.cx.map(|v| v * f),
-        cy: base.cy.map(|v| v * f),
-        cz: base.cz.map(|v| v * f),
-        slip_force: base.slip_force.map(|v| v * f),
-        ..base.clone()
-    };
-    let (half_link, quarter_link) = if p.quarter {
-        let lp = m.parts[link].props.clone();
-        (
-            m.add_part(
-                4,
-                "crossings_on_symmetry",
-                ElementKind::Link,
-                scaled(0.5, &lp),
-            ),
-            m.add_part(5, "centre_crossing", ElementKind::Link, scaled(0.25, &lp)),
-        )
-    } else {
-        (link, link)
-    };
-    // Halved: the yarns on a symmetry plane, and (crossing interface) those on the
-    // interface lines; with band ends the last crossing line is a full yarn.
-    let on_line = |k: usize| k == 0 || (k == n && !ends);
-    let last = if ends { n + 1 } else { n };
-    let mut eid = 1;
-    for j in 0..=n {
-        for i in 0..=n {
-            let k = j * w + i;
-            if i < last {
-                m.add_element(
-                    eid,
-                    if on_line(j) { half_yarn } else { yarn },
-                    &[warp_at(i, j), warp_at(i + 1, j)],
-                );
-                eid += 1;
-            }
-            if j < last {
-                m.add_element(
-                    eid,
-                    if on_line(i) { half_yarn } else { yarn },
-                    &[weft_at(i, j), weft_at(i, j + 1)],
-                );
-                eid += 1;
-            }
-            let lk = match (p.quarter && i == 0, p.quarter && j == 0) {
-                (true, true) => quarter_link,
-                (true, false) | (false, true) => half_link,
-                _ => link,
-            };
-            // Node 1 the lower yarn, node 2 the upper: the link's normal points from
-            // node 1 to node 2, so that d_z < 0 presses them together (the unilateral
-            // spring and Coulomb friction read it).
-            let pair = if warp_on_top(i, j) {
-                [weft[k], warp[k]]
-            } else {
-                [warp[k], weft[k]]
-            };
-            if p.local_frame {
-                // The frame: e₁ along the warp (the chord of its neighbours at i ∓ 1), the
-                // normal ⟂ the weft (neighbours at j ∓ 1). At k = 0 (a symmetry plane, or
-                // the interface of a full model) the chord to k + 2, at the same crimp
-                // height: the mirrored neighbour's chord, level as symmetry asks (a
-                // one-sided chord to k + 1 would tilt the normal by 2a/p and read the
-                // crimp's pressure as a pull there, measured); at k = n the chord to n − 1
-                // (those crossings are tied to the membrane), or with band ends the chord
-                // from n − 1 to the band's end.
-                let chord = |k: usize| match k {
-                    0 => (0, 2.min(last)),
-                    k if k == last => (k - 1, k),
-                    k => (k - 1, k + 1),
-                };
-                let ((ia, ib), (ja, jb)) = (chord(i), chord(j));
-                m.add_link_with_frame(
-                    eid,
-                    lk,
-                    &pair,
-                    [
-                        warp_at(ia, j),
-                        warp_at(ib, j),
-                        weft_at(i, ja),
-                        weft_at(i, jb),
-                    ],
-                );
-            } else {
-                m.add_element(eid, lk, &pair);
-            }
-            eid += 1;
-        }
-    }
-    let coarse = coarse_membrane(&mut m, &pos, p.quarter, c, &membrane, 1_000_000);
-    if p.pretension_strain != 0.0 && p.pretension_start == PretensionStart::Balanced {
-        // The membrane carries the yarns' tension per unit width as a uniform initial
-        // stress in both directions: in equilibrium with the yarn ends tied to its hole
-        // (a yarn of tension E A ε₀ per strip of width p; half yarns on the lines).
-        let s0 = p.pretension_per_width() / membrane.thickness;
-        let b = m
-            .elements
-            .get_mut(&ElementKind::Quad)
-            .expect("the coarse membrane");
-        b.stress0 = vec![[s0, s0, 0.0]; b.len()];
-    }
-    // Every yarn node on the patch boundary (the yarn ends and the nodes of the yarns
-    // that run along it) is tied to the membrane edge it lies on.
-    let on_boundary: Vec<usize> = warp
-        .iter()
-        .chain(weft.iter())
-        .chain(warp_end.iter())
-        .chain(weft_end.iter())
-        .copied()
-        .filter(|&n| {
-            let x = m.coords[n];
-            (x[0].abs() - c).abs() < 1e-12 || (x[1].abs() - c).abs() < 1e-12
-        })
-        .collect();
-    let interface = tie_to_hole(&mut m, &coarse, &on_boundary)?;
-    hold_outer_edge(&mut m, &coarse, p.quarter, p.length);
-    let share = if p.quarter { 0.25 } else { 1.0 };
-    m.projectiles.push(ProjectileSpec {
-        id: 1,
-        shape: p.projectile_shape,
-        radius: p.projectile_radius,
-        length: 2.0 * p.projectile_radius,
-        mass: share * p.projectile_mass,
-        tip: [0.0, 0.0, p.crimp + 1e-5],
-        axis: [0.0, 0.0, -1.0],
-        velocity: [0.0, 0.0, -p.projectile_velocity],
-        prescribed_velocity: false,
-        contact_stiffness: None,
-        friction: p.projectile_friction,
-        segment_contact: true,
-    });
-    m.node_sets.insert("reference".into(), warp.clone());
-    m.node_sets.insert("interface".into(), interface);
-    centre_line_sets(&mut m, &warp, c);
-    m.analysis = Analysis {
-        end_time: p.end_time,
-        output_interval: p.output_interval,
-        dt_safety: p.dt_safety,
-        ..Default::default()
-    };
-    m.validate()?;
-    if p.pretension_strain != 0.0 && p.pretension_start == PretensionStart::Relaxed {
-        relax_start(&mut m, p)?;
-    }
-    Ok(m)
-}
-
-/// The relaxed start: relax a copy of the model (no projectile, link sliders stuck) and
-/// write its equilibrium as the initial displacements.
-fn relax_start(m: &mut Model, p: &WovenParams) -> Result<()> {
-    let mut r = m.clone();
-    r.projectiles.clear();
-    for part in r.parts.iter_mut().filter(|q| q.kind == ElementKind::Link) {
-        part.props.slip_force = None;
-        part.props.friction = None;
-        part.props.unilateral = None;
-    }
-    let mut solver = crate::solver::Solver::new(&r)?;
-    let tension = p.yarn_modulus * p.yarn_area * p.pretension_strain.abs();
-    let stats = solver.relax(
-        &crate::solver::relax::RelaxOptions {
-            max_steps: RELAX_MAX_STEPS,
-            min_steps: RELAX_CHECK_EVERY,
-            check_every: RELAX_CHECK_EVERY,
-            alpha: 0.8,
-            kinetic_tolerance: RELAX_KINETIC_TOLERANCE,
-            force_tolerance: RELAX_FORCE_TOLERANCE,
-            force_scale: tension,
-            creep_window: RELAX_PROBE_STEPS,
-            creep_tolerance: RELAX_CREEP_TOLERANCE * p.crimp.abs().max(p.spacing * 1e-3),
-            work_offset: 0.0,
-            contact_damping: 0.0,
-            hold_in_rest_test: vec![],
-            probe_first: false,
-        },
-        &mut |_| {},
-    )?;
-    if !stats.converged {
-        return Err(WeftError::input(format!(
-            "the pretensioned model did not settle in {} steps (residual force {:.3e} N of the yarn tension {tension:.3e} N; a free node moved {:.3e} m at rest)",
-            stats.steps, stats.residual, stats.creep
-        ))
-        .expected("an equilibrium of the crimped crossings under the pretension")
-        .hint("check --crimp and --k-z, or start with --pretension-start balanced"));
-    }
-    // A unilateral link found pulling at the equilibrium would let go at the start.
-    if let Some(b) = m.block(ElementKind::Link) {
-        // The solver's three link families keep the table's order within each.
-        let el = &solver.op.el;
-        let (plain, framed, sliding) = (&el.link, &el.framed_link, &el.sliding_link);
-        let (mut ip, mut ifr, mut isl) = (0, 0, 0);
-        for e in 0..b.len() {
-            let props = &m.parts[b.part[e]].props;
-            let f = if props.sliding == Some(true) {
-                isl += 1;
-                sliding.normal_spring_force(isl - 1, &solver.state.x)
-            } else if props.local_frame == Some(true) {
-                ifr += 1;
-                framed.normal_spring_force(ifr - 1, &solver.state.x)
-            } else {
-                ip += 1;
-                plain.normal_spring_force(ip - 1, &solver.state.x)
-            };
-            if props.unilateral != Some(true) {
-                continue;
-            }
-            if f < -RELAX_FORCE_TOLERANCE * tension {
-                return Err(WeftError::input(format!(
-                    "unilateral link `{}` pulls its yarns together with {:.3e} N at the relaxed equilibrium",
-                    b.id[e], -f
-                ))
-                .expected("every unilateral link in compression at the pretensioned equilibrium")
-                .hint("a crossing whose yarns separate under the pretension: use two-way links, or --pretension-start balanced"));
-            }
-        }
-    }
-    m.initial_displacement = solver
-        .state
-        .x
-        .iter()
-        .zip(&m.coords)
-        .map(|(x, x0)| [x[0] - x0[0], x[1] - x0[1], x[2] - x0[2]])
-        .collect();
-    m.validate()
 }

@@ -1,0 +1,345 @@
+//! `woven`: the yarn-level plain-weave patch (the paper's §2 reference model; Barauskas &
+//! Abraitienė, IJIE 34(7), 2007): every yarn a band of orthotropic membrane quads whose
+//! nodal thickness follows the lenticular cross-section, warp along x, weft along y,
+//! crimped over and under each other, yarn–yarn contact with friction within and between
+//! layers, a rigid projectile against the band faces.
+//!
+//! Glossary: p yarn spacing; w, h yarn width and thickness; R = (w² + h²)/(4h) the radius
+//! of the two circular arcs of the lenticular section; t(y) = 2(√(R² − y²) − R + h/2) the
+//! thickness at distance y from the band's centre line (0 at the edges, h at the centre);
+//! A = 2[R² acos((R − h/2)/R) − (R − h/2)√(R² − (R − h/2)²)] its exact area (≈ (2/3)wh);
+//! a the crimp amplitude: the warp at y_j = jp follows z = (−1)^j a cos(πx/p), the weft at
+//! x_i = ip follows z = −(−1)^i a cos(πy/p), so that they alternate over and under at
+//! every crossing (a plain weave, symmetric about x = 0 and y = 0: the quarter model has
+//! symmetry planes there, through the centre lines of the middle yarns). The full patch
+//! has its yarns at (j + ½)p and the phase x − p/2, so that its crests too lie at the
+//! crossings.
+//!
+//! Discretisation: `per_spacing` quads per spacing along, `across` quads across the width.
+//! A one-point quad takes the mean of its nodal thicknesses, which under-integrates the
+//! lenticular profile (by 25 % with 2 quads across, 6 % with 4): the nodal thicknesses are
+//! scaled by A/A_h so that the band's area, hence its mass and axial stiffness E·A, are
+//! exact; the contact envelope is then that much thicker at the centre line (reported as
+//! `thickness_scale`). Crimp: by default a = t_c/2 + 1 nm, with t_c the (scaled) centre
+//! thickness, so that crossing yarns just touch at their centre lines; a larger
+//! `crimp_amplitude` leaves a gap that a formed weave would close.
+//!
+//! Chains (`yarn_model`, the second representation): each yarn the chain of its band's
+//! centre-line nodes joined by trusses of the band's exact section A (A/2 on a symmetry
+//! plane), so the same mass and axial stiffness E·A; their contact thickness is t_c, the
+//! band's centre thickness (nodes and segments); the default crimp amplitude is the
+//! smallest at which the straight chords leaving a crossing stay t_c + 2 nm from the node
+//! above them ([`chain_touching_amplitude`]: 0.5 % above t_c/2); the projectile's nose
+//! grows by t_c/2 about the same centre, since it meets the chains' nodes.
+//!
+//! The yarns start stress-free in this geometric crimp; `weft-form` (`crate::form`) forms
+//! the weave by contact equilibrium under a residual tension.
+
+mod params;
+mod section;
+mod yarns;
+
+pub use params::{Edge, Surround, WovenBandParams, YarnModel};
+pub use section::{chain_touching_amplitude, Lenticular};
+use section::{crimp_amplitude, crimp_of, Section};
+use yarns::{add_layer, insert_sets, Built, Weave};
+
+use crate::error::{Result, WeftError};
+use crate::model::contacts::{ContactDef, Slave};
+use crate::model::{Analysis, Model, ProjectileSpec, SymmetryPlane};
+
+/// What the generator reports besides the model.
+#[derive(Debug, Clone)]
+pub struct WovenInfo {
+    /// Nodal thickness scale A/A_h (see the module docs).
+    pub thickness_scale: f64,
+    /// Crimp amplitude used [m] and the resulting crimp (path length/spacing − 1).
+    pub crimp_amplitude: f64,
+    pub crimp: f64,
+    /// Exact section area [m²] and areal density of one layer [kg/m²].
+    pub area: f64,
+    pub areal_density: f64,
+    /// The yarns' contact thickness: the bands' centre thickness t_c [m].
+    pub contact_thickness: f64,
+}
+
+fn check(p: &WovenBandParams) -> Result<()> {
+    let bad = |name: &str, v: String, exp: &str| {
+        Err(WeftError::input(format!("--{name} = `{v}`")).expected(exp.to_string()))
+    };
+    for (n, v) in [
+        ("spacing", p.spacing),
+        ("width", p.width),
+        ("thickness", p.thickness),
+        ("modulus", p.modulus),
+        ("transverse-modulus", p.transverse_modulus),
+        ("shear-modulus", p.shear_modulus),
+        ("density", p.density),
+        ("projectile-radius", p.projectile_radius),
+        ("projectile-mass", p.projectile_mass),
+        ("end-time", p.end_time),
+        ("output-interval", p.output_interval),
+    ] {
+        if !(v > 0.0 && v.is_finite()) {
+            return bad(n, v.to_string(), "a finite value > 0");
+        }
+    }
+    if !(p.yarns as f64 * p.spacing).is_finite() {
+        return bad(
+            "spacing",
+            p.spacing.to_string(),
+            "a spacing whose patch, yarns × spacing, is finite",
+        );
+    }
+    if p.yarns == 0 || (!p.quarter && p.yarns % 2 != 0) {
+        return bad(
+            "yarns",
+            p.yarns.to_string(),
+            "≥ 1 (quarter), or even ≥ 2 (full patch)",
+        );
+    }
+    if p.width >= p.spacing {
+        return Err(WeftError::input(format!(
+            "yarn width {} m is not below the spacing {} m",
+            p.width, p.spacing
+        ))
+        .expected("w < p: neighbouring yarns would overlap")
+        .hint("lower --width or raise --spacing"));
+    }
+    if p.thickness >= p.width {
+        return Err(WeftError::input(format!(
+            "yarn thickness {} m is not below its width {} m",
+            p.thickness, p.width
+        ))
+        .expected("h < w: a lenticular section is flatter than a circle"));
+    }
+    if p.per_spacing < 4 || p.per_spacing % 2 != 0 {
+        return bad(
+            "per-spacing",
+            p.per_spacing.to_string(),
+            "an even number ≥ 4 (a node at every crossing and midway)",
+        );
+    }
+    if p.across < 2 || p.across % 2 != 0 {
+        return bad(
+            "across",
+            p.across.to_string(),
+            "an even number ≥ 2 (a node on the centre line)",
+        );
+    }
+    if p.layers == 0 {
+        return bad("layers", "0".into(), "≥ 1");
+    }
+    for (flag, v, what) in [
+        ("friction", p.friction, "a Coulomb coefficient ≥ 0"),
+        (
+            "projectile-friction",
+            p.projectile_friction,
+            "a Coulomb coefficient ≥ 0",
+        ),
+        ("layer-gap", p.layer_gap, "a clearance ≥ 0 in m"),
+    ] {
+        if !(v >= 0.0) {
+            return bad(flag, v.to_string(), what);
+        }
+    }
+    if !(p.dt_safety > 0.0 && p.dt_safety <= 1.0) {
+        return bad(
+            "dt-safety",
+            p.dt_safety.to_string(),
+            "a safety factor 0 < f ≤ 1 on the stable step",
+        );
+    }
+    if !(p.projectile_velocity.is_finite() && p.projectile_velocity >= 0.0) {
+        return bad(
+            "projectile-velocity",
+            p.projectile_velocity.to_string(),
+            "a speed ≥ 0 in m/s",
+        );
+    }
+    Ok(())
+}
+
+/// The yarn-level patch and what was derived.
+pub fn woven(p: &WovenBandParams) -> Result<(Model, WovenInfo)> {
+    check(p)?;
+    let section = Section::new(p);
+    let amp = crimp_amplitude(p, &section)?;
+    // Layer pitch: a layer spans ±(a + t_c/2) about its mid-plane.
+    let pitch = 2.0 * amp + section.t_centre + p.layer_gap;
+    if p.layers > 1 && p.layer_gap <= 0.0 {
+        return Err(
+            WeftError::input("layers touch: --layer-gap is 0".to_string())
+                .expected("a gap > 0 between layers"),
+        );
+    }
+    let crimp = crimp_of(amp, p.spacing);
+    let weave = Weave::new(p, section, amp);
+    let mut m = Model::default();
+    let mut built = Built::new();
+    for layer in 0..p.layers {
+        add_layer(&mut m, &weave, layer, -(layer as f64) * pitch, &mut built);
+    }
+    add_contacts(&mut m, p, &weave.section, &built.parts);
+    if p.quarter {
+        for normal in [0, 1] {
+            m.symmetry.push(SymmetryPlane {
+                normal,
+                position: 0.0,
+                tolerance: 1e-9,
+            });
+        }
+    }
+    add_projectile(&mut m, p, &weave.section, built.top);
+    insert_sets(&mut m, built);
+    m.analysis = Analysis {
+        end_time: p.end_time,
+        output_interval: p.output_interval,
+        dt_safety: p.dt_safety,
+        history_sets: vec![
+            "axis_x".into(),
+            "axis_x_weft".into(),
+            "diagonal".into(),
+            "diagonal_weft".into(),
+        ],
+        ..Analysis::default()
+    };
+    let area = weave.section.lens.area();
+    let info = WovenInfo {
+        thickness_scale: weave.section.scale,
+        crimp_amplitude: amp,
+        crimp,
+        area,
+        areal_density: 2.0 * p.density * area * (1.0 + crimp) / p.spacing,
+        contact_thickness: weave.section.t_centre,
+    };
+    if let Some(s) = &p.surround {
+        surround(&mut m, p, s, &info)?;
+    }
+    m.validate()?;
+    Ok((m, info))
+}
+
+/// Contact: warp against weft in each layer, and every yarn of a layer against every
+/// yarn of the next; all two-way, with yarn–yarn friction.
+fn add_contacts(m: &mut Model, p: &WovenBandParams, s: &Section, parts: &[(usize, usize)]) {
+    let mut cid = 0;
+    let mut contact = |m: &mut Model, a: usize, b: usize| {
+        cid += 1;
+        let mut c = ContactDef::new(cid, Slave::Part(a), b).with_friction(p.friction);
+        c.two_way = true;
+        if s.chain {
+            // The band's centre thickness: unformed crossings just touch, as the bands'.
+            c.slave_thickness = Some(s.t_centre);
+            c.master_thickness = Some(s.t_centre);
+        }
+        m.contacts.push(c);
+    };
+    for l in 0..p.layers {
+        let (w, f) = parts[l];
+        contact(m, f, w);
+        if l + 1 < p.layers {
+            let (w2, f2) = parts[l + 1];
+            for a in [w, f] {
+                for b in [w2, f2] {
+                    contact(m, b, a);
+                }
+            }
+        }
+    }
+}
+
+/// The projectile above the fabric's `top`, on the centre (a quarter of its mass in a
+/// quarter model).
+fn add_projectile(m: &mut Model, p: &WovenBandParams, s: &Section, top: f64) {
+    let share = if p.quarter { 0.25 } else { 1.0 };
+    // The projectile meets the chains' nodes, which carry no contact thickness of their
+    // own: its nose grows by t_c/2 (the sum of the nose and a yarn's contact radius, the
+    // Minkowski sum, so that it meets the yarns' surfaces where the bands' would), and
+    // its tip sits t_c/2 lower (the same nose centre).
+    let grow = if s.chain { 0.5 * s.t_centre } else { 0.0 };
+    m.projectiles.push(ProjectileSpec {
+        id: 1,
+        shape: p.projectile_shape,
+        radius: p.projectile_radius + grow,
+        length: 2.0 * p.projectile_radius,
+        mass: share * p.projectile_mass,
+        tip: [0.0, 0.0, top - grow + 1e-6],
+        axis: [0.0, 0.0, -1.0],
+        velocity: [0.0, 0.0, -p.projectile_velocity],
+        prescribed_velocity: false,
+        contact_stiffness: None,
+        friction: p.projectile_friction,
+        segment_contact: !s.chain,
+    });
+}
+
+/// Ties the quarter patch's yarn ends into a graded membrane (see [`Surround`]).
+fn surround(m: &mut Model, p: &WovenBandParams, s: &Surround, info: &WovenInfo) -> Result<()> {
+    use crate::generate::surround::{coarse_membrane, graded_lines, tie_to_hole, MembraneProps};
+    if !p.quarter {
+        return Err(WeftError::input("--membrane-length with --full".to_string())
+            .expected("a quarter patch: a full patch's yarn ends lie at the crimp's crests, off the membrane's plane")
+            .hint("leave out --full"));
+    }
+    let c = (p.yarns as f64 - 0.5) * p.spacing;
+    let bad = |name: &str, v: f64, exp: &str| {
+        Err(WeftError::input(format!("--{name} = `{v}`")).expected(exp.to_string()))
+    };
+    if !(s.length > c + 0.5 * p.spacing) || !s.length.is_finite() {
+        return bad(
+            "membrane-length",
+            s.length,
+            &format!("a half-size larger than the patch's {c:.4e} m + p/2"),
+        );
+    }
+    if !(s.growth >= 1.0 && s.growth <= 3.0) {
+        return bad("membrane-growth", s.growth, "a growth ratio in [1, 3]");
+    }
+    for (name, v) in [
+        ("membrane-density-ratio", s.density_ratio),
+        ("membrane-modulus-ratio", s.modulus_ratio),
+        ("membrane-shear-ratio", s.shear_ratio),
+    ] {
+        if !(v > 0.0 && v.is_finite()) {
+            return bad(name, v, "a ratio > 0");
+        }
+    }
+    let layers = p.layers as f64;
+    let thickness = s.thickness.unwrap_or(2.0 * info.area * layers / p.spacing);
+    if !(thickness > 0.0 && thickness.is_finite()) {
+        return bad("membrane-thickness", thickness, "a thickness > 0 in m");
+    }
+    let e_m = s.modulus_ratio * p.modulus;
+    let props = MembraneProps {
+        youngs_modulus: e_m,
+        poisson_ratio: 0.0,
+        shear_modulus: s.shear_ratio * e_m,
+        thickness,
+        density: s.density_ratio * info.areal_density * layers / thickness,
+    };
+    // The yarn ends are tied, not held.
+    let ends = m.node_sets["edge"].clone();
+    let is_end: std::collections::HashSet<usize> = ends.iter().copied().collect();
+    m.constraints.retain(|(n, _)| !is_end.contains(n));
+    let lines = graded_lines(c, 0.5 * p.spacing, s.length, s.growth)?;
+    let first_id = m.node_id.iter().copied().max().unwrap_or(0) + 1;
+    let patch_nodes = m.num_nodes();
+    let coarse = coarse_membrane(m, &lines, true, c, &props, first_id);
+    let tied = tie_to_hole(m, &coarse, &ends)?;
+    for &o in &coarse.outer {
+        m.constraints.push((o, [true, true, true]));
+    }
+    // The x axis line on both sides of the interface: the patch's crossings, then the
+    // membrane's nodes on y = 0 beyond it.
+    let mut axis: Vec<usize> = m.node_sets["axis_x"].clone();
+    let mut beyond: Vec<usize> = (patch_nodes..m.num_nodes())
+        .filter(|&n| m.coords[n][1].abs() < 1e-12 && m.coords[n][0] > c - 1e-12)
+        .collect();
+    beyond.sort_by(|&a, &b| m.coords[a][0].total_cmp(&m.coords[b][0]));
+    axis.extend(beyond);
+    m.node_sets.insert("axis_x_all".into(), axis);
+    m.node_sets.insert("interface".into(), tied);
+    m.analysis.history_sets.push("axis_x_all".into());
+    Ok(())
+}
