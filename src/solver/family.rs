@@ -17,7 +17,7 @@
 //! is the order of the force slots, of the masses' accumulation and of the sums, so it
 //! is part of what makes results reproducible bit for bit.
 
-use super::beam::Rotations;
+use super::rotations::Rotations;
 use super::vec3::{Mat3, Vec3};
 use crate::error::Result;
 use crate::model::{ElementKind, Model};

@@ -35,6 +35,7 @@ pub mod operator;
 pub mod output;
 pub mod point_mass;
 pub mod relax;
+pub mod rotations;
 pub mod sliding_link;
 pub mod stable;
 pub mod statics;
@@ -436,13 +437,13 @@ impl Solver {
             )));
         }
         let mut mass = vec![0.0; nn];
-        let mut rot = beam::Rotations::new(nn);
+        let mut rot = rotations::Rotations::new(nn);
         let el = Families::build(&mut family::Build {
             model: m,
             mass: &mut mass,
             rot: &mut rot,
         })?;
-        rot.finish(m, &el.beam);
+        rot.finish(m, &el.beam.rot);
         let faces: Vec<(&[u32], f64)> = el
             .tri
             .nodes

@@ -9,7 +9,7 @@
 //! through the CSR index `slot_ptr`/`slots`), so the sum does not depend on the thread
 //! count.
 
-use super::beam::Rotations;
+use super::rotations::Rotations;
 use super::contact::{ProjectileContact, SurfaceContact};
 use super::family::ForceCtx;
 use super::ties::Ties;
