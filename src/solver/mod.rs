@@ -27,6 +27,7 @@
 
 pub mod beam;
 pub mod contact;
+pub mod families;
 pub mod family;
 pub mod integrator;
 pub mod link;
@@ -48,23 +49,13 @@ use std::time::{Duration, Instant};
 use crate::error::{Result, WeftError};
 use crate::model::{ElementKind, Model};
 
+pub use families::Families;
 use family::ForceCtx;
 pub use family::CHUNK;
 use integrator::{Nodal, NodePartial};
 pub use operator::{Operator, State};
 pub use stable::{MassScaling, StableStep};
 pub use ties::tie_weights;
-
-crate::families! {
-    truss: truss::TrussGroup,
-    link: link::LinkGroup,
-    framed_link: link::FramedLinkGroup,
-    sliding_link: sliding_link::SlidingLinkGroup,
-    point_mass: point_mass::PointMassGroup,
-    tri: membrane::MembraneGroup<3>,
-    quad: membrane::MembraneGroup<4>,
-    beam: beam::BeamGroup,
-}
 
 /// The energy-balance stop applies from this step on. In the first steps every energy
 /// is O(Δt⁴) and the trapezoidal external work lags the kinetic energy by a relative O(1)
