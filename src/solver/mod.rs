@@ -317,7 +317,11 @@ impl Solver {
             );
         }
         if let Some(target) = a.target_time_step {
-            self.scale_mass(target, a.dt_safety);
+            let (mass, rep) =
+                self.nodal_bound()
+                    .scale_mass(target, a.dt_safety, self.physical_mass);
+            self.mass = mass;
+            self.scaling = Some(rep);
         }
         for (im, m) in self.inv_m.iter_mut().zip(&self.mass) {
             *im = if *m > 0.0 { 1.0 / m } else { 0.0 };
@@ -400,6 +404,28 @@ impl Solver {
             element: self.controlling_element(node),
         };
         Ok(())
+    }
+
+    /// The nodes as the stable step's bound reads them (see [`stable::NodalBound`]).
+    fn nodal_bound(&self) -> stable::NodalBound<'_> {
+        stable::NodalBound {
+            op: &self.op,
+            state: &self.state,
+            mass: &self.mass,
+            fixed: &self.fixed,
+            alpha: self.alpha,
+            node_id: &self.node_id,
+        }
+    }
+
+    /// The stable step (without safety factor) and its controlling node.
+    pub fn stable_step(&self) -> (f64, usize) {
+        self.nodal_bound().stable_step()
+    }
+
+    /// The stiffest element attached to a node.
+    pub fn controlling_element(&self, node: usize) -> Option<(ElementKind, i64)> {
+        self.nodal_bound().controlling_element(node)
     }
 
     /// A slave's initial velocity must be its masters'.
@@ -562,10 +588,11 @@ impl Solver {
         let mut k = 0u64;
         let progress_every = (n_out / 200).max(1);
         let mut last_e = Energies::default();
-        let mut stiffening = self.stiffening_check();
+        let mut stiffening = self.nodal_bound().stiffening_check();
         while k <= n_out {
             if self.state.step % STIFFENING_CHECK_EVERY == 0 {
-                self.check_stiffening(&mut stiffening, dt)?;
+                self.nodal_bound()
+                    .check_stiffening(&mut stiffening, dt, a.dt_safety)?;
             }
             let t0 = Instant::now();
             self.op.apply_loads(&self.state);
@@ -761,7 +788,7 @@ impl Solver {
 }
 
 /// Steps between two checks of the membranes' stiffening against the step
-/// (`Solver::check_stiffening`, in `stable.rs`): often enough that a strain growing
+/// (`NodalBound::check_stiffening`, in `stable.rs`): often enough that a strain growing
 /// towards the margin (1/dt_safety² − 1 = 0.23 at 0.9, in 1 + 3E₁₁) is caught before it
 /// has run away; one check costs about one membrane force pass without the forces.
 const STIFFENING_CHECK_EVERY: u64 = 20;
