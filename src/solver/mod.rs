@@ -594,165 +594,27 @@ impl Solver {
                 self.nodal_bound()
                     .check_stiffening(&mut stiffening, dt, a.dt_safety)?;
             }
-            let t0 = Instant::now();
-            self.op.apply_loads(&self.state);
-            let t1 = Instant::now();
-            self.op.element_forces(&self.state);
-            let t1c = Instant::now();
-            self.op.contact_and_ties(&self.state, &self.mass, dt);
-            let t2 = Instant::now();
-            times.contact += t2 - t1c;
-            times.loads += t1 - t0;
-            times.forces += t2 - t1;
+            let t2 = self.compute_forces(dt, &mut times);
             let dt_next = dt;
             let snap = k as f64 * a.output_interval <= self.state.t + dt_next;
-            let nd = Nodal {
-                inv_m: &self.inv_m,
-                mass: &self.mass,
-                fixed: &self.fixed,
-                alpha: self.alpha,
-            };
-            let r = if snap {
-                integrator::advance_nodes::<true>(
-                    &mut self.state,
-                    &self.op,
-                    &nd,
-                    dt_next,
-                    &mut self.partials,
-                )
-            } else {
-                integrator::advance_nodes::<false>(
-                    &mut self.state,
-                    &self.op,
-                    &nd,
-                    dt_next,
-                    &mut self.partials,
-                )
-            };
-            let (ke, dp) = r.map_err(|node| self.nan_error(node))?;
+            let (ke, dp) = self.advance_nodes(snap, dt_next)?;
             // Element energies at t_n (x^n is in xn), before the rotations advance.
             let el_e = if snap {
                 self.element_energies_at(true)
             } else {
                 ElementEnergies::default()
             };
-            let (ke_rot, dp_rot) = if self.state.rot.is_empty() {
-                (0.0, 0.0)
-            } else {
-                integrator::advance_rotations(
-                    &mut self.state,
-                    &self.op.el.beam.moments,
-                    self.alpha,
-                    dt_next,
-                    &self.node_id,
-                )?
-            };
+            let (ke_rot, dp_rot) = self.advance_rotations(dt_next)?;
             let (ke, dp) = (ke + ke_rot, dp + dp_rot);
             self.ledger.mass_damping += 0.5 * self.state.dt_prev * dp;
-            if !self.op.ties.is_empty() {
-                let st = &mut self.state;
-                self.op
-                    .ties
-                    .update_slaves(&mut st.x, &mut st.v, snap.then_some(&mut st.vn[..]));
-            }
-            let mut contact_e = 0.0;
-            if snap {
-                // Projectile states at t_n: tip and contact force before their update.
-                sampler.cur.proj.clear();
-                for p in &self.op.projectiles.projectiles {
-                    sampler.cur.proj.push([
-                        p.tip[0], p.tip[1], p.tip[2], 0.0, 0.0, 0.0, p.force[0], p.force[1],
-                        p.force[2],
-                    ]);
-                }
-                if !self.op.projectiles.is_empty() {
-                    contact_e = self.op.projectiles.energy(&self.state.xn, &self.mass, dt);
-                }
-            }
-            let ke_proj = if self.op.projectiles.is_empty() {
-                0.0
-            } else {
-                self.op.projectiles.advance(self.state.dt_prev, dt_next)
-            };
+            self.update_tie_slaves(snap);
+            let (contact_e, ke_proj) =
+                self.advance_projectiles(snap, dt, dt_next, &mut sampler.cur.proj);
             let ke = ke + ke_proj;
             let t3 = Instant::now();
             times.update += t3 - t2;
             if snap {
-                for (row, p) in sampler
-                    .cur
-                    .proj
-                    .iter_mut()
-                    .zip(&self.op.projectiles.projectiles)
-                {
-                    row[3..6].copy_from_slice(&p.v_full);
-                }
-                let contact = contact_e
-                    + self.op.projectiles.friction_work
-                    + (self.op.surfaces.stored + self.op.surfaces.dissipated);
-                let w_ext = self.op.loads.work + self.op.projectiles.prescribed_work;
-                let e = self.ledger.book(ke, &el_e, contact, w_ext, self.state.step);
-                sampler.cur.t = self.state.t;
-                sampler.cur.e = e;
-                last_e = e;
-                // A non-finite energy is a broken run even when the nodes are finite (a
-                // comparison with NaN is false: it would pass the check below).
-                let terms = [
-                    ("kinetic", ke),
-                    ("internal", el_e.internal),
-                    ("damping", el_e.damping),
-                    ("friction", el_e.friction),
-                    ("hourglass", el_e.hourglass),
-                    ("contact (stored and friction work)", contact),
-                    ("external work", w_ext),
-                ];
-                if let Some((name, v)) = terms.iter().find(|(_, v)| !v.is_finite()) {
-                    let hint = if *name == "external work" {
-                        let big = self.op.loads.loads.iter().max_by(|a, b| {
-                            let m = |l: &crate::model::Load| {
-                                l.force.iter().map(|f| f.abs()).fold(0.0, f64::max)
-                            };
-                            m(a).total_cmp(&m(b))
-                        });
-                        match big {
-                            Some(l) => format!(
-                                "the loads' work overflowed: the largest is load `{}` (loads.parquet, node `{}`, force {:?} N)",
-                                l.id, self.node_id[l.node], l.force
-                            ),
-                            None => "a projectile with prescribed velocity did non-finite work".to_string(),
-                        }
-                    } else if *name == "kinetic" {
-                        "a mass × velocity² overflowed: check the initial velocities, the element and point masses (parts.parquet) and the projectiles' mass and velocity (projectile.parquet)".to_string()
-                    } else {
-                        "a penalty or element with zero mass or zero length somewhere; the contact report names the definitions (run with the same model and a shorter end time to look at it)".to_string()
-                    };
-                    return Err(WeftError::Numerical {
-                        what: format!("the {name} energy is {v}"),
-                        step: self.state.step,
-                        time: self.state.t,
-                        hint: Some(hint),
-                    });
-                }
-                if e.balance_error_relative > a.max_energy_error
-                    && self.state.step >= ENERGY_CHECK_AFTER
-                {
-                    return Err(WeftError::Numerical {
-                        what: format!(
-                            "energy balance error {:.3e} J is {:.1} % of the reference energy {:.3e} J (limit {:.1} %): the run is unstable or a force is not conservative",
-                            e.balance_error, 100.0 * e.balance_error_relative, self.ledger.reference, 100.0 * a.max_energy_error
-                        ),
-                        step: self.state.step,
-                        time: self.state.t,
-                        hint: Some(format!(
-                            "the step is {:.4e} s (stable estimate {:.4e} s); lower dt_safety, or raise max_energy_error if the loss is physical",
-                            self.stable.dt, self.stable.dt_stable
-                        )),
-                    });
-                }
-                for (j, &i) in self.output_nodes.iter().enumerate() {
-                    let (x, x0) = (self.state.xn[i], self.x0[i]);
-                    sampler.cur.u[j] = [x[0] - x0[0], x[1] - x0[1], x[2] - x0[2]];
-                    sampler.cur.v[j] = self.state.vn[i];
-                }
+                last_e = self.book_sample(ke, &el_e, contact_e, &mut sampler)?;
                 sampler.emit(
                     &mut k,
                     n_out,
@@ -784,6 +646,213 @@ impl Solver {
             elements: self.op.el.len() - self.op.el.point_mass.id.len(),
             nodes: self.x0.len(),
         })
+    }
+
+    /// The forces at t_n: loads, element forces, then contact and ties, timed into
+    /// `times`; the instant they were done.
+    fn compute_forces(&mut self, dt: f64, times: &mut PhaseTimes) -> Instant {
+        let t0 = Instant::now();
+        self.op.apply_loads(&self.state);
+        let t1 = Instant::now();
+        self.op.element_forces(&self.state);
+        let t1c = Instant::now();
+        self.op.contact_and_ties(&self.state, &self.mass, dt);
+        let t2 = Instant::now();
+        times.contact += t2 - t1c;
+        times.loads += t1 - t0;
+        times.forces += t2 - t1;
+        t2
+    }
+
+    /// The nodes' update over `dt` (at a sample step, `snap`, also x^n and v^n kept): the
+    /// kinetic energy and the mass-damping power, or the error that names a node gone
+    /// non-finite.
+    fn advance_nodes(&mut self, snap: bool, dt: f64) -> Result<(f64, f64)> {
+        let nd = Nodal {
+            inv_m: &self.inv_m,
+            mass: &self.mass,
+            fixed: &self.fixed,
+            alpha: self.alpha,
+        };
+        let r = if snap {
+            integrator::advance_nodes::<true>(
+                &mut self.state,
+                &self.op,
+                &nd,
+                dt,
+                &mut self.partials,
+            )
+        } else {
+            integrator::advance_nodes::<false>(
+                &mut self.state,
+                &self.op,
+                &nd,
+                dt,
+                &mut self.partials,
+            )
+        };
+        r.map_err(|node| self.nan_error(node))
+    }
+
+    /// The rotational nodes' update over `dt`: their kinetic energy and mass-damping
+    /// power (zero without beams).
+    fn advance_rotations(&mut self, dt: f64) -> Result<(f64, f64)> {
+        if self.state.rot.is_empty() {
+            return Ok((0.0, 0.0));
+        }
+        integrator::advance_rotations(
+            &mut self.state,
+            &self.op.el.beam.moments,
+            self.alpha,
+            dt,
+            &self.node_id,
+        )
+    }
+
+    /// The tied slaves follow their masters (at a sample step, their v^n too).
+    fn update_tie_slaves(&mut self, snap: bool) {
+        if !self.op.ties.is_empty() {
+            let st = &mut self.state;
+            self.op
+                .ties
+                .update_slaves(&mut st.x, &mut st.v, snap.then_some(&mut st.vn[..]));
+        }
+    }
+
+    /// The projectiles' update from `dt_prev` to `dt_next` (`dt`: the step of their
+    /// penalty): their kinetic energy, and at a sample step their state at t_n into `rows`
+    /// (tip and contact force, before the update) and their contact energy at t_n.
+    /// Returns (contact energy, kinetic energy).
+    fn advance_projectiles(
+        &mut self,
+        snap: bool,
+        dt: f64,
+        dt_next: f64,
+        rows: &mut Vec<[f64; 9]>,
+    ) -> (f64, f64) {
+        let mut contact_e = 0.0;
+        if snap {
+            // Projectile states at t_n: tip and contact force before their update.
+            rows.clear();
+            for p in &self.op.projectiles.projectiles {
+                rows.push([
+                    p.tip[0], p.tip[1], p.tip[2], 0.0, 0.0, 0.0, p.force[0], p.force[1], p.force[2],
+                ]);
+            }
+            if !self.op.projectiles.is_empty() {
+                contact_e = self.op.projectiles.energy(&self.state.xn, &self.mass, dt);
+            }
+        }
+        let ke_proj = if self.op.projectiles.is_empty() {
+            0.0
+        } else {
+            self.op.projectiles.advance(self.state.dt_prev, dt_next)
+        };
+        (contact_e, ke_proj)
+    }
+
+    /// A sample at t_n: the projectiles' velocities, the energies booked in the ledger
+    /// and checked (finite, balanced), and the output nodes' displacements and velocities,
+    /// into the sampler's current snapshot. Returns the energies.
+    fn book_sample(
+        &mut self,
+        ke: f64,
+        el_e: &ElementEnergies,
+        contact_e: f64,
+        sampler: &mut Sampler,
+    ) -> Result<Energies> {
+        for (row, p) in sampler
+            .cur
+            .proj
+            .iter_mut()
+            .zip(&self.op.projectiles.projectiles)
+        {
+            row[3..6].copy_from_slice(&p.v_full);
+        }
+        let contact = contact_e
+            + self.op.projectiles.friction_work
+            + (self.op.surfaces.stored + self.op.surfaces.dissipated);
+        let w_ext = self.op.loads.work + self.op.projectiles.prescribed_work;
+        let e = self.ledger.book(ke, el_e, contact, w_ext, self.state.step);
+        sampler.cur.t = self.state.t;
+        sampler.cur.e = e;
+        self.check_finite_energies(ke, el_e, contact, w_ext)?;
+        self.check_balance(&e)?;
+        for (j, &i) in self.output_nodes.iter().enumerate() {
+            let (x, x0) = (self.state.xn[i], self.x0[i]);
+            sampler.cur.u[j] = [x[0] - x0[0], x[1] - x0[1], x[2] - x0[2]];
+            sampler.cur.v[j] = self.state.vn[i];
+        }
+        Ok(e)
+    }
+
+    /// A non-finite energy is a broken run even when the nodes are finite (a comparison
+    /// with NaN is false: it would pass the balance check): the error names the term and
+    /// its likely cause.
+    fn check_finite_energies(
+        &self,
+        ke: f64,
+        el_e: &ElementEnergies,
+        contact: f64,
+        w_ext: f64,
+    ) -> Result<()> {
+        let terms = [
+            ("kinetic", ke),
+            ("internal", el_e.internal),
+            ("damping", el_e.damping),
+            ("friction", el_e.friction),
+            ("hourglass", el_e.hourglass),
+            ("contact (stored and friction work)", contact),
+            ("external work", w_ext),
+        ];
+        let Some((name, v)) = terms.iter().find(|(_, v)| !v.is_finite()) else {
+            return Ok(());
+        };
+        let hint = if *name == "external work" {
+            let big = self.op.loads.loads.iter().max_by(|a, b| {
+                let m =
+                    |l: &crate::model::Load| l.force.iter().map(|f| f.abs()).fold(0.0, f64::max);
+                m(a).total_cmp(&m(b))
+            });
+            match big {
+                Some(l) => format!(
+                    "the loads' work overflowed: the largest is load `{}` (loads.parquet, node `{}`, force {:?} N)",
+                    l.id, self.node_id[l.node], l.force
+                ),
+                None => "a projectile with prescribed velocity did non-finite work".to_string(),
+            }
+        } else if *name == "kinetic" {
+            "a mass × velocity² overflowed: check the initial velocities, the element and point masses (parts.parquet) and the projectiles' mass and velocity (projectile.parquet)".to_string()
+        } else {
+            "a penalty or element with zero mass or zero length somewhere; the contact report names the definitions (run with the same model and a shorter end time to look at it)".to_string()
+        };
+        Err(WeftError::Numerical {
+            what: format!("the {name} energy is {v}"),
+            step: self.state.step,
+            time: self.state.t,
+            hint: Some(hint),
+        })
+    }
+
+    /// The energy balance stops the run once its error passes the analysis' limit
+    /// (from [`ENERGY_CHECK_AFTER`] steps on).
+    fn check_balance(&self, e: &Energies) -> Result<()> {
+        let a = &self.analysis;
+        if e.balance_error_relative > a.max_energy_error && self.state.step >= ENERGY_CHECK_AFTER {
+            return Err(WeftError::Numerical {
+                what: format!(
+                    "energy balance error {:.3e} J is {:.1} % of the reference energy {:.3e} J (limit {:.1} %): the run is unstable or a force is not conservative",
+                    e.balance_error, 100.0 * e.balance_error_relative, self.ledger.reference, 100.0 * a.max_energy_error
+                ),
+                step: self.state.step,
+                time: self.state.t,
+                hint: Some(format!(
+                    "the step is {:.4e} s (stable estimate {:.4e} s); lower dt_safety, or raise max_energy_error if the loss is physical",
+                    self.stable.dt, self.stable.dt_stable
+                )),
+            });
+        }
+        Ok(())
     }
 }
 
