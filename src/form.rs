@@ -930,7 +930,8 @@ pub fn form_from(
     }
     let x = solver.state.x.clone();
     let max_pen = solver.op.surfaces.deepest();
-    if let Some((r, g, cid, node, el)) = max_pen {
+    if let Some(d) = max_pen {
+        let (r, g, cid, node, el) = (d.ratio, d.depth, d.contact_id, d.node, d.element);
         if r > p.penetration_limit {
             // The surface's element kind (of the definition's master part; a two-way
             // definition between bands or between chains has one kind on both sides).
@@ -1036,7 +1037,7 @@ pub fn form_from(
         weft_tension: tens[1],
         warp_end_tension: end_t[0],
         weft_end_tension: end_t[1],
-        max_penetration_ratio: max_pen.map_or(0.0, |d| d.0),
+        max_penetration_ratio: max_pen.map_or(0.0, |d| d.ratio),
         top_rise: rise,
         wall_seconds: t0.elapsed().as_secs_f64(),
         start: match start {

@@ -192,6 +192,22 @@ pub fn guard_kappa(m: &Model) -> f64 {
     k.iter().cloned().fold(0.0, f64::max) + proj
 }
 
+/// The deepest penetration of a force evaluation ([`SurfaceContact::deepest`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Deepest {
+    /// The penetration over the contact distance of the thickest slave and face of its
+    /// side, (t_s,max + t_F,max)/2.
+    pub ratio: f64,
+    /// The penetration g (beyond a tracked initial one) [m].
+    pub depth: f64,
+    /// The contact definition's id.
+    pub contact_id: i64,
+    /// The slave node (index).
+    pub node: usize,
+    /// The id of the face's element.
+    pub element: i64,
+}
+
 /// Every contact definition of a model, and the broad phase they share.
 #[derive(Debug, Clone, Default)]
 pub struct SurfaceContact {
@@ -289,24 +305,23 @@ impl SurfaceContact {
     /// The deepest penetration at the last force evaluation, relative to the contact
     /// distance of the thickest slave and face of its side, (t_s,max + t_F,max)/2 (the
     /// centre-line distance of two crossing yarns; a thin band edge's own distance would
-    /// make a sub-micrometre overlap look deep): (ratio, g [m], contact id, slave node,
-    /// face element).
-    pub fn deepest(&self) -> Option<(f64, f64, i64, usize, i64)> {
-        let mut best: Option<(f64, f64, i64, usize, i64)> = None;
+    /// make a sub-micrometre overlap look deep).
+    pub fn deepest(&self) -> Option<Deepest> {
+        let mut best: Option<Deepest> = None;
         for s in &self.sides {
             for (si, o) in s.out.iter().enumerate() {
                 if o.face == u32::MAX || s.reach <= 0.0 {
                     continue;
                 }
                 let r = o.g / s.reach;
-                if best.as_ref().is_none_or(|b| r > b.0) {
-                    best = Some((
-                        r,
-                        o.g,
-                        s.contact_id,
-                        s.slaves[si] as usize,
-                        s.face_id[o.face as usize],
-                    ));
+                if best.as_ref().is_none_or(|b| r > b.ratio) {
+                    best = Some(Deepest {
+                        ratio: r,
+                        depth: o.g,
+                        contact_id: s.contact_id,
+                        node: s.slaves[si] as usize,
+                        element: s.face_id[o.face as usize],
+                    });
                 }
             }
         }
