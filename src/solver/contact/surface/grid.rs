@@ -34,29 +34,7 @@ struct Grid {
 
 impl Grid {
     fn new(boxes: &[([f64; 3], [f64; 3])]) -> Grid {
-        // Bounds and the largest box: minima and maxima, exact in any order.
-        type Bounds = ([f64; 3], [f64; 3], f64);
-        let merge = |p: Bounds, q: Bounds| -> Bounds {
-            (
-                std::array::from_fn(|d| p.0[d].min(q.0[d])),
-                std::array::from_fn(|d| p.1[d].max(q.1[d])),
-                p.2.max(q.2),
-            )
-        };
-        let none: Bounds = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3], 1e-12);
-        let (lo, hi, mut h) = boxes
-            .par_iter()
-            .fold(
-                || none,
-                |acc, (a, b)| {
-                    let w = (0..3)
-                        .map(|d| b[d] - a[d])
-                        .fold(f64::NEG_INFINITY, f64::max);
-                    merge(acc, (*a, *b, w))
-                },
-            )
-            .reduce(|| none, merge);
-        h *= GRID_CELL_FRACTION;
+        let (lo, hi, h) = extent(boxes);
         if boxes.is_empty() || !(0..3).all(|d| lo[d].is_finite() && hi[d].is_finite()) {
             return Grid {
                 origin: [0.0; 3],
@@ -66,20 +44,7 @@ impl Grid {
                 items: vec![],
             };
         }
-        // A few cells per box at most (a patch whose faces are far apart in one
-        // direction would otherwise ask for a huge, empty grid).
-        let cap = GRID_CELLS_PER_BOX * boxes.len() + 64;
-        let mut dims = [1usize; 3];
-        loop {
-            for d in 0..3 {
-                dims[d] = ((hi[d] - lo[d]) / h).floor() as usize + 1;
-            }
-            if dims[0].saturating_mul(dims[1]).saturating_mul(dims[2]) <= cap {
-                break;
-            }
-            h *= 1.5;
-        }
-        let ncell = dims[0] * dims[1] * dims[2];
+        let (dims, h) = cell_counts(&lo, &hi, h, boxes.len());
         // Truncation is the floor here: every coordinate is ≥ the origin.
         let cell = |p: &[f64; 3]| -> [u32; 3] {
             std::array::from_fn(|d| {
@@ -88,122 +53,15 @@ impl Grid {
         };
         // Each box's cell range (first, last per axis).
         let span: Vec<[[u32; 3]; 2]> = boxes.par_iter().map(|(a, b)| [cell(a), cell(b)]).collect();
-        // The cells are filled by blocks of whole rows (a row: the cells of one (j, k)),
-        // in parallel: each block takes the boxes that reach its rows, in box order, so a
-        // cell lists its boxes in box order whatever the blocks (a counting sort).
-        let nrows = dims[1] * dims[2];
-        let rows_per = nrows.div_ceil(GRID_BLOCKS).max(1);
-        let nblocks = nrows.div_ceil(rows_per);
-        let row_of = |j: u32, k: u32| grid_row(&dims, j, k);
-        // The boxes that reach each block, in box order: found in parallel over fixed
-        // ranges of boxes (`members[r][b]`, read range after range; the same lists for
-        // any number of threads), each row's block looked up rather than divided for
-        // (measured: this loop was most of the rebuild's serial time).
-        let block_of: Vec<u32> = (0..nrows).map(|r| (r / rows_per) as u32).collect();
-        let per_range = span.len().div_ceil(GRID_BLOCKS).max(1);
-        let members: Vec<Vec<Vec<u32>>> = span
-            .par_chunks(per_range)
-            .enumerate()
-            .map(|(ri, range)| {
-                let f0 = ri * per_range;
-                let mut m: Vec<Vec<u32>> = vec![Vec::new(); nblocks];
-                for (j, [ca, cb]) in range.iter().enumerate() {
-                    let mut last = usize::MAX;
-                    for k in ca[2]..=cb[2] {
-                        let (b0, b1) = (
-                            block_of[row_of(ca[1], k)] as usize,
-                            block_of[row_of(cb[1], k)] as usize,
-                        );
-                        for b in b0.max(last.wrapping_add(1))..=b1 {
-                            m[b].push((f0 + j) as u32);
-                            last = b;
-                        }
-                    }
-                }
-                m
-            })
-            .collect();
-        let block_members = |b: usize| members.iter().flat_map(move |m| m[b].iter().copied());
-        // Visit the cells of block `b` that box `fi` covers (a generic function, not a
-        // closure taking `dyn FnMut`: the visits inline, without a call per cell).
-        #[inline(always)]
-        fn visit(
-            span: &[[u32; 3]; 2],
-            (r0, r1): (usize, usize),
-            dims: &[usize; 3],
-            mut f: impl FnMut(usize),
-        ) {
-            let [ca, cb] = span;
-            for k in ca[2]..=cb[2] {
-                for j in ca[1]..=cb[1] {
-                    let r = grid_row(dims, j, k);
-                    if r < r0 || r >= r1 {
-                        continue;
-                    }
-                    for i in ca[0]..=cb[0] {
-                        f((r - r0) * dims[0] + i as usize);
-                    }
-                }
-            }
-        }
-        let rows = |b: usize| (b * rows_per, ((b + 1) * rows_per).min(nrows));
-        // Counts, then each block's running sums, then the blocks' offsets.
-        let block_cells = rows_per * dims[0];
-        let mut count = vec![0u32; ncell + 1];
-        let totals: Vec<u32> = count[1..]
-            .par_chunks_mut(block_cells)
-            .enumerate()
-            .map(|(b, cnt)| {
-                for fi in block_members(b) {
-                    visit(&span[fi as usize], rows(b), &dims, |c| cnt[c] += 1);
-                }
-                let mut run = 0u32;
-                for c in cnt.iter_mut() {
-                    run += *c;
-                    *c = run;
-                }
-                run
-            })
-            .collect();
-        let mut offsets = Vec::with_capacity(nblocks);
-        let mut run = 0u32;
-        for t in &totals {
-            offsets.push(run);
-            run += t;
-        }
-        count[1..]
-            .par_chunks_mut(block_cells)
-            .zip(&offsets)
-            .for_each(|(cnt, &o)| cnt.iter_mut().for_each(|c| *c += o));
-        // Fill: each block writes its own slice of the items.
-        let mut items = vec![0u32; run as usize];
-        let mut slices: Vec<&mut [u32]> = Vec::with_capacity(nblocks);
-        let mut rest: &mut [u32] = &mut items;
-        for t in &totals {
-            let (head, tail) = rest.split_at_mut(*t as usize);
-            slices.push(head);
-            rest = tail;
-        }
-        let ptr = &count;
-        slices.into_par_iter().enumerate().for_each(|(b, out)| {
-            let c0 = b * block_cells;
-            let base = offsets[b];
-            let mut fill: Vec<u32> = ptr[c0..(c0 + block_cells).min(ncell)]
-                .iter()
-                .map(|&p| p - base)
-                .collect();
-            for fi in block_members(b) {
-                visit(&span[fi as usize], rows(b), &dims, |c| {
-                    out[fill[c] as usize] = fi;
-                    fill[c] += 1;
-                });
-            }
-        });
+        let blocks = Blocks::new(dims);
+        let members = blocks.members(&span);
+        let (ptr, totals, offsets) = blocks.count(&span, &members);
+        let items = blocks.fill(&span, &members, &ptr, &totals, &offsets);
         Grid {
             origin: lo,
             h,
             dims,
-            ptr: count,
+            ptr,
             items,
         }
     }
@@ -224,10 +82,230 @@ impl Grid {
     }
 }
 
+/// The bounds (lo, hi) of the boxes and the grid's cell size ([`GRID_CELL_FRACTION`] of
+/// the largest box's largest side, at least 10⁻¹² of it).
+fn extent(boxes: &[([f64; 3], [f64; 3])]) -> ([f64; 3], [f64; 3], f64) {
+    // Bounds and the largest box: minima and maxima, exact in any order.
+    type Bounds = ([f64; 3], [f64; 3], f64);
+    let merge = |p: Bounds, q: Bounds| -> Bounds {
+        (
+            std::array::from_fn(|d| p.0[d].min(q.0[d])),
+            std::array::from_fn(|d| p.1[d].max(q.1[d])),
+            p.2.max(q.2),
+        )
+    };
+    let none: Bounds = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3], 1e-12);
+    let (lo, hi, mut h) = boxes
+        .par_iter()
+        .fold(
+            || none,
+            |acc, (a, b)| {
+                let w = (0..3)
+                    .map(|d| b[d] - a[d])
+                    .fold(f64::NEG_INFINITY, f64::max);
+                merge(acc, (*a, *b, w))
+            },
+        )
+        .reduce(|| none, merge);
+    h *= GRID_CELL_FRACTION;
+    (lo, hi, h)
+}
+
+/// The cells per axis over (lo, hi) at the cell size `h`, and the cell size: grown until
+/// there are a few cells per box at most (a patch whose faces are far apart in one
+/// direction would otherwise ask for a huge, empty grid).
+fn cell_counts(lo: &[f64; 3], hi: &[f64; 3], mut h: f64, n_boxes: usize) -> ([usize; 3], f64) {
+    let cap = GRID_CELLS_PER_BOX * n_boxes + 64;
+    let mut dims = [1usize; 3];
+    loop {
+        for d in 0..3 {
+            dims[d] = ((hi[d] - lo[d]) / h).floor() as usize + 1;
+        }
+        if dims[0].saturating_mul(dims[1]).saturating_mul(dims[2]) <= cap {
+            break;
+        }
+        h *= 1.5;
+    }
+    (dims, h)
+}
+
 /// The row (the cells of one (j, k)) of the grid's cell indices j, k.
 #[inline(always)]
 fn grid_row(dims: &[usize; 3], j: u32, k: u32) -> usize {
     k as usize * dims[1] + j as usize
+}
+
+/// The grid's cells split for the parallel fill: whole rows (a row: the cells of one
+/// (j, k)) in blocks of `rows_per` rows. Each block takes the boxes that reach its rows,
+/// in box order, so a cell lists its boxes in box order whatever the blocks (a counting
+/// sort).
+struct Blocks {
+    dims: [usize; 3],
+    ncell: usize,
+    nrows: usize,
+    rows_per: usize,
+    nblocks: usize,
+    /// Cells per block (the last may have fewer).
+    block_cells: usize,
+    /// The block of each row.
+    block_of: Vec<u32>,
+}
+
+impl Blocks {
+    fn new(dims: [usize; 3]) -> Blocks {
+        let nrows = dims[1] * dims[2];
+        let rows_per = nrows.div_ceil(GRID_BLOCKS).max(1);
+        Blocks {
+            dims,
+            ncell: dims[0] * dims[1] * dims[2],
+            nrows,
+            rows_per,
+            nblocks: nrows.div_ceil(rows_per),
+            block_cells: rows_per * dims[0],
+            // Each row's block looked up rather than divided for (measured: the loop of
+            // `members` was most of the rebuild's serial time).
+            block_of: (0..nrows).map(|r| (r / rows_per) as u32).collect(),
+        }
+    }
+
+    /// The rows of block `b`, [first, last).
+    fn rows(&self, b: usize) -> (usize, usize) {
+        (b * self.rows_per, ((b + 1) * self.rows_per).min(self.nrows))
+    }
+
+    /// The boxes that reach each block, in box order: found in parallel over fixed ranges
+    /// of boxes (`members[r][b]`, read range after range; the same lists for any number of
+    /// threads).
+    fn members(&self, span: &[[[u32; 3]; 2]]) -> Vec<Vec<Vec<u32>>> {
+        let (dims, block_of) = (&self.dims, &self.block_of);
+        let row_of = |j: u32, k: u32| grid_row(dims, j, k);
+        let per_range = span.len().div_ceil(GRID_BLOCKS).max(1);
+        span.par_chunks(per_range)
+            .enumerate()
+            .map(|(ri, range)| {
+                let f0 = ri * per_range;
+                let mut m: Vec<Vec<u32>> = vec![Vec::new(); self.nblocks];
+                for (j, [ca, cb]) in range.iter().enumerate() {
+                    let mut last = usize::MAX;
+                    for k in ca[2]..=cb[2] {
+                        let (b0, b1) = (
+                            block_of[row_of(ca[1], k)] as usize,
+                            block_of[row_of(cb[1], k)] as usize,
+                        );
+                        for b in b0.max(last.wrapping_add(1))..=b1 {
+                            m[b].push((f0 + j) as u32);
+                            last = b;
+                        }
+                    }
+                }
+                m
+            })
+            .collect()
+    }
+
+    /// The cells' counts as CSR pointers (`ncell + 1`: each block's running sums, then the
+    /// blocks' offsets added), with each block's total and offset.
+    fn count(
+        &self,
+        span: &[[[u32; 3]; 2]],
+        members: &[Vec<Vec<u32>>],
+    ) -> (Vec<u32>, Vec<u32>, Vec<u32>) {
+        let mut count = vec![0u32; self.ncell + 1];
+        let totals: Vec<u32> = count[1..]
+            .par_chunks_mut(self.block_cells)
+            .enumerate()
+            .map(|(b, cnt)| {
+                for fi in block_members(members, b) {
+                    visit(&span[fi as usize], self.rows(b), &self.dims, |c| {
+                        cnt[c] += 1
+                    });
+                }
+                let mut run = 0u32;
+                for c in cnt.iter_mut() {
+                    run += *c;
+                    *c = run;
+                }
+                run
+            })
+            .collect();
+        let mut offsets = Vec::with_capacity(self.nblocks);
+        let mut run = 0u32;
+        for t in &totals {
+            offsets.push(run);
+            run += t;
+        }
+        count[1..]
+            .par_chunks_mut(self.block_cells)
+            .zip(&offsets)
+            .for_each(|(cnt, &o)| cnt.iter_mut().for_each(|c| *c += o));
+        (count, totals, offsets)
+    }
+
+    /// The cells' lists of boxes (CSR items, at the pointers `ptr`): each block writes its
+    /// own slice of the items.
+    fn fill(
+        &self,
+        span: &[[[u32; 3]; 2]],
+        members: &[Vec<Vec<u32>>],
+        ptr: &[u32],
+        totals: &[u32],
+        offsets: &[u32],
+    ) -> Vec<u32> {
+        let run: u32 = totals.iter().sum();
+        let mut items = vec![0u32; run as usize];
+        let mut slices: Vec<&mut [u32]> = Vec::with_capacity(self.nblocks);
+        let mut rest: &mut [u32] = &mut items;
+        for t in totals {
+            let (head, tail) = rest.split_at_mut(*t as usize);
+            slices.push(head);
+            rest = tail;
+        }
+        let (block_cells, ncell) = (self.block_cells, self.ncell);
+        slices.into_par_iter().enumerate().for_each(|(b, out)| {
+            let c0 = b * block_cells;
+            let base = offsets[b];
+            let mut fill: Vec<u32> = ptr[c0..(c0 + block_cells).min(ncell)]
+                .iter()
+                .map(|&p| p - base)
+                .collect();
+            for fi in block_members(members, b) {
+                visit(&span[fi as usize], self.rows(b), &self.dims, |c| {
+                    out[fill[c] as usize] = fi;
+                    fill[c] += 1;
+                });
+            }
+        });
+        items
+    }
+}
+
+/// The boxes that reach block `b`, in box order (see [`Blocks::members`]).
+fn block_members(members: &[Vec<Vec<u32>>], b: usize) -> impl Iterator<Item = u32> + '_ {
+    members.iter().flat_map(move |m| m[b].iter().copied())
+}
+
+/// Visit the cells of the block of rows (r0, r1) that a box of cell range `span` covers
+/// (a generic function, not a closure taking `dyn FnMut`: the visits inline, without a
+/// call per cell).
+#[inline(always)]
+fn visit(
+    span: &[[u32; 3]; 2],
+    (r0, r1): (usize, usize),
+    dims: &[usize; 3],
+    mut f: impl FnMut(usize),
+) {
+    let [ca, cb] = span;
+    for k in ca[2]..=cb[2] {
+        for j in ca[1]..=cb[1] {
+            let r = grid_row(dims, j, k);
+            if r < r0 || r >= r1 {
+                continue;
+            }
+            for i in ca[0]..=cb[0] {
+                f((r - r0) * dims[0] + i as usize);
+            }
+        }
+    }
 }
 
 impl Side {
