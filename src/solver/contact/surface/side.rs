@@ -6,7 +6,7 @@
 use rayon::prelude::*;
 
 use super::kernels::{bbox, envelope_directions, thickness_box, Friction, SlaveState};
-use crate::model::contacts::{InitialPenetration, Slave};
+use crate::model::contacts::{ContactDef, InitialPenetration, Slave};
 use crate::model::{ElementKind, Model};
 use crate::solver::contact::projectile::PENALTY_FACTOR;
 
@@ -192,36 +192,46 @@ pub(super) fn part_nodes(m: &Model, part: usize) -> Vec<u32> {
     v
 }
 
-impl Side {
-    /// The side of definition `row` whose `slave` nodes meet the faces of part `master`,
-    /// with the nodal masses `mass`.
-    pub(super) fn new(m: &Model, row: usize, slave: &Slave, master: usize, mass: &[f64]) -> Side {
-        let d = &m.contacts[row];
-        let slaves: Vec<u32> = match slave {
-            Slave::Part(p) => part_nodes(m, *p),
-            Slave::Set(s) => {
-                let mut v: Vec<u32> = m.node_sets[s].iter().map(|&n| n as u32).collect();
-                v.sort_unstable();
-                v.dedup();
-                v
-            }
-        };
-        let st = nodal_thickness(
-            m,
-            match slave {
-                Slave::Part(p) => Some(*p),
-                Slave::Set(_) => None,
-            },
-        );
-        let slave_t: Vec<f64> = slaves
-            .iter()
-            .map(|&s| d.slave_thickness.unwrap_or(st[s as usize]))
-            .collect();
+/// The slave nodes of a definition, sorted, each once.
+fn slave_nodes(m: &Model, slave: &Slave) -> Vec<u32> {
+    match slave {
+        Slave::Part(p) => part_nodes(m, *p),
+        Slave::Set(s) => {
+            let mut v: Vec<u32> = m.node_sets[s].iter().map(|&n| n as u32).collect();
+            v.sort_unstable();
+            v.dedup();
+            v
+        }
+    }
+}
+
+/// The faces of a definition's master part, in element order: their nodes (unused
+/// entries 0; `npe` per face), nodal contact thicknesses, nodal masses [kg] and element
+/// ids.
+struct MasterFaces {
+    faces: Vec<[u32; 4]>,
+    npe: usize,
+    face_t: Vec<[f64; 4]>,
+    face_m: Vec<[f64; 4]>,
+    face_id: Vec<i64>,
+}
+
+impl MasterFaces {
+    /// The faces of part `master` of definition `d`, with the nodal masses `mass`: each
+    /// node's thickness is the definition's `master_thickness`, else a membrane's own
+    /// nodal thickness, else its nodal thickness from its elements.
+    fn new(m: &Model, d: &ContactDef, master: usize, mass: &[f64]) -> MasterFaces {
         let kind = m.parts[master].kind;
         let b = &m.elements[&kind];
         let npe = kind.nodes_per_element();
         let mt = nodal_thickness(m, Some(master));
-        let (mut faces, mut face_t, mut face_m, mut face_id) = (vec![], vec![], vec![], vec![]);
+        let mut mf = MasterFaces {
+            faces: vec![],
+            npe,
+            face_t: vec![],
+            face_m: vec![],
+            face_id: vec![],
+        };
         for e in 0..b.len() {
             if b.part[e] != master {
                 continue;
@@ -240,11 +250,39 @@ impl Side {
                 });
                 fm[a] = mass[n];
             }
-            faces.push(f);
-            face_t.push(t);
-            face_m.push(fm);
-            face_id.push(b.id[e]);
+            mf.faces.push(f);
+            mf.face_t.push(t);
+            mf.face_m.push(fm);
+            mf.face_id.push(b.id[e]);
         }
+        mf
+    }
+}
+
+impl Side {
+    /// The side of definition `row` whose `slave` nodes meet the faces of part `master`,
+    /// with the nodal masses `mass`.
+    pub(super) fn new(m: &Model, row: usize, slave: &Slave, master: usize, mass: &[f64]) -> Side {
+        let d = &m.contacts[row];
+        let slaves = slave_nodes(m, slave);
+        let st = nodal_thickness(
+            m,
+            match slave {
+                Slave::Part(p) => Some(*p),
+                Slave::Set(_) => None,
+            },
+        );
+        let slave_t: Vec<f64> = slaves
+            .iter()
+            .map(|&s| d.slave_thickness.unwrap_or(st[s as usize]))
+            .collect();
+        let MasterFaces {
+            faces,
+            npe,
+            face_t,
+            face_m,
+            face_id,
+        } = MasterFaces::new(m, d, master, mass);
         let ts_max = slave_t.iter().cloned().fold(0.0, f64::max);
         let tf_max = face_t.iter().flatten().cloned().fold(0.0, f64::max);
         // The largest coordinate of the side's nodes, the scale of the round-off.
