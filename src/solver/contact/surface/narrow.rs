@@ -5,7 +5,9 @@
 
 use rayon::prelude::*;
 
-use super::kernels::{box_distance2, fmax, pair_force, release, thickness_gradient, SlaveState};
+use super::kernels::{
+    box_distance2, fmax, pair_force, release, thickness_gradient, Friction, SlaveState,
+};
 use super::side::{ChunkSums, PairOut, Reaction, Side, SLAVE_CHUNK};
 use crate::model::contacts::InitialPenetration;
 use crate::solver::contact::closest::closest_on_face;
@@ -133,6 +135,145 @@ fn filter_block<const NF: usize>(
     nn
 }
 
+/// The faces a slave penetrates, gathered over its candidates: the deepest, the
+/// penetration-weighted sums of the normals and of the thickness gradients, and how many
+/// of the shares (the chunk's scratch [`Shares`]) are filled.
+struct Found {
+    /// The candidate of largest raw penetration: (face, g, normal).
+    best: Option<(u32, f64, [f64; 3])>,
+    /// Σ g n over the faces the node penetrates (off their mid-surface), and how many: in
+    /// a concave crease (a node under a tent of two faces) both feet are valid and the
+    /// nearer one's normal flips as the node crosses the bisector; the
+    /// penetration-weighted normal turns continuously instead.
+    n_sum: [f64; 3],
+    n_count: u32,
+    /// Σ g ∇t_F and Σ g over the same faces.
+    tg_sum: [f64; 3],
+    g_sum: f64,
+    /// Shares filled.
+    n_pen: usize,
+}
+
+/// The faces a slave penetrates (face, weights, g), the deepest [`MAX_SHARED`]: the
+/// reaction is shared over them as the normal is, so that a node over a vertex or a
+/// ridge, whose faces tie, pushes them all alike (the deepest alone, ties to the first in
+/// face order, pushed one side only, and the reaction jumped between faces as the node
+/// moved: measured, a formed weave tiled from its mirror-symmetric cell was out of balance
+/// by 0.10 of the crossing force at the vertex's neighbours, and drifted when left alone).
+/// Scratch of a chunk of slaves (only the first `Found::n_pen` entries are read): declared
+/// once per chunk, not zeroed per slave.
+type Shares = [(u32, [f64; 4], f64); MAX_SHARED];
+
+impl Found {
+    /// Nothing found yet.
+    #[inline(always)]
+    fn new() -> Found {
+        Found {
+            best: None,
+            n_sum: [0.0; 3],
+            n_count: 0,
+            tg_sum: [0.0; 3],
+            g_sum: 0.0,
+            n_pen: 0,
+        }
+    }
+
+    /// A face `fi` the slave penetrates.
+    #[inline(always)]
+    fn add(&mut self, fi: u32, hit: Hit, pen: &mut Shares) {
+        let Hit {
+            w,
+            g,
+            dist,
+            r,
+            tg,
+            flat,
+        } = hit;
+        if self.n_pen < MAX_SHARED {
+            pen[self.n_pen] = (fi, w, g);
+            self.n_pen += 1;
+        } else {
+            // Full: replace the shallowest (the first of equals).
+            let mut k = 0;
+            for j in 1..MAX_SHARED {
+                if pen[j].2 < pen[k].2 {
+                    k = j;
+                }
+            }
+            if g > pen[k].2 {
+                pen[k] = (fi, w, g);
+            }
+        }
+        if dist > 0.0 {
+            for d in 0..3 {
+                self.n_sum[d] += g * r[d] / dist;
+                self.tg_sum[d] += g * tg[d];
+            }
+            self.g_sum += g;
+            self.n_count += 1;
+        }
+        if self.best.as_ref().is_none_or(|b| g > b.1) {
+            let n = if dist > 0.0 {
+                [r[0] / dist, r[1] / dist, r[2] / dist]
+            } else {
+                flat
+            };
+            self.best = Some((fi, g, n));
+        }
+    }
+}
+
+/// One narrow phase of a side: what it reads (the positions and velocities, the step,
+/// the side's slaves, faces and candidates), borrowed apart from the slaves' results and
+/// states, which it writes chunk by chunk.
+struct Narrow<'a> {
+    x: &'a [[f64; 3]],
+    v: &'a [[f64; 3]],
+    /// Δt² of the penalty, and Δt^{n−½} of the friction slip.
+    dt2: f64,
+    dt_prev: f64,
+    /// Setup: report penetrations instead of pushing.
+    initial: bool,
+    /// Per cell of the staleness test, |S| of `Side::margin` (None: no slave skipped).
+    spread: Option<&'a [f64]>,
+    face_box: &'a [[f64; 8]],
+    face_dir: &'a [[f32; 6]],
+    margin: &'a [f64],
+    slave_cell: &'a [u32],
+    faces: &'a [[u32; 4]],
+    face_t: &'a [[f64; 4]],
+    face_m: &'a [[f64; 4]],
+    slaves: &'a [u32],
+    slave_t: &'a [f64],
+    slave_m: &'a [f64],
+    cand_ptr: &'a [u32],
+    cand: &'a [u32],
+    fr: Friction,
+    kappa: f64,
+    zeta: f64,
+    /// The definition's initial penetrations are `keep`: the penalty acts on their full
+    /// depth from the start (no g₀ tracked).
+    keep: bool,
+    /// Round-off allowance η of the box tests [m].
+    eta: f64,
+}
+
+/// One fixed chunk of slaves as the narrow phase writes it: (chunk index, ((((results,
+/// (states, held)), slaves in contact), reaction shares), sums)).
+type Chunk<'c> = (
+    usize,
+    (
+        (
+            (
+                (&'c mut [PairOut], (&'c mut [SlaveState], &'c mut [bool])),
+                &'c mut Vec<u32>,
+            ),
+            &'c mut Vec<Reaction>,
+        ),
+        &'c mut ChunkSums,
+    ),
+);
+
 impl Side {
     /// Narrow phase and friction for every slave, in parallel chunks, into `out`.
     /// `initial`: report penetrations instead of pushing (setup).
@@ -164,260 +305,36 @@ impl Side {
         initial: bool,
         spread: Option<&[f64]>,
     ) {
-        let (face_box, face_dir) = (&self.face_box, &self.face_dir);
-        let (margin, slave_cell) = (&self.margin, &self.slave_cell);
-        let (faces, nf, face_t, face_m) = (&self.faces, NF, &self.face_t, &self.face_m);
-        let (slaves, slave_t, slave_m) = (&self.slaves, &self.slave_t, &self.slave_m);
-        let (cand_ptr, cand) = (&self.cand_ptr, &self.cand);
-        let (fr, kappa, zeta) = (self.friction, self.kappa, self.damping);
-        let keep = self.on_initial == InitialPenetration::Keep;
-        let eta = self.box_margin;
-        let dt2 = dt * dt;
+        let nar = Narrow {
+            x,
+            v,
+            dt2: dt * dt,
+            dt_prev,
+            initial,
+            spread,
+            face_box: &self.face_box,
+            face_dir: &self.face_dir,
+            margin: &self.margin,
+            slave_cell: &self.slave_cell,
+            faces: &self.faces,
+            face_t: &self.face_t,
+            face_m: &self.face_m,
+            slaves: &self.slaves,
+            slave_t: &self.slave_t,
+            slave_m: &self.slave_m,
+            cand_ptr: &self.cand_ptr,
+            cand: &self.cand,
+            fr: self.friction,
+            kappa: self.kappa,
+            zeta: self.damping,
+            keep: self.on_initial == InitialPenetration::Keep,
+            eta: self.box_margin,
+        };
         let nchunks = self.slaves.len().div_ceil(SLAVE_CHUNK);
         self.chunk_active.resize_with(nchunks, Vec::new);
         self.chunk_reactions.resize_with(nchunks, Vec::new);
         self.chunk_sums.resize(nchunks, ChunkSums::default());
-        type Chunk<'c> = (
-            usize,
-            (
-                (
-                    (
-                        (&'c mut [PairOut], (&'c mut [SlaveState], &'c mut [bool])),
-                        &'c mut Vec<u32>,
-                    ),
-                    &'c mut Vec<Reaction>,
-                ),
-                &'c mut ChunkSums,
-            ),
-        );
-        let body = |(ci, ((((outs, (sts, held)), active), reactions), sums)): Chunk| {
-            active.clear();
-            reactions.clear();
-            *sums = ChunkSums::default();
-            // Scratch of the slaves (only the first n_pen, nn entries are read):
-            // declared once per chunk, not zeroed per slave.
-            let mut pen = [(0u32, [0.0f64; 4], 0.0f64); MAX_SHARED];
-            let mut near = [0u32; 32];
-            // (A slave that is open and holds no state is not written: its output is
-            // read only while it is in contact, and its state is the default one. At the
-            // setup every slave is written.)
-            for (j, ((o, st), hd)) in outs
-                .iter_mut()
-                .zip(sts.iter_mut())
-                .zip(held.iter_mut())
-                .enumerate()
-            {
-                let si = ci * SLAVE_CHUNK + j;
-                if spread.is_some_and(|sp| margin[si] > sp[slave_cell[si] as usize]) {
-                    // No candidate can pass the filter (see `Side::margin`): what the
-                    // full test gives a slave that finds no face.
-                    sums.skipped += 1;
-                    if *hd {
-                        st.g0 = 0.0;
-                        sums.dissipated += release(st);
-                        *hd = false;
-                    }
-                    continue;
-                }
-                let s = slaves[si] as usize;
-                let p = x[s];
-                // The candidate of largest raw penetration.
-                let mut best: Option<(u32, f64, [f64; 3])> = None;
-                // Σ g n over the faces the node penetrates, and how many: in a concave
-                // crease (a node under a tent of two faces) both feet are valid and the
-                // nearer one's normal flips as the node crosses the bisector; the
-                // penetration-weighted normal turns continuously instead.
-                let (mut n_sum, mut n_count) = ([0.0f64; 3], 0u32);
-                let (mut tg_sum, mut g_sum) = ([0.0f64; 3], 0.0f64);
-                // The faces it penetrates (face, weights, g), the deepest MAX_SHARED: the
-                // reaction is shared over them as the normal is, so that a node over a
-                // vertex or a ridge, whose faces tie, pushes them all alike (the deepest
-                // alone, ties to the first in face order, pushed one side only, and the
-                // reaction jumped between faces as the node moved: measured, a formed weave
-                // tiled from its mirror-symmetric cell was out of balance by 0.10 of the
-                // crossing force at the vertex's neighbours, and drifted when left alone).
-                let mut n_pen = 0usize;
-                // A face can be penetrated only if the slave is within t_s/2 of its
-                // thickness box: the foot q = Σ w_a x_a is a convex combination of the
-                // nodes (each triangle's barycentric weights, averaged over a quad's
-                // two splits), and t_F = Σ w_a t_a the same combination of their
-                // thicknesses, so the ball of radius t_F/2 about q lies in the box, and
-                // |x_s − q| < (t_s + t_F)/2 puts x_s within t_s/2 of it. The test in
-                // floating point keeps η = 10⁻⁹ (|x|_max + reach) more, 10⁶ times the
-                // round-off of the foot and the box, so that it rejects only faces
-                // that the closest-point test below rejects too: the same bits.
-                let reach = 0.5 * slave_t[si] + eta;
-                let r2 = reach * reach;
-                // Only faces the node penetrates (g > 0) matter: a node whose best g is
-                // ≤ 0 is open whether or not some face was evaluated, and a tracked initial
-                // penetration g₀ then drops to 0 either way.
-                let list = &cand[cand_ptr[si] as usize..cand_ptr[si + 1] as usize];
-                sums.tested += list.len() as u64;
-                for block in list.chunks(32) {
-                    let nn = filter_block::<NF>(
-                        p[0], p[1], p[2], reach, r2, block, face_box, face_dir, &mut near,
-                    );
-                    sums.evaluated += nn as u64;
-                    for &fi in &near[..nn] {
-                        let Some(Hit {
-                            w,
-                            g,
-                            dist,
-                            r,
-                            tg,
-                            flat,
-                        }) = evaluate_face::<NF>(
-                            p[0],
-                            p[1],
-                            p[2],
-                            slave_t[si],
-                            &faces[fi as usize],
-                            &face_t[fi as usize],
-                            x,
-                        )
-                        else {
-                            continue;
-                        };
-                        sums.penetrated += 1;
-                        if n_pen < MAX_SHARED {
-                            pen[n_pen] = (fi, w, g);
-                            n_pen += 1;
-                        } else {
-                            // Full: replace the shallowest (the first of equals).
-                            let mut k = 0;
-                            for j in 1..MAX_SHARED {
-                                if pen[j].2 < pen[k].2 {
-                                    k = j;
-                                }
-                            }
-                            if g > pen[k].2 {
-                                pen[k] = (fi, w, g);
-                            }
-                        }
-                        if dist > 0.0 {
-                            for d in 0..3 {
-                                n_sum[d] += g * r[d] / dist;
-                                tg_sum[d] += g * tg[d];
-                            }
-                            g_sum += g;
-                            n_count += 1;
-                        }
-                        if best.as_ref().is_none_or(|b| g > b.1) {
-                            let n = if dist > 0.0 {
-                                [r[0] / dist, r[1] / dist, r[2] / dist]
-                            } else {
-                                flat
-                            };
-                            best = Some((fi, g, n));
-                        }
-                    }
-                }
-                let mut out = PairOut {
-                    face: u32::MAX,
-                    ..Default::default()
-                };
-                let g_raw = best.as_ref().map_or(f64::NEG_INFINITY, |b| b.1);
-                if initial {
-                    st.g0 = if keep { 0.0 } else { g_raw.max(0.0) };
-                    *hd = st.g0 != 0.0;
-                    if let Some(b) = &best {
-                        out.face = if g_raw > 0.0 { b.0 } else { u32::MAX };
-                    }
-                    *o = out;
-                    continue;
-                }
-                if !*hd && !(g_raw > 0.0) {
-                    // Open before and now, holding nothing (g₀ = 0, no stick spring):
-                    // nothing changes.
-                    continue;
-                }
-                // The tracked initial penetration shrinks as the node leaves.
-                if g_raw < st.g0 {
-                    st.g0 = g_raw.max(0.0);
-                }
-                let g = g_raw - st.g0;
-                match best {
-                    Some((fi, _, mut n)) if g > 0.0 => {
-                        if n_count > 1 {
-                            let l = dot(&n_sum, &n_sum).sqrt();
-                            if l > 0.0 {
-                                n = [n_sum[0] / l, n_sum[1] / l, n_sum[2] / l];
-                            }
-                        }
-                        // Shares λ_F = g_F/Σg of the penetrated faces; the foot's mass
-                        // and velocity are their λ-weighted interpolations, so that the
-                        // penalty and the friction slip are continuous as faces come and
-                        // go, and the power of the shared reaction is −f·v_foot.
-                        let g_pen: f64 = pen[..n_pen].iter().map(|e| e.2).sum();
-                        let ms = slave_m[si];
-                        let (mut mf, mut vf) = (0.0f64, [0.0f64; 3]);
-                        for &(fj, wj, gj) in &pen[..n_pen] {
-                            let lam = gj / g_pen;
-                            let fn_ = &faces[fj as usize];
-                            let fm = &face_m[fj as usize];
-                            for a in 0..nf {
-                                let la = lam * wj[a];
-                                mf += la * fm[a];
-                                let va = &v[fn_[a] as usize];
-                                for d in 0..3 {
-                                    vf[d] += la * va[d];
-                                }
-                            }
-                        }
-                        let mstar = if ms > 0.0 { ms.min(mf) } else { mf };
-                        let k = kappa * mstar / dt2;
-                        let vr = sub(&v[s], &vf);
-                        let vn = dot(&vr, &n);
-                        let vt = [vr[0] - vn * n[0], vr[1] - vn * n[1], vr[2] - vn * n[2]];
-                        let (mut force, stored, mut diss) =
-                            pair_force(g, &n, k, &vt, dt_prev, &fr, st);
-                        // Where the face's thickness varies (a lenticular band), the
-                        // contact distance depends on where the foot lies: the force is
-                        // −∂(½kg²)/∂x_s = k g (n − ½∇t_F), normal to the thickness
-                        // envelope rather than to the mid-surface; ∇t_F is weighted over
-                        // the penetrated faces like n, so that it turns continuously over
-                        // the ridge of a band's centre line.
-                        if g_sum > 0.0 {
-                            for d in 0..3 {
-                                force[d] -= 0.5 * k * g * tg_sum[d] / g_sum;
-                            }
-                        }
-                        if zeta > 0.0 {
-                            // Normal dashpot, never pulling the surfaces together.
-                            let c = 2.0 * zeta * (k * mstar).sqrt();
-                            let fd = (-c * vn).max(-k * g);
-                            for d in 0..3 {
-                                force[d] += fd * n[d];
-                            }
-                            diss -= fd * vn * dt_prev;
-                        }
-                        out = PairOut {
-                            face: fi,
-                            f: force,
-                            stored,
-                            dissipated: diss,
-                            g,
-                        };
-                        for &(fj, wj, gj) in &pen[..n_pen] {
-                            let lam = gj / g_pen;
-                            reactions.push(Reaction {
-                                slave: si as u32,
-                                face: fj,
-                                w: std::array::from_fn(|a| lam * wj[a]),
-                            });
-                        }
-                    }
-                    _ => out.dissipated = release(st),
-                }
-                *hd = st.k != 0.0 || st.g0 != 0.0 || st.ft != [0.0; 3];
-                if out.face != u32::MAX {
-                    active.push(si as u32);
-                    sums.stored += out.stored;
-                }
-                sums.dissipated += out.dissipated;
-                *o = out;
-            }
-        };
+        let body = |c: Chunk| nar.chunk::<NF>(c);
         if self.slaves.len() <= SLAVE_CHUNK {
             self.out
                 .chunks_mut(SLAVE_CHUNK)
@@ -449,6 +366,258 @@ impl Side {
                 // samples 14.8 % against 13.2 %, the second thread idle meanwhile).
                 .with_max_len(NARROW_TASK_CHUNKS)
                 .for_each(body);
+        }
+    }
+}
+
+impl Narrow<'_> {
+    /// The slaves of one chunk: each skipped, or its faces found, then its contact (or
+    /// at the setup its initial penetration) into its result, state and the chunk's
+    /// lists and sums.
+    #[inline(always)]
+    fn chunk<const NF: usize>(&self, c: Chunk) {
+        let (ci, ((((outs, (sts, held)), active), reactions), sums)) = c;
+        active.clear();
+        reactions.clear();
+        *sums = ChunkSums::default();
+        // Scratch of the slaves (only the first n_pen, nn entries are read):
+        // declared once per chunk, not zeroed per slave.
+        let mut pen: Shares = [(0u32, [0.0f64; 4], 0.0f64); MAX_SHARED];
+        let mut near = [0u32; 32];
+        // (A slave that is open and holds no state is not written: its output is
+        // read only while it is in contact, and its state is the default one. At the
+        // setup every slave is written.)
+        for (j, ((o, st), hd)) in outs
+            .iter_mut()
+            .zip(sts.iter_mut())
+            .zip(held.iter_mut())
+            .enumerate()
+        {
+            let si = ci * SLAVE_CHUNK + j;
+            if self
+                .spread
+                .is_some_and(|sp| self.margin[si] > sp[self.slave_cell[si] as usize])
+            {
+                // No candidate can pass the filter (see `Side::margin`): what the
+                // full test gives a slave that finds no face.
+                sums.skipped += 1;
+                if *hd {
+                    st.g0 = 0.0;
+                    sums.dissipated += release(st);
+                    *hd = false;
+                }
+                continue;
+            }
+            let s = self.slaves[si] as usize;
+            let found = self.search::<NF>(si, &self.x[s], &mut near, &mut pen, sums);
+            let mut out = PairOut {
+                face: u32::MAX,
+                ..Default::default()
+            };
+            let g_raw = found.best.as_ref().map_or(f64::NEG_INFINITY, |b| b.1);
+            if self.initial {
+                st.g0 = if self.keep { 0.0 } else { g_raw.max(0.0) };
+                *hd = st.g0 != 0.0;
+                if let Some(b) = &found.best {
+                    out.face = if g_raw > 0.0 { b.0 } else { u32::MAX };
+                }
+                *o = out;
+                continue;
+            }
+            if !*hd && !(g_raw > 0.0) {
+                // Open before and now, holding nothing (g₀ = 0, no stick spring):
+                // nothing changes.
+                continue;
+            }
+            // The tracked initial penetration shrinks as the node leaves.
+            if g_raw < st.g0 {
+                st.g0 = g_raw.max(0.0);
+            }
+            let g = g_raw - st.g0;
+            match found.best {
+                Some((fi, _, n)) if g > 0.0 => {
+                    // Shares λ_F = g_F/Σg of the penetrated faces.
+                    let pen = &pen[..found.n_pen];
+                    let g_pen: f64 = pen.iter().map(|e| e.2).sum();
+                    out = self.contact::<NF>(si, s, fi, n, g, &found, pen, g_pen, st);
+                    self.share_reaction(si, pen, g_pen, reactions);
+                }
+                _ => out.dissipated = release(st),
+            }
+            *hd = st.k != 0.0 || st.g0 != 0.0 || st.ft != [0.0; 3];
+            if out.face != u32::MAX {
+                active.push(si as u32);
+                sums.stored += out.stored;
+            }
+            sums.dissipated += out.dissipated;
+            *o = out;
+        }
+    }
+
+    /// The faces slave `si` at `p` penetrates, among its candidates (counted into `sums`),
+    /// in candidate order.
+    #[inline(always)]
+    fn search<const NF: usize>(
+        &self,
+        si: usize,
+        p: &[f64; 3],
+        near: &mut [u32; 32],
+        pen: &mut Shares,
+        sums: &mut ChunkSums,
+    ) -> Found {
+        let mut found = Found::new();
+        // A face can be penetrated only if the slave is within t_s/2 of its
+        // thickness box: the foot q = Σ w_a x_a is a convex combination of the
+        // nodes (each triangle's barycentric weights, averaged over a quad's
+        // two splits), and t_F = Σ w_a t_a the same combination of their
+        // thicknesses, so the ball of radius t_F/2 about q lies in the box, and
+        // |x_s − q| < (t_s + t_F)/2 puts x_s within t_s/2 of it. The test in
+        // floating point keeps η = 10⁻⁹ (|x|_max + reach) more, 10⁶ times the
+        // round-off of the foot and the box, so that it rejects only faces
+        // that the closest-point test below rejects too: the same bits.
+        let reach = 0.5 * self.slave_t[si] + self.eta;
+        let r2 = reach * reach;
+        // Only faces the node penetrates (g > 0) matter: a node whose best g is
+        // ≤ 0 is open whether or not some face was evaluated, and a tracked initial
+        // penetration g₀ then drops to 0 either way.
+        let list = &self.cand[self.cand_ptr[si] as usize..self.cand_ptr[si + 1] as usize];
+        sums.tested += list.len() as u64;
+        for block in list.chunks(32) {
+            let nn = filter_block::<NF>(
+                p[0],
+                p[1],
+                p[2],
+                reach,
+                r2,
+                block,
+                self.face_box,
+                self.face_dir,
+                near,
+            );
+            sums.evaluated += nn as u64;
+            for &fi in &near[..nn] {
+                let Some(hit) = evaluate_face::<NF>(
+                    p[0],
+                    p[1],
+                    p[2],
+                    self.slave_t[si],
+                    &self.faces[fi as usize],
+                    &self.face_t[fi as usize],
+                    self.x,
+                ) else {
+                    continue;
+                };
+                sums.penetrated += 1;
+                found.add(fi, hit, pen);
+            }
+        }
+        found
+    }
+
+    /// The contact of slave `si` (node `s`) with its deepest face `fi` of normal `n`, at
+    /// the penetration `g` beyond its tracked initial one, over the penetrated faces `pen`
+    /// (of total penetration `g_pen`): the normal (their penetration-weighted mean where
+    /// it penetrates several), the penalty and friction force, the envelope's slope and
+    /// the normal dashpot, into the slave's result.
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    fn contact<const NF: usize>(
+        &self,
+        si: usize,
+        s: usize,
+        fi: u32,
+        mut n: [f64; 3],
+        g: f64,
+        found: &Found,
+        pen: &[(u32, [f64; 4], f64)],
+        g_pen: f64,
+        st: &mut SlaveState,
+    ) -> PairOut {
+        let (n_sum, tg_sum, g_sum) = (found.n_sum, found.tg_sum, found.g_sum);
+        if found.n_count > 1 {
+            let l = dot(&n_sum, &n_sum).sqrt();
+            if l > 0.0 {
+                n = [n_sum[0] / l, n_sum[1] / l, n_sum[2] / l];
+            }
+        }
+        let (mf, vf) = self.foot::<NF>(pen, g_pen);
+        let ms = self.slave_m[si];
+        let mstar = if ms > 0.0 { ms.min(mf) } else { mf };
+        let k = self.kappa * mstar / self.dt2;
+        let vr = sub(&self.v[s], &vf);
+        let vn = dot(&vr, &n);
+        let vt = [vr[0] - vn * n[0], vr[1] - vn * n[1], vr[2] - vn * n[2]];
+        let (mut force, stored, mut diss) = pair_force(g, &n, k, &vt, self.dt_prev, &self.fr, st);
+        // Where the face's thickness varies (a lenticular band), the
+        // contact distance depends on where the foot lies: the force is
+        // −∂(½kg²)/∂x_s = k g (n − ½∇t_F), normal to the thickness
+        // envelope rather than to the mid-surface; ∇t_F is weighted over
+        // the penetrated faces like n, so that it turns continuously over
+        // the ridge of a band's centre line.
+        if g_sum > 0.0 {
+            for d in 0..3 {
+                force[d] -= 0.5 * k * g * tg_sum[d] / g_sum;
+            }
+        }
+        if self.zeta > 0.0 {
+            // Normal dashpot, never pulling the surfaces together.
+            let c = 2.0 * self.zeta * (k * mstar).sqrt();
+            let fd = (-c * vn).max(-k * g);
+            for d in 0..3 {
+                force[d] += fd * n[d];
+            }
+            diss -= fd * vn * self.dt_prev;
+        }
+        PairOut {
+            face: fi,
+            f: force,
+            stored,
+            dissipated: diss,
+            g,
+        }
+    }
+
+    /// The foot's mass and velocity: over the penetrated faces `pen` (of total
+    /// penetration `g_pen`) in the shares λ_F = g_F/Σg, their nodes' masses and
+    /// velocities interpolated at their feet, so that the penalty and the friction slip
+    /// are continuous as faces come and go, and the power of the shared reaction is
+    /// −f·v_foot.
+    #[inline(always)]
+    fn foot<const NF: usize>(&self, pen: &[(u32, [f64; 4], f64)], g_pen: f64) -> (f64, [f64; 3]) {
+        let (mut mf, mut vf) = (0.0f64, [0.0f64; 3]);
+        for &(fj, wj, gj) in pen {
+            let lam = gj / g_pen;
+            let fn_ = &self.faces[fj as usize];
+            let fm = &self.face_m[fj as usize];
+            for a in 0..NF {
+                let la = lam * wj[a];
+                mf += la * fm[a];
+                let va = &self.v[fn_[a] as usize];
+                for d in 0..3 {
+                    vf[d] += la * va[d];
+                }
+            }
+        }
+        (mf, vf)
+    }
+
+    /// The shares of slave `si`'s reaction over the faces it penetrates (`pen`, of total
+    /// penetration `g_pen`), in the same shares λ_F = g_F/Σg as its foot.
+    #[inline(always)]
+    fn share_reaction(
+        &self,
+        si: usize,
+        pen: &[(u32, [f64; 4], f64)],
+        g_pen: f64,
+        reactions: &mut Vec<Reaction>,
+    ) {
+        for &(fj, wj, gj) in pen {
+            let lam = gj / g_pen;
+            reactions.push(Reaction {
+                slave: si as u32,
+                face: fj,
+                w: std::array::from_fn(|a| lam * wj[a]),
+            });
         }
     }
 }
