@@ -7,16 +7,20 @@
 //! [1/s]; u = x − X displacement.
 //!
 //! Where things live:
-//! - [`family`]: the element-family vocabulary and [`Families`], the list of families
-//!   (one module each: [`truss`], [`link`], [`point_mass`], [`membrane`] (triangles and
-//!   quads), [`beam`]);
+//! - [`family`]: the element-family vocabulary; [`families`]: [`Families`], the list of
+//!   families (one module each: [`truss`], [`link`], [`sliding_link`], [`point_mass`],
+//!   [`membrane`] (triangles and quads), [`beam`]); [`rotations`]: the rotational nodes
+//!   the beams create;
 //! - [`operator`]: loads, element forces, contact and tie transfer → nodal forces;
 //! - [`integrator`]: central difference for the nodes, the rotations and (through
 //!   [`contact`]) the rigid projectiles;
 //! - [`stable`]: the stable step (nodal Gershgorin bound) and mass scaling;
-//! - [`ties`], [`contact`]: tied interfaces, projectile contact;
-//! - this module: setup ([`Solver::new`]), the time loop ([`Solver::run`]), the energy
-//!   ledger and the sampling onto the output grid.
+//! - [`ties`], [`contact`]: tied interfaces, projectile and surface contact;
+//! - [`energy`]: the energies and the ledger; [`output`]: the sampling onto the output
+//!   grid and the sinks;
+//! - [`statics`], [`relax`]: linear statics and dynamic relaxation on the same model;
+//! - this module: setup ([`Solver::new`]) and the time loop ([`Solver::run`]), a short
+//!   list of named steps.
 //!
 //! Phases of a step: loads (f_ext at t_n, external work) → element forces (per element,
 //! in parallel chunks, into a per-element force buffer) → contact and ties → node
