@@ -16,7 +16,8 @@ use super::weave::{centre_line, family, quads, trusses, CentreLines};
 /// the element).
 pub fn check_penetration(m: &Model, solver: &Solver, limit: f64) -> Result<f64> {
     let max_pen = solver.op.surfaces.deepest();
-    if let Some((r, g, cid, node, el)) = max_pen {
+    if let Some(d) = max_pen {
+        let (r, g, cid, node, el) = (d.ratio, d.depth, d.contact_id, d.node, d.element);
         if r > limit {
             // The surface's element kind (of the definition's master part; a two-way
             // definition between bands or between chains has one kind on both sides).
@@ -37,7 +38,7 @@ pub fn check_penetration(m: &Model, solver: &Solver, limit: f64) -> Result<f64> 
             .hint("lower the tension, or raise the contact penalty_scale in contacts.parquet"));
         }
     }
-    Ok(max_pen.map_or(0.0, |d| d.0))
+    Ok(max_pen.map_or(0.0, |d| d.ratio))
 }
 
 /// The bands' tension per family: the volume mean of (P ê₁)·f̂₁ × the yarn's section

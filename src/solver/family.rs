@@ -13,11 +13,11 @@
 //! - `energies`: per-chunk partial sums (internal, damping, friction, hourglass).
 //!
 //! Adding a family is one file that implements [`Family`] and one line in
-//! [`families!`](crate::families)' invocation in `solver/mod.rs`. The order of that list
+//! [`families!`](crate::families)' invocation in `solver/families.rs`. The order of that list
 //! is the order of the force slots, of the masses' accumulation and of the sums, so it
 //! is part of what makes results reproducible bit for bit.
 
-use super::beam::Rotations;
+use super::rotations::Rotations;
 use super::vec3::{Mat3, Vec3};
 use crate::error::Result;
 use crate::model::{ElementKind, Model};

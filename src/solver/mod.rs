@@ -7,16 +7,20 @@
 //! [1/s]; u = x − X displacement.
 //!
 //! Where things live:
-//! - [`family`]: the element-family vocabulary and [`Families`], the list of families
-//!   (one module each: [`truss`], [`link`], [`point_mass`], [`membrane`] (triangles and
-//!   quads), [`beam`]);
+//! - [`family`]: the element-family vocabulary; [`families`]: [`Families`], the list of
+//!   families (one module each: [`truss`], [`link`], [`sliding_link`], [`point_mass`],
+//!   [`membrane`] (triangles and quads), [`beam`]); [`rotations`]: the rotational nodes
+//!   the beams create;
 //! - [`operator`]: loads, element forces, contact and tie transfer → nodal forces;
 //! - [`integrator`]: central difference for the nodes, the rotations and (through
 //!   [`contact`]) the rigid projectiles;
 //! - [`stable`]: the stable step (nodal Gershgorin bound) and mass scaling;
-//! - [`ties`], [`contact`]: tied interfaces, projectile contact;
-//! - this module: setup ([`Solver::new`]), the time loop ([`Solver::run`]), the energy
-//!   ledger and the sampling onto the output grid.
+//! - [`ties`], [`contact`]: tied interfaces, projectile and surface contact;
+//! - [`energy`]: the energies and the ledger; [`output`]: the sampling onto the output
+//!   grid and the sinks;
+//! - [`statics`], [`relax`]: linear statics and dynamic relaxation on the same model;
+//! - this module: setup ([`Solver::new`]) and the time loop ([`Solver::run`]), a short
+//!   list of named steps.
 //!
 //! Phases of a step: loads (f_ext at t_n, external work) → element forces (per element,
 //! in parallel chunks, into a per-element force buffer) → contact and ties → node
@@ -27,6 +31,8 @@
 
 pub mod beam;
 pub mod contact;
+pub mod energy;
+pub mod families;
 pub mod family;
 pub mod integrator;
 pub mod link;
@@ -35,6 +41,7 @@ pub mod operator;
 pub mod output;
 pub mod point_mass;
 pub mod relax;
+pub mod rotations;
 pub mod sliding_link;
 pub mod stable;
 pub mod statics;
@@ -47,95 +54,17 @@ use std::time::{Duration, Instant};
 use crate::error::{Result, WeftError};
 use crate::model::{ElementKind, Model};
 
+use energy::{energy_floor, Ledger};
+pub use energy::{ElementEnergies, Energies, ENERGY_CHECK_AFTER};
+pub use families::Families;
 use family::ForceCtx;
 pub use family::CHUNK;
 use integrator::{Nodal, NodePartial};
 pub use operator::{Operator, State};
+use output::Sampler;
+pub use output::Sink;
 pub use stable::{MassScaling, StableStep};
 pub use ties::tie_weights;
-
-crate::families! {
-    truss: truss::TrussGroup,
-    link: link::LinkGroup,
-    framed_link: link::FramedLinkGroup,
-    sliding_link: sliding_link::SlidingLinkGroup,
-    point_mass: point_mass::PointMassGroup,
-    tri: membrane::MembraneGroup<3>,
-    quad: membrane::MembraneGroup<4>,
-    beam: beam::BeamGroup,
-}
-
-/// The energy-balance stop applies from this step on. In the first steps every energy
-/// is O(Δt⁴) and the trapezoidal external work lags the kinetic energy by a relative O(1)
-/// (Belytschko et al. §6.2.3); an instability grows exponentially and is caught soon
-/// after. NaN and infinity are caught from the first step.
-pub const ENERGY_CHECK_AFTER: u64 = 100;
-
-/// Energies at one time [J].
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub struct Energies {
-    pub kinetic: f64,
-    /// Stored elastic energy of all elements.
-    pub internal: f64,
-    /// Dissipated by dashpots and mass-proportional damping.
-    pub damping: f64,
-    /// Dissipated by friction sliders.
-    pub friction: f64,
-    /// Hourglass energy (membrane quads).
-    pub hourglass: f64,
-    /// Contact energy: stored penalty energy and friction work in contact.
-    pub contact: f64,
-    pub external_work: f64,
-    /// kinetic + internal + damping + friction + hourglass + contact − initial − external work.
-    pub balance_error: f64,
-    /// |balance_error| over the energy scale so far, [`Energies::scale`].
-    pub balance_error_relative: f64,
-    /// Energy scale so far: max(|initial|, |external work|, kinetic + |internal|) over
-    /// the samples up to this one, and never below the round-off floor of the model (the
-    /// kinetic energy of its whole mass moving 10⁻¹² of its size per step) [J].
-    pub scale: f64,
-}
-
-impl Energies {
-    fn lerp(&self, o: &Energies, w: f64) -> Energies {
-        let l = |a: f64, b: f64| a + w * (b - a);
-        Energies {
-            kinetic: l(self.kinetic, o.kinetic),
-            internal: l(self.internal, o.internal),
-            damping: l(self.damping, o.damping),
-            friction: l(self.friction, o.friction),
-            hourglass: l(self.hourglass, o.hourglass),
-            contact: l(self.contact, o.contact),
-            external_work: l(self.external_work, o.external_work),
-            balance_error: l(self.balance_error, o.balance_error),
-            balance_error_relative: l(self.balance_error_relative, o.balance_error_relative),
-            scale: l(self.scale, o.scale),
-        }
-    }
-}
-
-/// Element energies at one state [J].
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub struct ElementEnergies {
-    /// Stored elastic energy.
-    pub internal: f64,
-    /// Dissipated by dashpots so far.
-    pub damping: f64,
-    /// Dissipated by link sliders so far.
-    pub friction: f64,
-    pub hourglass: f64,
-}
-
-/// Receives the output samples on the output time grid.
-pub trait Sink {
-    /// Displacements and velocities of the output nodes at time t.
-    fn history(&mut self, t: f64, nodes: &[usize], u: &[[f64; 3]], v: &[[f64; 3]]) -> Result<()>;
-    fn energy(&mut self, t: f64, e: &Energies) -> Result<()>;
-    /// A projectile at time t: tip position, velocity, contact force on it.
-    fn projectile(&mut self, _t: f64, _id: i64, _state: &[f64; 9]) -> Result<()> {
-        Ok(())
-    }
-}
 
 /// Wall time per phase.
 #[derive(Debug, Clone, Default)]
@@ -171,186 +100,6 @@ impl RunStats {
         } else {
             0.0
         }
-    }
-}
-
-/// The energy ledger: the running balance E_kin + E_int + dissipated + contact − E₀ −
-/// W_ext, checked at every output sample.
-#[derive(Debug, Clone, Default)]
-struct Ledger {
-    /// Energy dissipated by mass-proportional damping [J] (trapezoidal in time).
-    mass_damping: f64,
-    /// Total energy at the first sample.
-    e0: Option<f64>,
-    /// Reference energy max(|E₀|, |W_ext|, E_kin + |E_int|) so far, at least `floor`.
-    reference: f64,
-    /// Round-off floor of the reference [J] (see [`Energies::scale`]): a model with no
-    /// load and no initial velocity has only round-off energies (~1e-27 J), which must
-    /// not be judged against each other.
-    floor: f64,
-    max_rel: f64,
-    last_rel: f64,
-}
-
-impl Ledger {
-    /// Books the energies at t_n; the relative balance error.
-    fn book(
-        &mut self,
-        ke: f64,
-        el: &ElementEnergies,
-        contact: f64,
-        w_ext: f64,
-        step: u64,
-    ) -> Energies {
-        let (ie, damp, fric, hg) = (el.internal, el.damping, el.friction, el.hourglass);
-        let total = ke + ie + damp + self.mass_damping + fric + hg + contact;
-        let e_init = *self.e0.get_or_insert(total);
-        let err = total - e_init - w_ext;
-        // |E_int|: with initial stresses the stored energy ½E·DE + S₀·E can be negative.
-        self.reference = self
-            .reference
-            .max(self.floor)
-            .max(e_init.abs())
-            .max(w_ext.abs())
-            .max(ke + ie.abs());
-        let rel = if self.reference > 0.0 {
-            err.abs() / self.reference
-        } else {
-            0.0
-        };
-        if step >= ENERGY_CHECK_AFTER {
-            self.max_rel = self.max_rel.max(rel);
-        }
-        self.last_rel = rel;
-        Energies {
-            kinetic: ke,
-            internal: ie,
-            damping: damp + self.mass_damping,
-            friction: fric,
-            hourglass: hg,
-            contact,
-            external_work: w_ext,
-            balance_error: err,
-            balance_error_relative: rel,
-            scale: self.reference,
-        }
-    }
-    /// The run's balance: the worst after ENERGY_CHECK_AFTER steps, else the last.
-    fn reported(&self, steps: u64) -> f64 {
-        if steps >= ENERGY_CHECK_AFTER {
-            self.max_rel
-        } else {
-            self.last_rel
-        }
-    }
-}
-
-/// Round-off floor of the energy scale [J]: ½ M (10⁻¹² L/Δt)², the kinetic energy of
-/// the model's mass M moving 10⁻¹² of its size L (bounding-box diagonal) per step. Round-off
-/// motion (positions to ~2·10⁻¹⁶ L) is ~10⁸ times below it; a loaded model's energies are
-/// many orders above it.
-fn energy_floor(x: &[[f64; 3]], mass: &[f64], dt: f64) -> f64 {
-    let mut lo = [f64::INFINITY; 3];
-    let mut hi = [f64::NEG_INFINITY; 3];
-    for p in x {
-        for d in 0..3 {
-            lo[d] = lo[d].min(p[d]);
-            hi[d] = hi[d].max(p[d]);
-        }
-    }
-    let l2: f64 = (0..3).map(|d| (hi[d] - lo[d]).powi(2)).sum();
-    let m: f64 = mass.iter().filter(|m| m.is_finite()).sum();
-    if !(dt > 0.0) || !l2.is_finite() {
-        return 0.0;
-    }
-    0.5 * m * 1e-24 * l2 / (dt * dt)
-}
-
-/// One snapshot of the output nodes at a step.
-#[derive(Debug, Clone, Default)]
-struct Snapshot {
-    t: f64,
-    u: Vec<[f64; 3]>,
-    v: Vec<[f64; 3]>,
-    e: Energies,
-    /// Per projectile: tip x, y, z, velocity, contact force.
-    proj: Vec<[f64; 9]>,
-}
-
-/// Linear interpolation of the step snapshots onto the fixed output grid t_k = k·Δt_out.
-struct Sampler {
-    prev: Snapshot,
-    cur: Snapshot,
-    have_prev: bool,
-    interp_u: Vec<[f64; 3]>,
-    interp_v: Vec<[f64; 3]>,
-}
-
-impl Sampler {
-    fn new(nout: usize) -> Sampler {
-        let prev = Snapshot {
-            u: vec![[0.0; 3]; nout],
-            v: vec![[0.0; 3]; nout],
-            ..Default::default()
-        };
-        Sampler {
-            cur: prev.clone(),
-            prev,
-            have_prev: false,
-            interp_u: vec![[0.0; 3]; nout],
-            interp_v: vec![[0.0; 3]; nout],
-        }
-    }
-
-    /// Sends every output time t_k ≤ `cur.t` not sent yet (k from `*k`), interpolated
-    /// between the previous and the current snapshot; then the current becomes previous.
-    fn emit(
-        &mut self,
-        k: &mut u64,
-        n_out: u64,
-        dt_out: f64,
-        ids: &[i64],
-        nodes: &[usize],
-        sink: &mut (dyn Sink + Send),
-        mut progress: impl FnMut(u64, f64),
-    ) -> Result<()> {
-        let (prev, cur) = (&self.prev, &self.cur);
-        while *k <= n_out && *k as f64 * dt_out <= cur.t {
-            let tk = *k as f64 * dt_out;
-            let w = if self.have_prev && prev.t < tk {
-                (tk - prev.t) / (cur.t - prev.t)
-            } else {
-                1.0
-            };
-            for (j, id) in ids.iter().enumerate() {
-                let row: [f64; 9] = if w >= 1.0 {
-                    cur.proj[j]
-                } else {
-                    std::array::from_fn(|c| {
-                        prev.proj[j][c] + w * (cur.proj[j][c] - prev.proj[j][c])
-                    })
-                };
-                sink.projectile(tk, *id, &row)?;
-            }
-            let (src_u, src_v, e) = if w >= 1.0 {
-                (&cur.u, &cur.v, cur.e)
-            } else {
-                for j in 0..cur.u.len() {
-                    for d in 0..3 {
-                        self.interp_u[j][d] = prev.u[j][d] + w * (cur.u[j][d] - prev.u[j][d]);
-                        self.interp_v[j][d] = prev.v[j][d] + w * (cur.v[j][d] - prev.v[j][d]);
-                    }
-                }
-                (&self.interp_u, &self.interp_v, prev.e.lerp(&cur.e, w))
-            };
-            sink.history(tk, nodes, src_u, src_v)?;
-            sink.energy(tk, &e)?;
-            progress(*k, tk);
-            *k += 1;
-        }
-        std::mem::swap(&mut self.prev, &mut self.cur);
-        self.have_prev = true;
-        Ok(())
     }
 }
 
@@ -436,13 +185,13 @@ impl Solver {
             )));
         }
         let mut mass = vec![0.0; nn];
-        let mut rot = beam::Rotations::new(nn);
+        let mut rot = rotations::Rotations::new(nn);
         let el = Families::build(&mut family::Build {
             model: m,
             mass: &mut mass,
             rot: &mut rot,
         })?;
-        rot.finish(m, &el.beam);
+        rot.finish(m, &el.beam.rot);
         let faces: Vec<(&[u32], f64)> = el
             .tri
             .nodes
@@ -572,7 +321,11 @@ impl Solver {
             );
         }
         if let Some(target) = a.target_time_step {
-            self.scale_mass(target, a.dt_safety);
+            let (mass, rep) =
+                self.nodal_bound()
+                    .scale_mass(target, a.dt_safety, self.physical_mass);
+            self.mass = mass;
+            self.scaling = Some(rep);
         }
         for (im, m) in self.inv_m.iter_mut().zip(&self.mass) {
             *im = if *m > 0.0 { 1.0 / m } else { 0.0 };
@@ -655,6 +408,28 @@ impl Solver {
             element: self.controlling_element(node),
         };
         Ok(())
+    }
+
+    /// The nodes as the stable step's bound reads them (see [`stable::NodalBound`]).
+    fn nodal_bound(&self) -> stable::NodalBound<'_> {
+        stable::NodalBound {
+            op: &self.op,
+            state: &self.state,
+            mass: &self.mass,
+            fixed: &self.fixed,
+            alpha: self.alpha,
+            node_id: &self.node_id,
+        }
+    }
+
+    /// The stable step (without safety factor) and its controlling node.
+    pub fn stable_step(&self) -> (f64, usize) {
+        self.nodal_bound().stable_step()
+    }
+
+    /// The stiffest element attached to a node.
+    pub fn controlling_element(&self, node: usize) -> Option<(ElementKind, i64)> {
+        self.nodal_bound().controlling_element(node)
     }
 
     /// A slave's initial velocity must be its masters'.
@@ -817,170 +592,33 @@ impl Solver {
         let mut k = 0u64;
         let progress_every = (n_out / 200).max(1);
         let mut last_e = Energies::default();
-        let mut stiffening = self.stiffening_check();
+        let mut stiffening = self.nodal_bound().stiffening_check();
         while k <= n_out {
             if self.state.step % STIFFENING_CHECK_EVERY == 0 {
-                self.check_stiffening(&mut stiffening, dt)?;
+                self.nodal_bound()
+                    .check_stiffening(&mut stiffening, dt, a.dt_safety)?;
             }
-            let t0 = Instant::now();
-            self.op.apply_loads(&self.state);
-            let t1 = Instant::now();
-            self.op.element_forces(&self.state);
-            let t1c = Instant::now();
-            self.op.contact_and_ties(&self.state, &self.mass, dt);
-            let t2 = Instant::now();
-            times.contact += t2 - t1c;
-            times.loads += t1 - t0;
-            times.forces += t2 - t1;
+            let t2 = self.compute_forces(dt, &mut times);
             let dt_next = dt;
             let snap = k as f64 * a.output_interval <= self.state.t + dt_next;
-            let nd = Nodal {
-                inv_m: &self.inv_m,
-                mass: &self.mass,
-                fixed: &self.fixed,
-                alpha: self.alpha,
-            };
-            let r = if snap {
-                integrator::advance_nodes::<true>(
-                    &mut self.state,
-                    &self.op,
-                    &nd,
-                    dt_next,
-                    &mut self.partials,
-                )
-            } else {
-                integrator::advance_nodes::<false>(
-                    &mut self.state,
-                    &self.op,
-                    &nd,
-                    dt_next,
-                    &mut self.partials,
-                )
-            };
-            let (ke, dp) = r.map_err(|node| self.nan_error(node))?;
+            let (ke, dp) = self.advance_nodes(snap, dt_next)?;
             // Element energies at t_n (x^n is in xn), before the rotations advance.
             let el_e = if snap {
                 self.element_energies_at(true)
             } else {
                 ElementEnergies::default()
             };
-            let (ke_rot, dp_rot) = if self.state.rot.is_empty() {
-                (0.0, 0.0)
-            } else {
-                integrator::advance_rotations(
-                    &mut self.state,
-                    &self.op.el.beam.moments,
-                    self.alpha,
-                    dt_next,
-                    &self.node_id,
-                )?
-            };
+            let (ke_rot, dp_rot) = self.advance_rotations(dt_next)?;
             let (ke, dp) = (ke + ke_rot, dp + dp_rot);
             self.ledger.mass_damping += 0.5 * self.state.dt_prev * dp;
-            if !self.op.ties.is_empty() {
-                let st = &mut self.state;
-                self.op
-                    .ties
-                    .update_slaves(&mut st.x, &mut st.v, snap.then_some(&mut st.vn[..]));
-            }
-            let mut contact_e = 0.0;
-            if snap {
-                // Projectile states at t_n: tip and contact force before their update.
-                sampler.cur.proj.clear();
-                for p in &self.op.projectiles.projectiles {
-                    sampler.cur.proj.push([
-                        p.tip[0], p.tip[1], p.tip[2], 0.0, 0.0, 0.0, p.force[0], p.force[1],
-                        p.force[2],
-                    ]);
-                }
-                if !self.op.projectiles.is_empty() {
-                    contact_e = self.op.projectiles.energy(&self.state.xn, &self.mass, dt);
-                }
-            }
-            let ke_proj = if self.op.projectiles.is_empty() {
-                0.0
-            } else {
-                self.op.projectiles.advance(self.state.dt_prev, dt_next)
-            };
+            self.update_tie_slaves(snap);
+            let (contact_e, ke_proj) =
+                self.advance_projectiles(snap, dt, dt_next, &mut sampler.cur.proj);
             let ke = ke + ke_proj;
             let t3 = Instant::now();
             times.update += t3 - t2;
             if snap {
-                for (row, p) in sampler
-                    .cur
-                    .proj
-                    .iter_mut()
-                    .zip(&self.op.projectiles.projectiles)
-                {
-                    row[3..6].copy_from_slice(&p.v_full);
-                }
-                let contact = contact_e
-                    + self.op.projectiles.friction_work
-                    + (self.op.surfaces.stored + self.op.surfaces.dissipated);
-                let w_ext = self.op.loads.work + self.op.projectiles.prescribed_work;
-                let e = self.ledger.book(ke, &el_e, contact, w_ext, self.state.step);
-                sampler.cur.t = self.state.t;
-                sampler.cur.e = e;
-                last_e = e;
-                // A non-finite energy is a broken run even when the nodes are finite (a
-                // comparison with NaN is false: it would pass the check below).
-                let terms = [
-                    ("kinetic", ke),
-                    ("internal", el_e.internal),
-                    ("damping", el_e.damping),
-                    ("friction", el_e.friction),
-                    ("hourglass", el_e.hourglass),
-                    ("contact (stored and friction work)", contact),
-                    ("external work", w_ext),
-                ];
-                if let Some((name, v)) = terms.iter().find(|(_, v)| !v.is_finite()) {
-                    let hint = if *name == "external work" {
-                        let big = self.op.loads.loads.iter().max_by(|a, b| {
-                            let m = |l: &crate::model::Load| {
-                                l.force.iter().map(|f| f.abs()).fold(0.0, f64::max)
-                            };
-                            m(a).total_cmp(&m(b))
-                        });
-                        match big {
-                            Some(l) => format!(
-                                "the loads' work overflowed: the largest is load `{}` (loads.parquet, node `{}`, force {:?} N)",
-                                l.id, self.node_id[l.node], l.force
-                            ),
-                            None => "a projectile with prescribed velocity did non-finite work".to_string(),
-                        }
-                    } else if *name == "kinetic" {
-                        "a mass × velocity² overflowed: check the initial velocities, the element and point masses (parts.parquet) and the projectiles' mass and velocity (projectile.parquet)".to_string()
-                    } else {
-                        "a penalty or element with zero mass or zero length somewhere; the contact report names the definitions (run with the same model and a shorter end time to look at it)".to_string()
-                    };
-                    return Err(WeftError::Numerical {
-                        what: format!("the {name} energy is {v}"),
-                        step: self.state.step,
-                        time: self.state.t,
-                        hint: Some(hint),
-                    });
-                }
-                if e.balance_error_relative > a.max_energy_error
-                    && self.state.step >= ENERGY_CHECK_AFTER
-                {
-                    return Err(WeftError::Numerical {
-                        what: format!(
-                            "energy balance error {:.3e} J is {:.1} % of the reference energy {:.3e} J (limit {:.1} %): the run is unstable or a force is not conservative",
-                            e.balance_error, 100.0 * e.balance_error_relative, self.ledger.reference, 100.0 * a.max_energy_error
-                        ),
-                        step: self.state.step,
-                        time: self.state.t,
-                        hint: Some(format!(
-                            "the step is {:.4e} s (stable estimate {:.4e} s); lower dt_safety, or raise max_energy_error if the loss is physical",
-                            self.stable.dt, self.stable.dt_stable
-                        )),
-                    });
-                }
-                for (j, &i) in self.output_nodes.iter().enumerate() {
-                    let (x, x0) = (self.state.xn[i], self.x0[i]);
-                    sampler.cur.u[j] = [x[0] - x0[0], x[1] - x0[1], x[2] - x0[2]];
-                    sampler.cur.v[j] = self.state.vn[i];
-                }
+                last_e = self.book_sample(ke, &el_e, contact_e, &mut sampler)?;
                 sampler.emit(
                     &mut k,
                     n_out,
@@ -1013,10 +651,217 @@ impl Solver {
             nodes: self.x0.len(),
         })
     }
+
+    /// The forces at t_n: loads, element forces, then contact and ties, timed into
+    /// `times`; the instant they were done.
+    fn compute_forces(&mut self, dt: f64, times: &mut PhaseTimes) -> Instant {
+        let t0 = Instant::now();
+        self.op.apply_loads(&self.state);
+        let t1 = Instant::now();
+        self.op.element_forces(&self.state);
+        let t1c = Instant::now();
+        self.op.contact_and_ties(&self.state, &self.mass, dt);
+        let t2 = Instant::now();
+        times.contact += t2 - t1c;
+        times.loads += t1 - t0;
+        times.forces += t2 - t1;
+        t2
+    }
+
+    /// The nodes' update over `dt` (at a sample step, `snap`, also x^n and v^n kept): the
+    /// kinetic energy and the mass-damping power, or the error that names a node gone
+    /// non-finite.
+    fn advance_nodes(&mut self, snap: bool, dt: f64) -> Result<(f64, f64)> {
+        let nd = Nodal {
+            inv_m: &self.inv_m,
+            mass: &self.mass,
+            fixed: &self.fixed,
+            alpha: self.alpha,
+        };
+        let r = if snap {
+            integrator::advance_nodes::<true>(
+                &mut self.state,
+                &self.op,
+                &nd,
+                dt,
+                &mut self.partials,
+            )
+        } else {
+            integrator::advance_nodes::<false>(
+                &mut self.state,
+                &self.op,
+                &nd,
+                dt,
+                &mut self.partials,
+            )
+        };
+        r.map_err(|node| self.nan_error(node))
+    }
+
+    /// The rotational nodes' update over `dt`: their kinetic energy and mass-damping
+    /// power (zero without beams).
+    fn advance_rotations(&mut self, dt: f64) -> Result<(f64, f64)> {
+        if self.state.rot.is_empty() {
+            return Ok((0.0, 0.0));
+        }
+        integrator::advance_rotations(
+            &mut self.state,
+            &self.op.el.beam.moments,
+            self.alpha,
+            dt,
+            &self.node_id,
+        )
+    }
+
+    /// The tied slaves follow their masters (at a sample step, their v^n too).
+    fn update_tie_slaves(&mut self, snap: bool) {
+        if !self.op.ties.is_empty() {
+            let st = &mut self.state;
+            self.op
+                .ties
+                .update_slaves(&mut st.x, &mut st.v, snap.then_some(&mut st.vn[..]));
+        }
+    }
+
+    /// The projectiles' update from `dt_prev` to `dt_next` (`dt`: the step of their
+    /// penalty): their kinetic energy, and at a sample step their state at t_n into `rows`
+    /// (tip and contact force, before the update) and their contact energy at t_n.
+    /// Returns (contact energy, kinetic energy).
+    fn advance_projectiles(
+        &mut self,
+        snap: bool,
+        dt: f64,
+        dt_next: f64,
+        rows: &mut Vec<[f64; 9]>,
+    ) -> (f64, f64) {
+        let mut contact_e = 0.0;
+        if snap {
+            // Projectile states at t_n: tip and contact force before their update.
+            rows.clear();
+            for p in &self.op.projectiles.projectiles {
+                rows.push([
+                    p.tip[0], p.tip[1], p.tip[2], 0.0, 0.0, 0.0, p.force[0], p.force[1], p.force[2],
+                ]);
+            }
+            if !self.op.projectiles.is_empty() {
+                contact_e = self.op.projectiles.energy(&self.state.xn, &self.mass, dt);
+            }
+        }
+        let ke_proj = if self.op.projectiles.is_empty() {
+            0.0
+        } else {
+            self.op.projectiles.advance(self.state.dt_prev, dt_next)
+        };
+        (contact_e, ke_proj)
+    }
+
+    /// A sample at t_n: the projectiles' velocities, the energies booked in the ledger
+    /// and checked (finite, balanced), and the output nodes' displacements and velocities,
+    /// into the sampler's current snapshot. Returns the energies.
+    fn book_sample(
+        &mut self,
+        ke: f64,
+        el_e: &ElementEnergies,
+        contact_e: f64,
+        sampler: &mut Sampler,
+    ) -> Result<Energies> {
+        for (row, p) in sampler
+            .cur
+            .proj
+            .iter_mut()
+            .zip(&self.op.projectiles.projectiles)
+        {
+            row[3..6].copy_from_slice(&p.v_full);
+        }
+        let contact = contact_e
+            + self.op.projectiles.friction_work
+            + (self.op.surfaces.stored + self.op.surfaces.dissipated);
+        let w_ext = self.op.loads.work + self.op.projectiles.prescribed_work;
+        let e = self.ledger.book(ke, el_e, contact, w_ext, self.state.step);
+        sampler.cur.t = self.state.t;
+        sampler.cur.e = e;
+        self.check_finite_energies(ke, el_e, contact, w_ext)?;
+        self.check_balance(&e)?;
+        for (j, &i) in self.output_nodes.iter().enumerate() {
+            let (x, x0) = (self.state.xn[i], self.x0[i]);
+            sampler.cur.u[j] = [x[0] - x0[0], x[1] - x0[1], x[2] - x0[2]];
+            sampler.cur.v[j] = self.state.vn[i];
+        }
+        Ok(e)
+    }
+
+    /// A non-finite energy is a broken run even when the nodes are finite (a comparison
+    /// with NaN is false: it would pass the balance check): the error names the term and
+    /// its likely cause.
+    fn check_finite_energies(
+        &self,
+        ke: f64,
+        el_e: &ElementEnergies,
+        contact: f64,
+        w_ext: f64,
+    ) -> Result<()> {
+        let terms = [
+            ("kinetic", ke),
+            ("internal", el_e.internal),
+            ("damping", el_e.damping),
+            ("friction", el_e.friction),
+            ("hourglass", el_e.hourglass),
+            ("contact (stored and friction work)", contact),
+            ("external work", w_ext),
+        ];
+        let Some((name, v)) = terms.iter().find(|(_, v)| !v.is_finite()) else {
+            return Ok(());
+        };
+        let hint = if *name == "external work" {
+            let big = self.op.loads.loads.iter().max_by(|a, b| {
+                let m =
+                    |l: &crate::model::Load| l.force.iter().map(|f| f.abs()).fold(0.0, f64::max);
+                m(a).total_cmp(&m(b))
+            });
+            match big {
+                Some(l) => format!(
+                    "the loads' work overflowed: the largest is load `{}` (loads.parquet, node `{}`, force {:?} N)",
+                    l.id, self.node_id[l.node], l.force
+                ),
+                None => "a projectile with prescribed velocity did non-finite work".to_string(),
+            }
+        } else if *name == "kinetic" {
+            "a mass × velocity² overflowed: check the initial velocities, the element and point masses (parts.parquet) and the projectiles' mass and velocity (projectile.parquet)".to_string()
+        } else {
+            "a penalty or element with zero mass or zero length somewhere; the contact report names the definitions (run with the same model and a shorter end time to look at it)".to_string()
+        };
+        Err(WeftError::Numerical {
+            what: format!("the {name} energy is {v}"),
+            step: self.state.step,
+            time: self.state.t,
+            hint: Some(hint),
+        })
+    }
+
+    /// The energy balance stops the run once its error passes the analysis' limit
+    /// (from [`ENERGY_CHECK_AFTER`] steps on).
+    fn check_balance(&self, e: &Energies) -> Result<()> {
+        let a = &self.analysis;
+        if e.balance_error_relative > a.max_energy_error && self.state.step >= ENERGY_CHECK_AFTER {
+            return Err(WeftError::Numerical {
+                what: format!(
+                    "energy balance error {:.3e} J is {:.1} % of the reference energy {:.3e} J (limit {:.1} %): the run is unstable or a force is not conservative",
+                    e.balance_error, 100.0 * e.balance_error_relative, self.ledger.reference, 100.0 * a.max_energy_error
+                ),
+                step: self.state.step,
+                time: self.state.t,
+                hint: Some(format!(
+                    "the step is {:.4e} s (stable estimate {:.4e} s); lower dt_safety, or raise max_energy_error if the loss is physical",
+                    self.stable.dt, self.stable.dt_stable
+                )),
+            });
+        }
+        Ok(())
+    }
 }
 
 /// Steps between two checks of the membranes' stiffening against the step
-/// (`Solver::check_stiffening`, in `stable.rs`): often enough that a strain growing
+/// (`NodalBound::check_stiffening`, in `stable.rs`): often enough that a strain growing
 /// towards the margin (1/dt_safety² − 1 = 0.23 at 0.9, in 1 + 3E₁₁) is caught before it
 /// has run away; one check costs about one membrane force pass without the forces.
 const STIFFENING_CHECK_EVERY: u64 = 20;

@@ -9,12 +9,12 @@
 //! through the CSR index `slot_ptr`/`slots`), so the sum does not depend on the thread
 //! count.
 
-use super::beam::Rotations;
 use super::contact::{ProjectileContact, SurfaceContact};
+use super::families::Families;
 use super::family::ForceCtx;
+use super::rotations::Rotations;
 use super::ties::Ties;
 use super::vec3::{add, dot};
-use super::Families;
 use crate::model::Load;
 
 /// The state the operator reads (the integrator owns and advances it).

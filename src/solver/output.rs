@@ -1,5 +1,7 @@
-//! Output sinks: in memory (tests, the fit stage) and streaming Parquet (the
-//! `simulate` stage). Layouts of `history.parquet` and `energy.parquet`: docs/tables.md.
+//! Output: what receives a run's samples on the fixed output grid ([`Sink`]), the
+//! `Sampler` that interpolates the steps onto that grid, and the sinks: in memory (tests,
+//! the fit stage) and streaming Parquet (the `simulate` stage). Layouts of
+//! `history.parquet` and `energy.parquet`: docs/tables.md.
 
 use std::path::Path;
 use std::sync::Arc;
@@ -7,9 +9,108 @@ use std::sync::Arc;
 use arrow_array::{Float64Array, Int64Array, RecordBatch};
 use arrow_schema::{DataType, Field, Schema, SchemaRef};
 
-use super::{Energies, Sink};
+use super::energy::Energies;
 use crate::error::Result;
 use crate::table::{batch, AtomicTableWriter, Col, Provenance};
+
+/// Receives the output samples on the output time grid.
+pub trait Sink {
+    /// Displacements and velocities of the output nodes at time t.
+    fn history(&mut self, t: f64, nodes: &[usize], u: &[[f64; 3]], v: &[[f64; 3]]) -> Result<()>;
+    fn energy(&mut self, t: f64, e: &Energies) -> Result<()>;
+    /// A projectile at time t: tip position, velocity, contact force on it.
+    fn projectile(&mut self, _t: f64, _id: i64, _state: &[f64; 9]) -> Result<()> {
+        Ok(())
+    }
+}
+
+/// One snapshot of the output nodes at a step.
+#[derive(Debug, Clone, Default)]
+pub(super) struct Snapshot {
+    pub(super) t: f64,
+    pub(super) u: Vec<[f64; 3]>,
+    pub(super) v: Vec<[f64; 3]>,
+    pub(super) e: Energies,
+    /// Per projectile: tip x, y, z, velocity, contact force.
+    pub(super) proj: Vec<[f64; 9]>,
+}
+
+/// Linear interpolation of the step snapshots onto the fixed output grid t_k = k·Δt_out.
+pub(super) struct Sampler {
+    prev: Snapshot,
+    pub(super) cur: Snapshot,
+    have_prev: bool,
+    interp_u: Vec<[f64; 3]>,
+    interp_v: Vec<[f64; 3]>,
+}
+
+impl Sampler {
+    pub(super) fn new(nout: usize) -> Sampler {
+        let prev = Snapshot {
+            u: vec![[0.0; 3]; nout],
+            v: vec![[0.0; 3]; nout],
+            ..Default::default()
+        };
+        Sampler {
+            cur: prev.clone(),
+            prev,
+            have_prev: false,
+            interp_u: vec![[0.0; 3]; nout],
+            interp_v: vec![[0.0; 3]; nout],
+        }
+    }
+
+    /// Sends every output time t_k ≤ `cur.t` not sent yet (k from `*k`), interpolated
+    /// between the previous and the current snapshot; then the current becomes previous.
+    pub(super) fn emit(
+        &mut self,
+        k: &mut u64,
+        n_out: u64,
+        dt_out: f64,
+        ids: &[i64],
+        nodes: &[usize],
+        sink: &mut (dyn Sink + Send),
+        mut progress: impl FnMut(u64, f64),
+    ) -> Result<()> {
+        let (prev, cur) = (&self.prev, &self.cur);
+        while *k <= n_out && *k as f64 * dt_out <= cur.t {
+            let tk = *k as f64 * dt_out;
+            let w = if self.have_prev && prev.t < tk {
+                (tk - prev.t) / (cur.t - prev.t)
+            } else {
+                1.0
+            };
+            for (j, id) in ids.iter().enumerate() {
+                let row: [f64; 9] = if w >= 1.0 {
+                    cur.proj[j]
+                } else {
+                    std::array::from_fn(|c| {
+                        prev.proj[j][c] + w * (cur.proj[j][c] - prev.proj[j][c])
+                    })
+                };
+                sink.projectile(tk, *id, &row)?;
+            }
+            let (src_u, src_v, e) = if w >= 1.0 {
+                (&cur.u, &cur.v, cur.e)
+            } else {
+                for j in 0..cur.u.len() {
+                    for d in 0..3 {
+                        self.interp_u[j][d] = prev.u[j][d] + w * (cur.u[j][d] - prev.u[j][d]);
+                        self.interp_v[j][d] = prev.v[j][d] + w * (cur.v[j][d] - prev.v[j][d]);
+                    }
+                }
+                (&self.interp_u, &self.interp_v, prev.e.lerp(&cur.e, w))
+            };
+            sink.history(tk, nodes, src_u, src_v)?;
+            sink.energy(tk, &e)?;
+            progress(*k, tk);
+            *k += 1;
+        }
+        std::mem::swap(&mut self.prev, &mut self.cur);
+        self.have_prev = true;
+        Ok(())
+    }
+}
 
 /// Everything in memory: `u[k][j]` is the displacement of output node j at sample k.
 #[derive(Debug, Clone, Default)]

@@ -101,6 +101,9 @@ pub struct RelaxStats {
     pub creep_node: usize,
 }
 
+/// What one chunk of nodes adds up in a step: the kinetic energy and the work removed
+/// [J], the largest squared residual force and its node, the largest squared contact
+/// force, and the first node gone non-finite (usize::MAX: none).
 #[derive(Clone, Copy, Default)]
 struct Part {
     ke: f64,
@@ -109,6 +112,36 @@ struct Part {
     res_node: usize,
     fc: f64,
     bad: usize,
+}
+
+/// A step's sums over the chunks (in chunk order): the kinetic energy and the work
+/// removed [J], the largest squared residual force and its node, and the largest squared
+/// contact force.
+struct StepSums {
+    ke: f64,
+    removed: f64,
+    res: f64,
+    res_node: usize,
+    fc: f64,
+}
+
+/// A rest test under way: a free (undamped) run from the relaxed state at rest,
+/// `creep_window` steps long; its start position, the largest displacement from it so
+/// far, and the step it started.
+struct Probe {
+    x0: Vec<[f64; 3]>,
+    far: f64,
+    since: u64,
+}
+
+/// What a rest test says after a step.
+enum Verdict {
+    /// Still running.
+    Running,
+    /// Over, and no node moved further than the tolerance: at rest.
+    AtRest,
+    /// Over, and the model moved: relaxation goes on.
+    Moving,
 }
 
 impl Solver {
@@ -130,10 +163,7 @@ impl Solver {
         let mut ke_window = 0.0f64;
         self.state.dt_prev = dt;
         let creep_window = o.creep_window.max(1);
-        // The probe: a free (undamped) run from the relaxed state at rest, `creep_window`
-        // steps long; its start position, the largest displacement from it so far, and
-        // the step it started.
-        let mut probe: Option<(Vec<[f64; 3]>, f64, u64)> = None;
+        let mut probe: Option<Probe> = None;
         self.op.surfaces.set_normal_damping(o.contact_damping);
         let free_mask: Vec<u8> = o
             .hold_in_rest_test
@@ -142,198 +172,50 @@ impl Solver {
             .collect();
         let mut next_probe = 0u64;
         st.creep = f64::INFINITY;
-        let start_probe = |s: &mut Solver| {
-            s.state.v.iter_mut().for_each(|v| *v = [0.0; 3]);
-            for &(n, mask) in &o.hold_in_rest_test {
-                s.fixed[n] |= mask;
-            }
-            s.op.surfaces.set_normal_damping(0.0);
-            Some((s.state.x.clone(), 0.0, 0u64))
-        };
         if o.probe_first {
-            probe = start_probe(self);
+            probe = Some(self.start_probe(o, 0));
         }
         for step in 0..o.max_steps {
             let alpha = if probe.is_some() { 0.0 } else { o.alpha };
-            self.op.apply_loads(&self.state);
-            self.op.element_forces(&self.state);
-            // The contact penalty κ m*/Δt² with the run's step, so that a formed state
-            // meets the same contact stiffness when an impact run starts from it.
-            self.op
-                .contact_and_ties(&self.state, &self.mass, self.stable.dt);
-            let (op, inv_m, fixed, mass) = (&self.op, &self.inv_m, &self.fixed, &self.mass);
-            // A tied slave carries no mass; its force went to its masters (the tie
-            // transfer), so it has no residual of its own: it follows them below.
-            let is_slave = &op.ties.is_slave;
-            let fcon = op.has_fcon().then_some(&op.fcon);
-            type Chunk<'c> = (
-                usize,
-                ((&'c mut [[f64; 3]], &'c mut [[f64; 3]]), &'c mut Part),
-            );
-            let body = |(ci, ((x, v), p)): Chunk| {
-                let i0 = ci * CHUNK;
-                let mut q = Part {
-                    bad: usize::MAX,
-                    ..Default::default()
-                };
-                for j in 0..x.len() {
-                    let i = i0 + j;
-                    let mut f = op.fext[i];
-                    if let Some(fc) = fcon {
-                        add(&mut f, &fc[i]);
-                        q.fc = q.fc.max(dot(&fc[i], &fc[i]));
-                    }
-                    for &s in op.gather.of(i) {
-                        add(&mut f, &op.fe[s as usize]);
-                    }
-                    let fx = fixed[i];
-                    for (d, fd) in f.iter_mut().enumerate() {
-                        if fx & (1 << d) != 0 {
-                            *fd = 0.0;
-                        }
-                    }
-                    let r = if is_slave.get(i).copied().unwrap_or(false) {
-                        0.0
-                    } else {
-                        dot(&f, &f)
-                    };
-                    if r > q.res {
-                        q.res = r;
-                        q.res_node = i;
-                    }
-                    let im = inv_m[i];
-                    // Local damping: each component of the force loses α|f| against the
-                    // motion (v^{n−½}); the work that takes is booked as removed.
-                    let mut vn = [0.0; 3];
-                    for d in 0..3 {
-                        let vd = v[j][d];
-                        let damp = if vd > 0.0 {
-                            -alpha * f[d].abs()
-                        } else if vd < 0.0 {
-                            alpha * f[d].abs()
-                        } else {
-                            0.0
-                        };
-                        vn[d] = vd + dt * (f[d] + damp) * im;
-                        q.removed -= damp * 0.5 * (vd + vn[d]) * dt;
-                    }
-                    q.ke += 0.5 * mass[i] * dot(&vn, &vn);
-                    let xn = [
-                        x[j][0] + dt * vn[0],
-                        x[j][1] + dt * vn[1],
-                        x[j][2] + dt * vn[2],
-                    ];
-                    if !(xn[0] + xn[1] + xn[2]).is_finite() && q.bad == usize::MAX {
-                        q.bad = i;
-                    }
-                    x[j] = xn;
-                    v[j] = vn;
-                }
-                *p = q;
-            };
-            let it = self
-                .state
-                .x
-                .par_chunks_mut(CHUNK)
-                .zip(self.state.v.par_chunks_mut(CHUNK))
-                .zip(parts.par_iter_mut())
-                .enumerate();
-            if nn <= CHUNK {
-                it.with_min_len(usize::MAX).for_each(body);
-            } else {
-                it.for_each(body);
-            }
-            let (mut ke, mut res, mut res_node, mut fc, mut removed) = (0.0, 0.0, 0, 0.0f64, 0.0);
-            for p in &parts {
-                if p.bad != usize::MAX {
-                    return Err(WeftError::Numerical {
-                        what: format!(
-                            "node `{}` became non-finite during dynamic relaxation",
-                            self.node_id[p.bad]
-                        ),
-                        step,
-                        time: step as f64 * dt,
-                        hint: Some("a contact or an element is unstable at this step; check the model's geometry and penalty_scale".into()),
-                    });
-                }
-                ke += p.ke;
-                removed += p.removed;
-                if p.res > res {
-                    res = p.res;
-                    res_node = p.res_node;
-                }
-                fc = fc.max(p.fc);
-            }
+            self.damped_step(alpha, dt, &mut parts);
+            let sums = self.sum_parts(&parts, step, dt)?;
             if !self.op.ties.is_empty() {
                 self.op
                     .ties
                     .update_slaves(&mut self.state.x, &mut self.state.v, None);
             }
-            st.removed += removed;
-            ke_window = ke_window.max(ke);
+            st.removed += sums.removed;
+            ke_window = ke_window.max(sums.ke);
             self.state.step += 1;
             st.steps = step + 1;
             if step == 0 && o.probe_first {
                 // The start's own balance (the forces of this first step are at the start
                 // state): what the report gives if the start passes its rest test.
-                st.residual = res.sqrt();
-                st.residual_node = res_node;
-                st.contact_force = fc.sqrt();
+                st.residual = sums.res.sqrt();
+                st.residual_node = sums.res_node;
+                st.contact_force = sums.fc.sqrt();
             }
-            if let Some((x0, far, since)) = &mut probe {
-                // The node furthest from where it started (ties: the lower index, so
-                // that the answer does not depend on the threads).
-                let (d, node) = self
-                    .state
-                    .x
-                    .par_iter()
-                    .zip(x0.par_iter())
-                    .enumerate()
-                    .map(|(i, (a, b))| {
-                        let d = [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
-                        (dot(&d, &d), i)
-                    })
-                    .reduce(
-                        || (0.0, usize::MAX),
-                        |p, q| {
-                            if q.0 > p.0 || (q.0 == p.0 && q.1 < p.1) {
-                                q
-                            } else {
-                                p
-                            }
-                        },
-                    );
-                if d.sqrt() > *far {
-                    *far = d.sqrt();
-                    st.creep_node = node;
-                }
-                if *far > o.creep_tolerance || st.steps - *since >= creep_window {
-                    st.creep = *far;
-                    for (&(n, _), &f0) in o.hold_in_rest_test.iter().zip(&free_mask) {
-                        self.fixed[n] = f0;
+            if let Some(p) = &mut probe {
+                match self.watch_probe(p, o, &free_mask, creep_window, &mut st) {
+                    Verdict::Running => {}
+                    Verdict::AtRest => break,
+                    Verdict::Moving => {
+                        // Still moving: relax on from here, and probe again later (after a
+                        // fifth of the steps so far: at most a fifth of the work is probes).
+                        probe = None;
+                        ke_window = 0.0;
+                        next_probe = st.steps + creep_window.max(st.steps / 5);
                     }
-                    self.op.surfaces.set_normal_damping(o.contact_damping);
-                    if *far <= o.creep_tolerance {
-                        // At rest where the probe started: that is the equilibrium.
-                        self.state.x.copy_from_slice(x0);
-                        st.converged = true;
-                        break;
-                    }
-                    // Still moving: relax on from here, and probe again later (after a
-                    // fifth of the steps so far: at most a fifth of the work is probes).
-                    probe = None;
-                    ke_window = 0.0;
-                    next_probe = st.steps + creep_window.max(st.steps / 5);
                 }
             }
             if st.steps % o.check_every.max(1) == 0 {
                 // While a probe runs, the stats stay those of the test that started it.
                 if probe.is_none() {
                     st.kinetic = ke_window;
-                    st.residual = res.sqrt();
-                    st.residual_node = res_node;
+                    st.residual = sums.res.sqrt();
+                    st.residual_node = sums.res_node;
                 }
-                st.contact_force = st.contact_force.max(fc.sqrt());
+                st.contact_force = st.contact_force.max(sums.fc.sqrt());
                 ke_window = 0.0;
                 check(&st);
                 let w = st.removed + st.kinetic + o.work_offset;
@@ -345,15 +227,12 @@ impl Solver {
                     // Left alone at rest from here, does the model stay? (Relaxation
                     // itself cannot tell: under local damping, the contacts' chatter
                     // holds a slow mode like friction, which then crawls.)
-                    probe = start_probe(self).map(|(x, far, _)| (x, far, st.steps));
+                    probe = Some(self.start_probe(o, st.steps));
                 }
             }
         }
         // Whatever ended the loop, the model's own holds and contact damping are back.
-        for (&(n, _), &f0) in o.hold_in_rest_test.iter().zip(&free_mask) {
-            self.fixed[n] = f0;
-        }
-        self.op.surfaces.set_normal_damping(o.contact_damping);
+        self.end_probe(o, &free_mask);
         // Leave the state at rest, with forces and velocities consistent (the contacts'
         // last evaluation, which reports such as the deepest overlap read, at the state
         // returned: a passed rest test returns the state it started from).
@@ -362,4 +241,207 @@ impl Solver {
             .contact_and_ties(&self.state, &self.mass, self.stable.dt);
         Ok(st)
     }
+
+    /// One step of local damping `alpha` over `dt`: the forces at x^n, then each node's
+    /// damped update, in parallel fixed chunks whose sums go to `parts`.
+    fn damped_step(&mut self, alpha: f64, dt: f64, parts: &mut [Part]) {
+        let nn = self.state.x.len();
+        self.op.apply_loads(&self.state);
+        self.op.element_forces(&self.state);
+        // The contact penalty κ m*/Δt² with the run's step, so that a formed state
+        // meets the same contact stiffness when an impact run starts from it.
+        self.op
+            .contact_and_ties(&self.state, &self.mass, self.stable.dt);
+        let (op, inv_m, fixed, mass) = (&self.op, &self.inv_m, &self.fixed, &self.mass);
+        // A tied slave carries no mass; its force went to its masters (the tie
+        // transfer), so it has no residual of its own: it follows them below.
+        let is_slave = &op.ties.is_slave;
+        let fcon = op.has_fcon().then_some(&op.fcon);
+        type Chunk<'c> = (
+            usize,
+            ((&'c mut [[f64; 3]], &'c mut [[f64; 3]]), &'c mut Part),
+        );
+        let body = |(ci, ((x, v), p)): Chunk| {
+            let i0 = ci * CHUNK;
+            let mut q = Part {
+                bad: usize::MAX,
+                ..Default::default()
+            };
+            for j in 0..x.len() {
+                let i = i0 + j;
+                let mut f = op.fext[i];
+                if let Some(fc) = fcon {
+                    add(&mut f, &fc[i]);
+                    q.fc = q.fc.max(dot(&fc[i], &fc[i]));
+                }
+                for &s in op.gather.of(i) {
+                    add(&mut f, &op.fe[s as usize]);
+                }
+                let fx = fixed[i];
+                for (d, fd) in f.iter_mut().enumerate() {
+                    if fx & (1 << d) != 0 {
+                        *fd = 0.0;
+                    }
+                }
+                let r = if is_slave.get(i).copied().unwrap_or(false) {
+                    0.0
+                } else {
+                    dot(&f, &f)
+                };
+                if r > q.res {
+                    q.res = r;
+                    q.res_node = i;
+                }
+                let im = inv_m[i];
+                // Local damping: each component of the force loses α|f| against the
+                // motion (v^{n−½}); the work that takes is booked as removed.
+                let mut vn = [0.0; 3];
+                for d in 0..3 {
+                    let vd = v[j][d];
+                    let damp = if vd > 0.0 {
+                        -alpha * f[d].abs()
+                    } else if vd < 0.0 {
+                        alpha * f[d].abs()
+                    } else {
+                        0.0
+                    };
+                    vn[d] = vd + dt * (f[d] + damp) * im;
+                    q.removed -= damp * 0.5 * (vd + vn[d]) * dt;
+                }
+                q.ke += 0.5 * mass[i] * dot(&vn, &vn);
+                let xn = [
+                    x[j][0] + dt * vn[0],
+                    x[j][1] + dt * vn[1],
+                    x[j][2] + dt * vn[2],
+                ];
+                if !(xn[0] + xn[1] + xn[2]).is_finite() && q.bad == usize::MAX {
+                    q.bad = i;
+                }
+                x[j] = xn;
+                v[j] = vn;
+            }
+            *p = q;
+        };
+        let it = self
+            .state
+            .x
+            .par_chunks_mut(CHUNK)
+            .zip(self.state.v.par_chunks_mut(CHUNK))
+            .zip(parts.par_iter_mut())
+            .enumerate();
+        if nn <= CHUNK {
+            it.with_min_len(usize::MAX).for_each(body);
+        } else {
+            it.for_each(body);
+        }
+    }
+
+    /// The chunks' sums in chunk order, or the error of a node gone non-finite at `step`.
+    fn sum_parts(&self, parts: &[Part], step: u64, dt: f64) -> Result<StepSums> {
+        let (mut ke, mut res, mut res_node, mut fc, mut removed) = (0.0, 0.0, 0, 0.0f64, 0.0);
+        for p in parts {
+            if p.bad != usize::MAX {
+                return Err(WeftError::Numerical {
+                    what: format!(
+                        "node `{}` became non-finite during dynamic relaxation",
+                        self.node_id[p.bad]
+                    ),
+                    step,
+                    time: step as f64 * dt,
+                    hint: Some("a contact or an element is unstable at this step; check the model's geometry and penalty_scale".into()),
+                });
+            }
+            ke += p.ke;
+            removed += p.removed;
+            if p.res > res {
+                res = p.res;
+                res_node = p.res_node;
+            }
+            fc = fc.max(p.fc);
+        }
+        Ok(StepSums {
+            ke,
+            removed,
+            res,
+            res_node,
+            fc,
+        })
+    }
+
+    /// A rest test starts at step `since`: the velocities zeroed, the degrees of freedom
+    /// of `hold_in_rest_test` held, the contacts undamped.
+    fn start_probe(&mut self, o: &RelaxOptions, since: u64) -> Probe {
+        self.state.v.iter_mut().for_each(|v| *v = [0.0; 3]);
+        for &(n, mask) in &o.hold_in_rest_test {
+            self.fixed[n] |= mask;
+        }
+        self.op.surfaces.set_normal_damping(0.0);
+        Probe {
+            x0: self.state.x.clone(),
+            far: 0.0,
+            since,
+        }
+    }
+
+    /// The model's own holds (`free_mask`, as they were before the rest tests) and the
+    /// relaxation's contact damping are back.
+    fn end_probe(&mut self, o: &RelaxOptions, free_mask: &[u8]) {
+        for (&(n, _), &f0) in o.hold_in_rest_test.iter().zip(free_mask) {
+            self.fixed[n] = f0;
+        }
+        self.op.surfaces.set_normal_damping(o.contact_damping);
+    }
+
+    /// After a step of a rest test: the farthest any node has moved from where it
+    /// started (into `st.creep_node`); once it passes the tolerance or the window is
+    /// over, the test ends (`st.creep`), and a model at rest returns to where the test
+    /// started (`st.converged`).
+    fn watch_probe(
+        &mut self,
+        p: &mut Probe,
+        o: &RelaxOptions,
+        free_mask: &[u8],
+        creep_window: u64,
+        st: &mut RelaxStats,
+    ) -> Verdict {
+        let (d, node) = farthest(&self.state.x, &p.x0);
+        if d.sqrt() > p.far {
+            p.far = d.sqrt();
+            st.creep_node = node;
+        }
+        if !(p.far > o.creep_tolerance || st.steps - p.since >= creep_window) {
+            return Verdict::Running;
+        }
+        st.creep = p.far;
+        self.end_probe(o, free_mask);
+        if p.far <= o.creep_tolerance {
+            // At rest where the probe started: that is the equilibrium.
+            self.state.x.copy_from_slice(&p.x0);
+            st.converged = true;
+            return Verdict::AtRest;
+        }
+        Verdict::Moving
+    }
+}
+
+/// The node furthest from where it started, and the square of that distance (ties: the
+/// lower index, so that the answer does not depend on the threads).
+fn farthest(x: &[[f64; 3]], x0: &[[f64; 3]]) -> (f64, usize) {
+    x.par_iter()
+        .zip(x0.par_iter())
+        .enumerate()
+        .map(|(i, (a, b))| {
+            let d = [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+            (dot(&d, &d), i)
+        })
+        .reduce(
+            || (0.0, usize::MAX),
+            |p, q| {
+                if q.0 > p.0 || (q.0 == p.0 && q.1 < p.1) {
+                    q
+                } else {
+                    p
+                }
+            },
+        )
 }

@@ -13,7 +13,8 @@
 //! stiffest element.
 
 use super::family::StiffCtx;
-use super::Solver;
+use super::operator::{Operator, State};
+use crate::error::{Result, WeftError};
 use crate::model::ElementKind;
 
 /// The stable time step and what controls it.
@@ -29,7 +30,7 @@ pub struct StableStep {
     pub element: Option<(ElementKind, i64)>,
 }
 
-/// What [`Solver::check_stiffening`] keeps through a run: the stable step's nodal
+/// What [`NodalBound::check_stiffening`] keeps through a run: the stable step's nodal
 /// stiffness and damping rows S_i, C_i, and its buffers (the stiffening added per node,
 /// and the element that added most: `(added, kind, id, Green strain)`).
 pub struct StiffeningCheck {
@@ -70,10 +71,22 @@ pub fn nodal_dt(s: f64, c: f64, m: f64, alpha: f64) -> f64 {
     (2.0 / w) / (1.0f64.hypot(xi) + xi)
 }
 
-impl Solver {
+/// What the nodal bound reads of a solver: the nodes' masses (scaled so far) and fixed
+/// directions (bit d: direction d), the mass damping α [1/s], the node ids (for the
+/// messages), and the operator (element families, ties, gather index) at a state.
+pub struct NodalBound<'a> {
+    pub op: &'a Operator,
+    pub state: &'a State,
+    pub mass: &'a [f64],
+    pub fixed: &'a [u8],
+    pub alpha: f64,
+    pub node_id: &'a [i64],
+}
+
+impl NodalBound<'_> {
     /// Per-node stiffness and damping sums S_i, C_i.
-    fn nodal_sums(&self) -> (Vec<f64>, Vec<f64>) {
-        let nn = self.x0.len();
+    pub fn nodal_sums(&self) -> (Vec<f64>, Vec<f64>) {
+        let nn = self.mass.len();
         let (mut s, mut c) = (vec![0.0; nn], vec![0.0; nn]);
         let mut rrow = vec![0.0; nn];
         let ctx = StiffCtx {
@@ -99,7 +112,7 @@ impl Solver {
     pub fn stable_step(&self) -> (f64, usize) {
         let (s, c) = self.nodal_sums();
         let mut best = (f64::INFINITY, 0);
-        for i in 0..self.x0.len() {
+        for i in 0..self.mass.len() {
             if self.fixed[i] == 0b111 || self.mass[i] <= 0.0 {
                 continue;
             }
@@ -111,9 +124,9 @@ impl Solver {
         best
     }
 
-    /// The stable step's nodal rows and the buffers of [`Solver::check_stiffening`],
+    /// The stable step's nodal rows and the buffers of [`NodalBound::check_stiffening`],
     /// made once per run so that the check allocates nothing.
-    pub(super) fn stiffening_check(&self) -> StiffeningCheck {
+    pub fn stiffening_check(&self) -> StiffeningCheck {
         let (s, c) = self.nodal_sums();
         let nn = s.len();
         StiffeningCheck {
@@ -131,12 +144,8 @@ impl Solver {
     /// Gershgorin bound (through ties to their masters, as the bound does), and a node
     /// whose step with those rows falls below the step in use stops the run, naming the
     /// element that stiffened it most: a clear message instead of the blow-up a few
-    /// steps later.
-    pub(super) fn check_stiffening(
-        &self,
-        k: &mut StiffeningCheck,
-        dt: f64,
-    ) -> crate::error::Result<()> {
+    /// steps later. (`dt_safety`: the analysis' safety factor, which the message names.)
+    pub fn check_stiffening(&self, k: &mut StiffeningCheck, dt: f64, dt_safety: f64) -> Result<()> {
         let x = &self.state.x;
         k.extra.fill(0.0);
         k.most.fill(None);
@@ -183,7 +192,7 @@ impl Solver {
                 ),
                 None => "its membranes have stretched".to_string(),
             };
-            return Err(crate::error::WeftError::Numerical {
+            return Err(WeftError::Numerical {
                 what: format!(
                     "{what}, which stiffens node `{}` so far that its stable step {dt_i:.4e} s is now below the step {dt:.4e} s in use",
                     self.node_id[i]
@@ -192,7 +201,7 @@ impl Solver {
                 time: self.state.t,
                 hint: Some(format!(
                     "the stable step is set once, from the undeformed model; strains this large are beyond what most materials bear (aramid yarns break near 3.6 %) and weft models no failure: shorten end_time, lower the load or the impact velocity, or lower dt_safety (now {}) to run on",
-                    self.analysis.dt_safety
+                    dt_safety
                 )),
             });
         }
@@ -214,28 +223,35 @@ impl Solver {
     }
 
     /// Conventional mass scaling applied selectively: only nodes whose stable step is
-    /// below the target get mass, just enough to reach it (with the safety factor).
-    pub(super) fn scale_mass(&mut self, target: f64, safety: f64) {
+    /// below the target get mass, just enough to reach it (with the safety factor). The
+    /// scaled masses and what was added (`physical_mass`: the model's mass unscaled).
+    pub fn scale_mass(
+        &self,
+        target: f64,
+        safety: f64,
+        physical_mass: f64,
+    ) -> (Vec<f64>, MassScaling) {
         let (s, c) = self.nodal_sums();
         let dt_before = {
             let mut best = f64::INFINITY;
-            for i in 0..self.x0.len() {
+            for i in 0..self.mass.len() {
                 if self.fixed[i] != 0b111 && self.mass[i] > 0.0 {
                     best = best.min(nodal_dt(s[i], c[i], self.mass[i], self.alpha));
                 }
             }
             best
         };
+        let mut mass = self.mass.to_vec();
         let mut rep = MassScaling {
             dt_stable_unscaled: dt_before,
             max_ratio: 1.0,
             ..Default::default()
         };
-        for i in 0..self.x0.len() {
+        for i in 0..self.mass.len() {
             if self.fixed[i] == 0b111 || self.mass[i] <= 0.0 {
                 continue;
             }
-            let m0 = self.mass[i];
+            let m0 = mass[i];
             let mut m = m0;
             // Δt grows like √m (faster with damping): a few multiplicative passes converge.
             for _ in 0..60 {
@@ -249,10 +265,10 @@ impl Solver {
                 rep.added_mass += m - m0;
                 rep.nodes_scaled += 1;
                 rep.max_ratio = rep.max_ratio.max(m / m0);
-                self.mass[i] = m;
+                mass[i] = m;
             }
         }
-        rep.added_fraction = rep.added_mass / self.physical_mass.max(f64::MIN_POSITIVE);
-        self.scaling = Some(rep);
+        rep.added_fraction = rep.added_mass / physical_mass.max(f64::MIN_POSITIVE);
+        (mass, rep)
     }
 }

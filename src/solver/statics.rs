@@ -16,10 +16,13 @@
 
 use std::time::Instant;
 
-use nalgebra::DVector;
+use nalgebra::{DMatrix, DVector};
 use nalgebra_sparse::factorization::CscCholesky;
 use nalgebra_sparse::{CooMatrix, CscMatrix};
 
+use std::collections::HashMap;
+
+use super::ties::Tie;
 use super::{beam, link, membrane, truss, Solver};
 use crate::error::{Result, WeftError};
 use crate::model::Model;
@@ -67,88 +70,218 @@ fn fd_stiffness<const N: usize>(
     k
 }
 
-impl Solver {
-    /// Solve the linear static problem of `m` (the model this solver was built from).
-    pub fn solve_static(&self, m: &Model) -> Result<StaticReport> {
-        let t0 = Instant::now();
-        let nn = self.x0.len();
+/// The equations of the free degrees of freedom: each node direction that is neither
+/// fixed nor a tied slave's has one, then each free axis of a beam node's rotation (after
+/// the translations). A slave's directions are expressed through its masters
+/// (u_s = Σ w_a u_a).
+struct Dofs<'a> {
+    /// Equation of each node's direction (usize::MAX: none).
+    eq: Vec<[usize; 3]>,
+    /// Equation of each rotational node's axis (usize::MAX: none).
+    eqr: Vec<[usize; 3]>,
+    /// Number of equations.
+    neq: usize,
+    /// The tie of each slave node.
+    slave: HashMap<usize, usize>,
+    ties: &'a [Tie],
+}
+
+/// One degree of freedom's equations and weights (none: it is held).
+type DofMap = Vec<(usize, f64)>;
+
+impl<'a> Dofs<'a> {
+    /// The equations of a solver's model (the translations, then the rotations).
+    fn new(s: &'a Solver) -> Dofs<'a> {
+        let nn = s.x0.len();
         // Degree-of-freedom maps: node direction → [(equation, weight)].
         let mut eq = vec![[usize::MAX; 3]; nn];
         let mut neq = 0;
-        let slave: std::collections::HashMap<usize, usize> = self
-            .op
-            .ties
-            .ties
-            .iter()
-            .enumerate()
-            .map(|(k, t)| (t.slave, k))
-            .collect();
+        let slave: HashMap<usize, usize> =
+            s.op.ties
+                .ties
+                .iter()
+                .enumerate()
+                .map(|(k, t)| (t.slave, k))
+                .collect();
         for i in 0..nn {
             if slave.contains_key(&i) {
                 continue;
             }
             for d in 0..3 {
-                if self.fixed[i] & (1 << d) == 0 {
+                if s.fixed[i] & (1 << d) == 0 {
                     eq[i][d] = neq;
                     neq += 1;
                 }
             }
         }
         // Rotations of beam nodes, after the translations.
-        let mut eqr = vec![[usize::MAX; 3]; self.state.rot.node.len()];
+        let mut eqr = vec![[usize::MAX; 3]; s.state.rot.node.len()];
         for (k, e) in eqr.iter_mut().enumerate() {
             for d in 0..3 {
-                if self.state.rot.fixed[k] & (1 << d) == 0 {
+                if s.state.rot.fixed[k] & (1 << d) == 0 {
                     e[d] = neq;
                     neq += 1;
                 }
             }
         }
-        let rmap = |k: usize, d: usize| -> Vec<(usize, f64)> {
-            if eqr[k][d] == usize::MAX {
-                vec![]
-            } else {
-                vec![(eqr[k][d], 1.0)]
+        Dofs {
+            eq,
+            eqr,
+            neq,
+            slave,
+            ties: &s.op.ties.ties,
+        }
+    }
+
+    /// Axis `d` of rotational node `k`.
+    fn rotation(&self, k: usize, d: usize) -> DofMap {
+        if self.eqr[k][d] == usize::MAX {
+            vec![]
+        } else {
+            vec![(self.eqr[k][d], 1.0)]
+        }
+    }
+
+    /// Direction `d` of node `i` (a slave's: its masters' free directions, weighted).
+    fn node(&self, i: usize, d: usize) -> DofMap {
+        let eq = &self.eq;
+        match self.slave.get(&i) {
+            Some(&k) => {
+                let t = &self.ties[k];
+                t.masters
+                    .iter()
+                    .zip(&t.w)
+                    .filter(|(&a, _)| eq[a][d] != usize::MAX)
+                    .map(|(&a, &wa)| (eq[a][d], wa))
+                    .collect()
             }
-        };
-        let map = |i: usize, d: usize| -> Vec<(usize, f64)> {
-            match slave.get(&i) {
-                Some(&k) => {
-                    let t = &self.op.ties.ties[k];
-                    t.masters
-                        .iter()
-                        .zip(&t.w)
-                        .filter(|(&a, _)| eq[a][d] != usize::MAX)
-                        .map(|(&a, &wa)| (eq[a][d], wa))
-                        .collect()
+            None if eq[i][d] != usize::MAX => vec![(eq[i][d], 1.0)],
+            None => vec![],
+        }
+    }
+
+    /// The three directions of each of `nodes`, in order.
+    fn nodes(&self, nodes: &[usize]) -> Vec<DofMap> {
+        (0..3 * nodes.len())
+            .map(|p| self.node(nodes[p / 3], p % 3))
+            .collect()
+    }
+
+    /// The node and direction of equation `i` (of a translation).
+    fn of_equation(&self, i: usize) -> (usize, usize) {
+        (0..self.eq.len())
+            .flat_map(|a| (0..3).map(move |d| (a, d)))
+            .find(|&(a, d)| self.eq[a][d] == i)
+            .unwrap_or((0, 0))
+    }
+
+    /// The load vector: the amplitudes F of the loads (their time laws ignored).
+    fn loads(&self, loads: &[crate::model::Load]) -> Vec<f64> {
+        let mut f = vec![0.0; self.neq];
+        for ld in loads {
+            for d in 0..3 {
+                for (i, w) in self.node(ld.node, d) {
+                    f[i] += w * ld.force[d];
                 }
-                None if eq[i][d] != usize::MAX => vec![(eq[i][d], 1.0)],
-                None => vec![],
             }
-        };
-        let mut trip: Vec<(usize, usize, f64)> = Vec::new();
-        let mut add_maps = |maps: &[Vec<(usize, f64)>], ke: &[f64]| {
-            let n = maps.len();
-            for p in 0..n {
-                for q in 0..n {
-                    let v = ke[p * n + q];
-                    if v == 0.0 {
-                        continue;
-                    }
-                    for &(i, wi) in &maps[p] {
-                        for &(j, wj) in &maps[q] {
-                            trip.push((i, j, wi * wj * v));
-                        }
+        }
+        f
+    }
+}
+
+/// The stiffness matrix as triplets (row, column, value), in assembly order (the order in
+/// which duplicates are summed).
+struct Triplets<'d> {
+    dofs: &'d Dofs<'d>,
+    trip: Vec<(usize, usize, f64)>,
+}
+
+impl Triplets<'_> {
+    /// An element stiffness `ke` over the degrees of freedom `maps`.
+    fn add_maps(&mut self, maps: &[DofMap], ke: &[f64]) {
+        let n = maps.len();
+        for p in 0..n {
+            for q in 0..n {
+                let v = ke[p * n + q];
+                if v == 0.0 {
+                    continue;
+                }
+                for &(i, wi) in &maps[p] {
+                    for &(j, wj) in &maps[q] {
+                        self.trip.push((i, j, wi * wj * v));
                     }
                 }
             }
+        }
+    }
+
+    /// An element stiffness `ke` over the translations of `nodes`.
+    fn add_element(&mut self, nodes: &[usize], ke: &[f64]) {
+        let maps = self.dofs.nodes(nodes);
+        self.add_maps(&maps, ke);
+    }
+}
+
+/// The equations kept in the solve: those with stiffness (`keep[i]`: the kept index of
+/// equation i, usize::MAX when held), how many, and how many are held at zero.
+struct Kept {
+    keep: Vec<usize>,
+    n: usize,
+    held: usize,
+}
+
+impl Kept {
+    /// K and F over the kept equations.
+    fn system(&self, trip: Vec<(usize, usize, f64)>, f: &[f64]) -> (CscMatrix<f64>, DVector<f64>) {
+        let (keep, n) = (&self.keep, self.n);
+        let mut coo = CooMatrix::new(n, n);
+        for (i, j, v) in trip {
+            let (a, b) = (keep[i], keep[j]);
+            if a != usize::MAX && b != usize::MAX {
+                coo.push(a, b, v);
+            }
+        }
+        let rhs = DVector::from_iterator(
+            n,
+            (0..f.len())
+                .filter(|&i| keep[i] != usize::MAX)
+                .map(|i| f[i]),
+        );
+        (CscMatrix::from(&coo), rhs)
+    }
+}
+
+impl Solver {
+    /// Solve the linear static problem of `m` (the model this solver was built from).
+    pub fn solve_static(&self, m: &Model) -> Result<StaticReport> {
+        let t0 = Instant::now();
+        let dofs = Dofs::new(self);
+        let mut k = Triplets {
+            dofs: &dofs,
+            trip: Vec::new(),
         };
-        let tmaps = |nodes: &[usize]| -> Vec<Vec<(usize, f64)>> {
-            (0..3 * nodes.len())
-                .map(|p| map(nodes[p / 3], p % 3))
-                .collect()
-        };
-        let mut add_element = |nodes: &[usize], ke: &[f64]| add_maps(&tmaps(nodes), ke);
+        self.add_stiffness(&mut k);
+        let f = dofs.loads(&m.loads);
+        let kept = self.hold_unresisted(&k.trip, &f, &dofs)?;
+        let (csc, rhs) = kept.system(k.trip, &f);
+        let nonzeros = csc.nnz();
+        let t1 = Instant::now();
+        let chol = self.factor(&csc, &kept, &dofs)?;
+        let sol = chol.solve(&rhs);
+        let u = displacements(&sol, &kept, &dofs)?;
+        Ok(StaticReport {
+            u,
+            dofs: kept.n,
+            held: kept.held,
+            nonzeros,
+            assemble_seconds: (t1 - t0).as_secs_f64(),
+            solve_seconds: t1.elapsed().as_secs_f64(),
+        })
+    }
+
+    /// Every element's stiffness into `k`, family by family (trusses, links, framed
+    /// links, sliding links, triangles, quads, beams).
+    fn add_stiffness(&self, k: &mut Triplets) {
         let x0 = &self.x0;
         let g = &self.op.el.truss;
         for e in 0..g.id.len() {
@@ -157,7 +290,7 @@ impl Solver {
                 let f2 = truss::force(&x[0], &x[1], g.k[e], g.l0[e], false);
                 [[-f2[0], -f2[1], -f2[2]], f2]
             });
-            add_element(&[a, b], &ke);
+            k.add_element(&[a, b], &ke);
         }
         let l = &self.op.el.link;
         for e in 0..l.id.len() {
@@ -170,7 +303,7 @@ impl Solver {
                 );
                 [[-f2[0], -f2[1], -f2[2]], f2]
             });
-            add_element(&[a, b], &ke);
+            k.add_element(&[a, b], &ke);
         }
         let l = &self.op.el.framed_link;
         for e in 0..l.id.len() {
@@ -178,13 +311,20 @@ impl Solver {
             let xe: [[f64; 3]; 6] = std::array::from_fn(|k| x0[nodes[k]]);
             let h = 1e-6 * l.chords[e][0].min(l.chords[e][1]);
             let ke = fd_stiffness(&xe, h, |x| l.reference_forces(e, x));
-            add_element(&nodes, &ke);
+            k.add_element(&nodes, &ke);
         }
-        // Sliding links: stuck at their reference anchors, on their window nodes (a short
-        // window's padding repeats its last node, whose padding slots carry no force).
-        let l = &self.op.el.sliding_link;
+        self.add_sliding_links(k);
+        add_membranes(&self.op.el.tri, x0, k);
+        add_membranes(&self.op.el.quad, x0, k);
+        self.add_beams(k);
+    }
+
+    /// Sliding links: stuck at their reference anchors, on their window nodes (a short
+    /// window's padding repeats its last node, whose padding slots carry no force).
+    fn add_sliding_links(&self, k: &mut Triplets) {
+        use super::sliding_link::WIN;
+        let (x0, l) = (&self.x0, &self.op.el.sliding_link);
         for e in 0..l.id.len() {
-            use super::sliding_link::WIN;
             let nodes: [usize; 2 * WIN] = l.nodes[e].map(|v| v as usize);
             let xe: [[f64; 3]; 2 * WIN] = std::array::from_fn(|k| x0[nodes[k]]);
             let chord = super::vec3::norm(&super::vec3::sub(&xe[1], &xe[0]));
@@ -195,35 +335,13 @@ impl Solver {
                 ];
                 l.reference_forces(e, &xs)
             });
-            add_element(&nodes, &ke);
+            k.add_element(&nodes, &ke);
         }
-        fn membranes<const N: usize>(
-            grp: &super::membrane::MembraneGroup<N>,
-            x0: &[[f64; 3]],
-            add: &mut dyn FnMut(&[usize], &[f64]),
-        ) {
-            for e in 0..grp.id.len() {
-                let nodes: [usize; N] = grp.nodes[e].map(|v| v as usize);
-                let xe: [[f64; 3]; N] = std::array::from_fn(|a| x0[nodes[a]]);
-                let mut mat = grp.material[e];
-                mat.no_compression = false;
-                let h = 1e-6 * grp.reference[e].area.sqrt();
-                let ke = fd_stiffness(&xe, h, |x| {
-                    membrane::forces_with(
-                        x,
-                        &grp.reference[e],
-                        &mat,
-                        grp.thickness[e],
-                        grp.k_hg[e],
-                        0.0,
-                    )
-                });
-                add(&nodes, &ke);
-            }
-        }
-        membranes(&self.op.el.tri, x0, &mut add_element);
-        membranes(&self.op.el.quad, x0, &mut add_element);
-        let bg = &self.op.el.beam;
+    }
+
+    /// Beams, over their nodes' translations and rotations.
+    fn add_beams(&self, k: &mut Triplets) {
+        let (x0, bg) = (&self.x0, &self.op.el.beam);
         for e in 0..bg.id.len() {
             let [a, b] = bg.nodes[e].map(|v| v as usize);
             let [ra, rb] = bg.rot[e].map(|v| v as usize);
@@ -237,25 +355,26 @@ impl Solver {
                     beam::forces(&u[0], &u[1], &r1, &r2, &bg.props[e])
                 },
             );
-            let mut maps = tmaps(&[a, b]);
-            for k in [ra, rb] {
+            let mut maps = k.dofs.nodes(&[a, b]);
+            for r in [ra, rb] {
                 for d in 0..3 {
-                    maps.push(rmap(k, d));
+                    maps.push(k.dofs.rotation(r, d));
                 }
             }
-            add_maps(&maps, &ke);
+            k.add_maps(&maps, &ke);
         }
-        let mut f = vec![0.0; neq];
-        for ld in &m.loads {
-            for d in 0..3 {
-                for (i, w) in map(ld.node, d) {
-                    f[i] += w * ld.force[d];
-                }
-            }
-        }
-        // Hold degrees of freedom without stiffness (and refuse loaded ones).
+    }
+
+    /// Hold degrees of freedom without stiffness (and refuse loaded ones).
+    fn hold_unresisted(
+        &self,
+        trip: &[(usize, usize, f64)],
+        f: &[f64],
+        dofs: &Dofs,
+    ) -> Result<Kept> {
+        let neq = dofs.neq;
         let mut diag = vec![0.0f64; neq];
-        for &(i, j, v) in &trip {
+        for &(i, j, v) in trip {
             if i == j {
                 diag[i] += v;
             }
@@ -269,10 +388,7 @@ impl Solver {
                 keep[i] = n;
                 n += 1;
             } else if f[i] != 0.0 {
-                let (node, d) = (0..nn)
-                    .flat_map(|a| (0..3).map(move |d| (a, d)))
-                    .find(|&(a, d)| eq[a][d] == i)
-                    .unwrap_or((0, 0));
+                let (node, d) = dofs.of_equation(i);
                 return Err(WeftError::input(format!(
                     "node `{}` is loaded along {} but nothing resists motion in that direction",
                     self.node_id[node],
@@ -285,19 +401,13 @@ impl Solver {
                 held += 1;
             }
         }
-        let mut coo = CooMatrix::new(n, n);
-        for (i, j, v) in trip {
-            let (a, b) = (keep[i], keep[j]);
-            if a != usize::MAX && b != usize::MAX {
-                coo.push(a, b, v);
-            }
-        }
-        let rhs =
-            DVector::from_iterator(n, (0..neq).filter(|&i| keep[i] != usize::MAX).map(|i| f[i]));
-        let csc = CscMatrix::from(&coo);
-        let nonzeros = csc.nnz();
-        let t1 = Instant::now();
-        let chol = CscCholesky::factor(&csc).map_err(|e| {
+        Ok(Kept { keep, n, held })
+    }
+
+    /// The Cholesky factor of K, or the error of a mechanism: a failed factorisation, or
+    /// a pivot far below its diagonal.
+    fn factor(&self, csc: &CscMatrix<f64>, kept: &Kept, dofs: &Dofs) -> Result<CscCholesky<f64>> {
+        let chol = CscCholesky::factor(csc).map_err(|e| {
             WeftError::input(format!("the stiffness matrix is not positive definite ({e:?}): the model is a mechanism or is not held against rigid motion"))
                 .expected("enough constraints to remove every rigid-body motion, and no mechanism (e.g. a pin-jointed grid in shear)")
                 .hint("add constraints or symmetry planes; use rigid joints (beams) where the structure must carry shear")
@@ -306,7 +416,7 @@ impl Solver {
         // a pivot L_ii² far below K_ii means a mechanism.
         let l = chol.l();
         let mut worst = (f64::INFINITY, 0usize);
-        for i in 0..n {
+        for i in 0..kept.n {
             let kd = csc.get_entry(i, i).map(|e| e.into_value()).unwrap_or(0.0);
             let lii = l.get_entry(i, i).map(|e| e.into_value()).unwrap_or(0.0);
             let ratio = lii * lii / kd;
@@ -315,11 +425,10 @@ impl Solver {
             }
         }
         if worst.0 < 1e-10 {
-            let eq_of = (0..neq).find(|&k| keep[k] == worst.1).unwrap_or(0);
-            let (node, d) = (0..nn)
-                .flat_map(|a| (0..3).map(move |d| (a, d)))
-                .find(|&(a, d)| eq[a][d] == eq_of)
-                .unwrap_or((0, 0));
+            let eq_of = (0..dofs.neq)
+                .find(|&k| kept.keep[k] == worst.1)
+                .unwrap_or(0);
+            let (node, d) = dofs.of_equation(eq_of);
             return Err(WeftError::input(format!(
                 "the stiffness matrix is not positive definite (pivot ratio {:.1e} at node `{}`, direction {}): the model is a mechanism or is not held against rigid motion",
                 worst.0,
@@ -329,34 +438,57 @@ impl Solver {
             .expected("enough constraints to remove every rigid-body motion, and no mechanism (e.g. a pin-jointed grid in shear)")
             .hint("add constraints or symmetry planes; use rigid joints (beams) where the structure must carry shear"));
         }
-        let sol = chol.solve(&rhs);
-        let mut full = vec![0.0; neq];
-        for i in 0..neq {
-            if keep[i] != usize::MAX {
-                full[i] = sol[(keep[i], 0)];
-            }
-        }
-        let u: Vec<[f64; 3]> = (0..nn)
-            .map(|i| std::array::from_fn(|d| map(i, d).iter().map(|&(k, w)| w * full[k]).sum()))
-            .collect();
-        if u.iter().flatten().any(|v| !v.is_finite()) {
-            return Err(WeftError::Numerical {
-                what: "the static solution is not finite".into(),
-                step: 0,
-                time: 0.0,
-                hint: Some(
-                    "the stiffness matrix is nearly singular: check constraints and properties"
-                        .into(),
-                ),
-            });
-        }
-        Ok(StaticReport {
-            u,
-            dofs: n,
-            held,
-            nonzeros,
-            assemble_seconds: (t1 - t0).as_secs_f64(),
-            solve_seconds: t1.elapsed().as_secs_f64(),
-        })
+        Ok(chol)
     }
+}
+
+/// Membrane triangles or quads (linear: without their no-compression rule).
+fn add_membranes<const N: usize>(
+    grp: &super::membrane::MembraneGroup<N>,
+    x0: &[[f64; 3]],
+    k: &mut Triplets,
+) {
+    for e in 0..grp.id.len() {
+        let nodes: [usize; N] = grp.nodes[e].map(|v| v as usize);
+        let xe: [[f64; 3]; N] = std::array::from_fn(|a| x0[nodes[a]]);
+        let mut mat = grp.material[e];
+        mat.no_compression = false;
+        let h = 1e-6 * grp.reference[e].area.sqrt();
+        let ke = fd_stiffness(&xe, h, |x| {
+            membrane::forces_with(
+                x,
+                &grp.reference[e],
+                &mat,
+                grp.thickness[e],
+                grp.k_hg[e],
+                0.0,
+            )
+        });
+        k.add_element(&nodes, &ke);
+    }
+}
+
+/// Every node's displacement from the solution over the kept equations (held ones zero,
+/// a slave's from its masters), or an error when it is not finite.
+fn displacements(sol: &DMatrix<f64>, kept: &Kept, dofs: &Dofs) -> Result<Vec<[f64; 3]>> {
+    let mut full = vec![0.0; dofs.neq];
+    for i in 0..dofs.neq {
+        if kept.keep[i] != usize::MAX {
+            full[i] = sol[(kept.keep[i], 0)];
+        }
+    }
+    let u: Vec<[f64; 3]> = (0..dofs.eq.len())
+        .map(|i| std::array::from_fn(|d| dofs.node(i, d).iter().map(|&(k, w)| w * full[k]).sum()))
+        .collect();
+    if u.iter().flatten().any(|v| !v.is_finite()) {
+        return Err(WeftError::Numerical {
+            what: "the static solution is not finite".into(),
+            step: 0,
+            time: 0.0,
+            hint: Some(
+                "the stiffness matrix is nearly singular: check constraints and properties".into(),
+            ),
+        });
+    }
+    Ok(u)
 }

@@ -19,6 +19,7 @@
 //! *Nonlinear Finite Elements*, §10.4 (penalty contact), Wriggers, *Computational
 //! Contact Mechanics*, §5.2 (regularised Coulomb friction).
 
+pub use super::closest::{closest_on_segment, closest_on_triangle};
 use crate::model::{ProjectileShape, ProjectileSpec};
 
 /// Default κ_c of the penalty stiffness k = κ_c m/Δt².
@@ -175,103 +176,6 @@ pub fn friction(n: &[f64; 3], fnorm: f64, vr: &[f64; 3], mu: f64) -> ([f64; 3], 
     )
 }
 
-/// Closest point of the triangle (a, b, c) to p, as barycentric weights (w_a, w_b, w_c)
-/// (Ericson, *Real-Time Collision Detection*, §5.1.5).
-#[inline(always)]
-pub fn closest_on_triangle(p: &[f64; 3], a: &[f64; 3], b: &[f64; 3], c: &[f64; 3]) -> [f64; 3] {
-    let sub = |x: &[f64; 3], y: &[f64; 3]| [x[0] - y[0], x[1] - y[1], x[2] - y[2]];
-    let dot = |x: &[f64; 3], y: &[f64; 3]| x[0] * y[0] + x[1] * y[1] + x[2] * y[2];
-    let (ab, ac, ap) = (sub(b, a), sub(c, a), sub(p, a));
-    let (d1, d2) = (dot(&ab, &ap), dot(&ac, &ap));
-    if d1 <= 0.0 && d2 <= 0.0 {
-        return [1.0, 0.0, 0.0];
-    }
-    let bp = sub(p, b);
-    let (d3, d4) = (dot(&ab, &bp), dot(&ac, &bp));
-    if d3 >= 0.0 && d4 <= d3 {
-        return [0.0, 1.0, 0.0];
-    }
-    let vc = d1 * d4 - d3 * d2;
-    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
-        // d1 − d3 = |ab|² is 0 only for a = b: the triangle is a segment (0/0 otherwise).
-        if !(d1 - d3 > 0.0) {
-            return closest_on_edges(p, a, b, c);
-        }
-        let v = d1 / (d1 - d3);
-        return [1.0 - v, v, 0.0];
-    }
-    let cp = sub(p, c);
-    let (d5, d6) = (dot(&ab, &cp), dot(&ac, &cp));
-    if d6 >= 0.0 && d5 <= d6 {
-        return [0.0, 0.0, 1.0];
-    }
-    let vb = d5 * d2 - d1 * d6;
-    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
-        if !(d2 - d6 > 0.0) {
-            return closest_on_edges(p, a, b, c);
-        }
-        let w = d2 / (d2 - d6);
-        return [1.0 - w, 0.0, w];
-    }
-    let va = d3 * d6 - d5 * d4;
-    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
-        if !((d4 - d3) + (d5 - d6) > 0.0) {
-            return closest_on_edges(p, a, b, c);
-        }
-        let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
-        return [0.0, 1.0 - w, w];
-    }
-    // va + vb + vc = |ab × ac|² = |ab|²|ac|² sin²θ. Each carries a round-off of order
-    // ε|ab|²|ac|², so the weights of a sliver (sin²θ ≤ 10⁻¹⁰) are noise (measured: a
-    // collinear triangle gave a point 0.09 of its length off): its edges' nearest point
-    // instead, within its height (≤ 10⁻⁵ of its size) of the true one.
-    // (d1 − d3 = |ab|², d2 − d6 = |ac|².)
-    let area2 = va + vb + vc;
-    if !(area2 > SLIVER * (d1 - d3) * (d2 - d6)) {
-        return closest_on_edges(p, a, b, c);
-    }
-    let denom = 1.0 / area2;
-    let (v, w) = (vb * denom, vc * denom);
-    [1.0 - v - w, v, w]
-}
-
-/// sin²θ below which [`closest_on_triangle`] treats a triangle as a sliver.
-const SLIVER: f64 = 1e-10;
-
-/// Closest point of the segment (a, b) to p, as the parameter t ∈ [0, 1] of a + t(b − a)
-/// (0 for a segment of no length).
-#[inline]
-pub fn closest_on_segment(p: &[f64; 3], a: &[f64; 3], b: &[f64; 3]) -> f64 {
-    let e = sub(b, a);
-    let ee = dot(&e, &e);
-    if ee > 0.0 {
-        (dot(&sub(p, a), &e) / ee).clamp(0.0, 1.0)
-    } else {
-        0.0
-    }
-}
-
-/// Closest point of the three edges of a triangle (a, b, c) to p, as weights: the
-/// fallback of [`closest_on_triangle`] for a triangle of no area.
-#[cold]
-fn closest_on_edges(p: &[f64; 3], a: &[f64; 3], b: &[f64; 3], c: &[f64; 3]) -> [f64; 3] {
-    let seg = |x: &[f64; 3], y: &[f64; 3]| -> (f64, f64) {
-        let t = closest_on_segment(p, x, y);
-        let r: [f64; 3] = std::array::from_fn(|d| p[d] - (x[d] + t * (y[d] - x[d])));
-        (t, dot(&r, &r))
-    };
-    let (tab, dab) = seg(a, b);
-    let (tbc, dbc) = seg(b, c);
-    let (tca, dca) = seg(c, a);
-    if dab <= dbc && dab <= dca {
-        [1.0 - tab, tab, 0.0]
-    } else if dbc <= dca {
-        [0.0, 1.0 - tbc, tbc]
-    } else {
-        [tca, 0.0, 1.0 - tca]
-    }
-}
-
 // ---------------------------------------------------------------------------------------
 // Projectile contact during a run: the projectiles, the face sample points and face
 // triangles they meet, and the force and energy passes.
@@ -279,7 +183,7 @@ fn closest_on_edges(p: &[f64; 3], a: &[f64; 3], b: &[f64; 3], c: &[f64; 3]) -> [
 use rayon::prelude::*;
 
 use crate::model::Model;
-use crate::solver::vec3::{add, dot, sub};
+use crate::solver::vec3::{add, dot};
 
 /// Skin of the projectile's list of nearby face triangles, as a fraction of its radius:
 /// the list holds every triangle that could come within the radius before the nose

@@ -1,0 +1,623 @@
+//! The narrow phase: per slave, its candidate faces past the box and envelope filters,
+//! the closest point on each, and over the faces it penetrates the shared normal, the
+//! penalty and friction force and the shares of the reaction; in parallel fixed chunks
+//! of slaves (`Side::narrow`).
+
+use rayon::prelude::*;
+
+use super::kernels::{
+    box_distance2, fmax, pair_force, release, thickness_gradient, Friction, SlaveState,
+};
+use super::side::{ChunkSums, PairOut, Reaction, Side, SLAVE_CHUNK};
+use crate::model::contacts::InitialPenetration;
+use crate::solver::contact::closest::closest_on_face;
+use crate::solver::vec3::{cross, dot, sub};
+
+/// Most slave chunks of one narrow-phase task (see `Side::narrow`).
+const NARROW_TASK_CHUNKS: usize = 4;
+
+/// Most faces one slave's reaction is shared over (a node at a quad vertex penetrates the
+/// four faces around it; more only in crushed regions, where the deepest are kept).
+const MAX_SHARED: usize = 8;
+
+/// A face a slave penetrates: the weights `w` of its foot q, the penetration `g` = c − |r|
+/// (c = (t_s + t_F)/2), |r| and r = x_s − q, the face's in-plane thickness gradient (when
+/// |r| > 0) and, for a slave on the mid-surface (|r| = 0), the face's unit normal.
+struct Hit {
+    w: [f64; 4],
+    g: f64,
+    dist: f64,
+    r: [f64; 3],
+    tg: [f64; 3],
+    flat: [f64; 3],
+}
+
+/// The closest point of face `f` (thicknesses `ft`) to a slave at (px, py, pz) of
+/// thickness `ts`, and whether the slave penetrates it. (A function of its own: inlined in
+/// the slave loop, the gathers of the face's nodes went through the stack and were
+/// reloaded as pairs spanning two stores; the compiler still reads the thicknesses only
+/// after the projection, where perf puts most of this function's own samples.)
+#[inline(never)]
+#[allow(clippy::too_many_arguments)]
+fn evaluate_face<const NF: usize>(
+    px: f64,
+    py: f64,
+    pz: f64,
+    ts: f64,
+    f: &[u32; 4],
+    ft: &[f64; 4],
+    x: &[[f64; 3]],
+) -> Option<Hit> {
+    let (f, t) = (*f, *ft);
+    let p = [px, py, pz];
+    let xf: [[f64; 3]; 4] = [
+        x[f[0] as usize],
+        x[f[1] as usize],
+        if NF > 2 { x[f[2] as usize] } else { [0.0; 3] },
+        if NF > 3 { x[f[3] as usize] } else { [0.0; 3] },
+    ];
+    let nf = NF;
+    let w = closest_on_face(&p, &xf, nf);
+    let q: [f64; 3] = std::array::from_fn(|d| (0..nf).map(|a| w[a] * xf[a][d]).sum());
+    let tf: f64 = (0..nf).map(|a| w[a] * t[a]).sum();
+    let r = sub(&p, &q);
+    let c = 0.5 * (ts + tf);
+    let d2 = dot(&r, &r);
+    if d2 >= c * c {
+        return None;
+    }
+    let dist = d2.sqrt();
+    let (tg, flat) = if dist > 0.0 {
+        (thickness_gradient(&t, &xf, nf), [0.0; 3])
+    } else {
+        let c = cross(&sub(&xf[1], &xf[0]), &sub(&xf[nf - 1], &xf[0]));
+        let cn = dot(&c, &c).sqrt();
+        let n = if cn > 0.0 {
+            [c[0] / cn, c[1] / cn, c[2] / cn]
+        } else {
+            [0.0, 0.0, 1.0]
+        };
+        ([0.0; 3], n)
+    };
+    Some(Hit {
+        w,
+        g: c - dist,
+        dist,
+        r,
+        tg,
+        flat,
+    })
+}
+
+/// The candidates of `block` a slave at (px, py, pz) may penetrate, in order, into `near`;
+/// returns how many. First, without branches, the distance to each face's thickness box
+/// at this step (within `reach` = t_s/2 + η, r2 its square).
+/// Then, of those, the faces whose envelope bounds h± along m± the slave is within
+/// t_s/2 + η of: the ball of radius t_F/2 about the foot q = Σ w_a x_a has the support
+/// m·q + t_F/2 = Σ w_a (m·x_a + t_a/2) ≤ max_a (m·x_a + t_a/2) = h along a unit m, so a
+/// slave with m·x_s ≥ h + t_s/2 is at least (t_s + t_F)/2 from q (η as in the box test:
+/// the same bits). Measured on the 60 × 60 to 20 µs: 60 % of the faces that pass the box
+/// test fail this one, none penetrated. (A function of its own, with the slave's position
+/// in registers: inlined, the position was spilled and reloaded across the loop.)
+#[inline(never)]
+#[allow(clippy::too_many_arguments)]
+fn filter_block<const NF: usize>(
+    px: f64,
+    py: f64,
+    pz: f64,
+    reach: f64,
+    r2: f64,
+    block: &[u32],
+    face_box: &[[f64; 8]],
+    face_dir: &[[f32; 6]],
+    near: &mut [u32; 32],
+) -> usize {
+    let p = [px, py, pz];
+    let mut nn = 0;
+    for &fi in block {
+        let d2 = box_distance2(&p, &face_box[fi as usize]);
+        near[nn] = fi;
+        nn += (d2 <= r2) as usize;
+    }
+    if NF >= 3 {
+        let mut kept = 0;
+        for i in 0..nn {
+            let fi = near[i];
+            let (m, b) = (&face_dir[fi as usize], &face_box[fi as usize]);
+            let m: [f64; 6] = std::array::from_fn(|k| m[k] as f64);
+            let up = m[0] * p[0] + m[1] * p[1] + m[2] * p[2] - b[6];
+            let dn = m[3] * p[0] + m[4] * p[1] + m[5] * p[2] - b[7];
+            near[kept] = fi;
+            kept += (fmax(up, dn) < reach) as usize;
+        }
+        nn = kept;
+    }
+    nn
+}
+
+/// The faces a slave penetrates, gathered over its candidates: the deepest, the
+/// penetration-weighted sums of the normals and of the thickness gradients, and how many
+/// of the shares (the chunk's scratch [`Shares`]) are filled.
+struct Found {
+    /// The candidate of largest raw penetration: (face, g, normal).
+    best: Option<(u32, f64, [f64; 3])>,
+    /// Σ g n over the faces the node penetrates (off their mid-surface), and how many: in
+    /// a concave crease (a node under a tent of two faces) both feet are valid and the
+    /// nearer one's normal flips as the node crosses the bisector; the
+    /// penetration-weighted normal turns continuously instead.
+    n_sum: [f64; 3],
+    n_count: u32,
+    /// Σ g ∇t_F and Σ g over the same faces.
+    tg_sum: [f64; 3],
+    g_sum: f64,
+    /// Shares filled.
+    n_pen: usize,
+}
+
+/// The faces a slave penetrates (face, weights, g), the deepest [`MAX_SHARED`]: the
+/// reaction is shared over them as the normal is, so that a node over a vertex or a
+/// ridge, whose faces tie, pushes them all alike (the deepest alone, ties to the first in
+/// face order, pushed one side only, and the reaction jumped between faces as the node
+/// moved: measured, a formed weave tiled from its mirror-symmetric cell was out of balance
+/// by 0.10 of the crossing force at the vertex's neighbours, and drifted when left alone).
+/// Scratch of a chunk of slaves (only the first `Found::n_pen` entries are read): declared
+/// once per chunk, not zeroed per slave.
+type Shares = [(u32, [f64; 4], f64); MAX_SHARED];
+
+impl Found {
+    /// Nothing found yet.
+    #[inline(always)]
+    fn new() -> Found {
+        Found {
+            best: None,
+            n_sum: [0.0; 3],
+            n_count: 0,
+            tg_sum: [0.0; 3],
+            g_sum: 0.0,
+            n_pen: 0,
+        }
+    }
+
+    /// A face `fi` the slave penetrates.
+    #[inline(always)]
+    fn add(&mut self, fi: u32, hit: Hit, pen: &mut Shares) {
+        let Hit {
+            w,
+            g,
+            dist,
+            r,
+            tg,
+            flat,
+        } = hit;
+        if self.n_pen < MAX_SHARED {
+            pen[self.n_pen] = (fi, w, g);
+            self.n_pen += 1;
+        } else {
+            // Full: replace the shallowest (the first of equals).
+            let mut k = 0;
+            for j in 1..MAX_SHARED {
+                if pen[j].2 < pen[k].2 {
+                    k = j;
+                }
+            }
+            if g > pen[k].2 {
+                pen[k] = (fi, w, g);
+            }
+        }
+        if dist > 0.0 {
+            for d in 0..3 {
+                self.n_sum[d] += g * r[d] / dist;
+                self.tg_sum[d] += g * tg[d];
+            }
+            self.g_sum += g;
+            self.n_count += 1;
+        }
+        if self.best.as_ref().is_none_or(|b| g > b.1) {
+            let n = if dist > 0.0 {
+                [r[0] / dist, r[1] / dist, r[2] / dist]
+            } else {
+                flat
+            };
+            self.best = Some((fi, g, n));
+        }
+    }
+}
+
+/// One narrow phase of a side: what it reads (the positions and velocities, the step,
+/// the side's slaves, faces and candidates), borrowed apart from the slaves' results and
+/// states, which it writes chunk by chunk.
+struct Narrow<'a> {
+    x: &'a [[f64; 3]],
+    v: &'a [[f64; 3]],
+    /// Δt² of the penalty, and Δt^{n−½} of the friction slip.
+    dt2: f64,
+    dt_prev: f64,
+    /// Setup: report penetrations instead of pushing.
+    initial: bool,
+    /// Per cell of the staleness test, |S| of `Side::margin` (None: no slave skipped).
+    spread: Option<&'a [f64]>,
+    face_box: &'a [[f64; 8]],
+    face_dir: &'a [[f32; 6]],
+    margin: &'a [f64],
+    slave_cell: &'a [u32],
+    faces: &'a [[u32; 4]],
+    face_t: &'a [[f64; 4]],
+    face_m: &'a [[f64; 4]],
+    slaves: &'a [u32],
+    slave_t: &'a [f64],
+    slave_m: &'a [f64],
+    cand_ptr: &'a [u32],
+    cand: &'a [u32],
+    fr: Friction,
+    kappa: f64,
+    zeta: f64,
+    /// The definition's initial penetrations are `keep`: the penalty acts on their full
+    /// depth from the start (no g₀ tracked).
+    keep: bool,
+    /// Round-off allowance η of the box tests [m].
+    eta: f64,
+}
+
+/// One fixed chunk of slaves as the narrow phase writes it: (chunk index, ((((results,
+/// (states, held)), slaves in contact), reaction shares), sums)).
+type Chunk<'c> = (
+    usize,
+    (
+        (
+            (
+                (&'c mut [PairOut], (&'c mut [SlaveState], &'c mut [bool])),
+                &'c mut Vec<u32>,
+            ),
+            &'c mut Vec<Reaction>,
+        ),
+        &'c mut ChunkSums,
+    ),
+);
+
+impl Side {
+    /// Narrow phase and friction for every slave, in parallel chunks, into `out`.
+    /// `initial`: report penetrations instead of pushing (setup).
+    /// `spread`: per cell of the staleness test, |S| of `Side::margin` at this step
+    /// (None: no slave is skipped).
+    pub(super) fn narrow(
+        &mut self,
+        x: &[[f64; 3]],
+        v: &[[f64; 3]],
+        dt: f64,
+        dt_prev: f64,
+        initial: bool,
+        spread: Option<&[f64]>,
+    ) {
+        // One copy per face kind, so that the loops over a face's nodes are unrolled.
+        match self.nf {
+            2 => self.narrow_n::<2>(x, v, dt, dt_prev, initial, spread),
+            3 => self.narrow_n::<3>(x, v, dt, dt_prev, initial, spread),
+            _ => self.narrow_n::<4>(x, v, dt, dt_prev, initial, spread),
+        }
+    }
+
+    fn narrow_n<const NF: usize>(
+        &mut self,
+        x: &[[f64; 3]],
+        v: &[[f64; 3]],
+        dt: f64,
+        dt_prev: f64,
+        initial: bool,
+        spread: Option<&[f64]>,
+    ) {
+        let nar = Narrow {
+            x,
+            v,
+            dt2: dt * dt,
+            dt_prev,
+            initial,
+            spread,
+            face_box: &self.face_box,
+            face_dir: &self.face_dir,
+            margin: &self.margin,
+            slave_cell: &self.slave_cell,
+            faces: &self.faces,
+            face_t: &self.face_t,
+            face_m: &self.face_m,
+            slaves: &self.slaves,
+            slave_t: &self.slave_t,
+            slave_m: &self.slave_m,
+            cand_ptr: &self.cand_ptr,
+            cand: &self.cand,
+            fr: self.friction,
+            kappa: self.kappa,
+            zeta: self.damping,
+            keep: self.on_initial == InitialPenetration::Keep,
+            eta: self.box_margin,
+        };
+        let nchunks = self.slaves.len().div_ceil(SLAVE_CHUNK);
+        self.chunk_active.resize_with(nchunks, Vec::new);
+        self.chunk_reactions.resize_with(nchunks, Vec::new);
+        self.chunk_sums.resize(nchunks, ChunkSums::default());
+        let body = |c: Chunk| nar.chunk::<NF>(c);
+        if self.slaves.len() <= SLAVE_CHUNK {
+            self.out
+                .chunks_mut(SLAVE_CHUNK)
+                .zip(
+                    self.state
+                        .chunks_mut(SLAVE_CHUNK)
+                        .zip(self.held.chunks_mut(SLAVE_CHUNK)),
+                )
+                .zip(self.chunk_active.iter_mut())
+                .zip(self.chunk_reactions.iter_mut())
+                .zip(self.chunk_sums.iter_mut())
+                .enumerate()
+                .for_each(body);
+        } else {
+            self.out
+                .par_chunks_mut(SLAVE_CHUNK)
+                .zip(
+                    self.state
+                        .par_chunks_mut(SLAVE_CHUNK)
+                        .zip(self.held.par_chunks_mut(SLAVE_CHUNK)),
+                )
+                .zip(self.chunk_active.par_iter_mut())
+                .zip(self.chunk_reactions.par_iter_mut())
+                .zip(self.chunk_sums.par_iter_mut())
+                .enumerate()
+                // A task per few chunks: the slaves in contact cluster under the nose, and
+                // rayon's default split leaves quarters of the range that a second thread
+                // cannot steal from (measured by thread in perf: the narrow phase's
+                // samples 14.8 % against 13.2 %, the second thread idle meanwhile).
+                .with_max_len(NARROW_TASK_CHUNKS)
+                .for_each(body);
+        }
+    }
+}
+
+impl Narrow<'_> {
+    /// The slaves of one chunk: each skipped, or its faces found, then its contact (or
+    /// at the setup its initial penetration) into its result, state and the chunk's
+    /// lists and sums.
+    #[inline(always)]
+    fn chunk<const NF: usize>(&self, c: Chunk) {
+        let (ci, ((((outs, (sts, held)), active), reactions), sums)) = c;
+        active.clear();
+        reactions.clear();
+        *sums = ChunkSums::default();
+        // Scratch of the slaves (only the first n_pen, nn entries are read):
+        // declared once per chunk, not zeroed per slave.
+        let mut pen: Shares = [(0u32, [0.0f64; 4], 0.0f64); MAX_SHARED];
+        let mut near = [0u32; 32];
+        // (A slave that is open and holds no state is not written: its output is
+        // read only while it is in contact, and its state is the default one. At the
+        // setup every slave is written.)
+        for (j, ((o, st), hd)) in outs
+            .iter_mut()
+            .zip(sts.iter_mut())
+            .zip(held.iter_mut())
+            .enumerate()
+        {
+            let si = ci * SLAVE_CHUNK + j;
+            if self
+                .spread
+                .is_some_and(|sp| self.margin[si] > sp[self.slave_cell[si] as usize])
+            {
+                // No candidate can pass the filter (see `Side::margin`): what the
+                // full test gives a slave that finds no face.
+                sums.skipped += 1;
+                if *hd {
+                    st.g0 = 0.0;
+                    sums.dissipated += release(st);
+                    *hd = false;
+                }
+                continue;
+            }
+            let s = self.slaves[si] as usize;
+            let found = self.search::<NF>(si, &self.x[s], &mut near, &mut pen, sums);
+            let mut out = PairOut {
+                face: u32::MAX,
+                ..Default::default()
+            };
+            let g_raw = found.best.as_ref().map_or(f64::NEG_INFINITY, |b| b.1);
+            if self.initial {
+                st.g0 = if self.keep { 0.0 } else { g_raw.max(0.0) };
+                *hd = st.g0 != 0.0;
+                if let Some(b) = &found.best {
+                    out.face = if g_raw > 0.0 { b.0 } else { u32::MAX };
+                }
+                *o = out;
+                continue;
+            }
+            if !*hd && !(g_raw > 0.0) {
+                // Open before and now, holding nothing (g₀ = 0, no stick spring):
+                // nothing changes.
+                continue;
+            }
+            // The tracked initial penetration shrinks as the node leaves.
+            if g_raw < st.g0 {
+                st.g0 = g_raw.max(0.0);
+            }
+            let g = g_raw - st.g0;
+            match found.best {
+                Some((fi, _, n)) if g > 0.0 => {
+                    // Shares λ_F = g_F/Σg of the penetrated faces.
+                    let pen = &pen[..found.n_pen];
+                    let g_pen: f64 = pen.iter().map(|e| e.2).sum();
+                    out = self.contact::<NF>(si, s, fi, n, g, &found, pen, g_pen, st);
+                    self.share_reaction(si, pen, g_pen, reactions);
+                }
+                _ => out.dissipated = release(st),
+            }
+            *hd = st.k != 0.0 || st.g0 != 0.0 || st.ft != [0.0; 3];
+            if out.face != u32::MAX {
+                active.push(si as u32);
+                sums.stored += out.stored;
+            }
+            sums.dissipated += out.dissipated;
+            *o = out;
+        }
+    }
+
+    /// The faces slave `si` at `p` penetrates, among its candidates (counted into `sums`),
+    /// in candidate order.
+    #[inline(always)]
+    fn search<const NF: usize>(
+        &self,
+        si: usize,
+        p: &[f64; 3],
+        near: &mut [u32; 32],
+        pen: &mut Shares,
+        sums: &mut ChunkSums,
+    ) -> Found {
+        let mut found = Found::new();
+        // A face can be penetrated only if the slave is within t_s/2 of its
+        // thickness box: the foot q = Σ w_a x_a is a convex combination of the
+        // nodes (each triangle's barycentric weights, averaged over a quad's
+        // two splits), and t_F = Σ w_a t_a the same combination of their
+        // thicknesses, so the ball of radius t_F/2 about q lies in the box, and
+        // |x_s − q| < (t_s + t_F)/2 puts x_s within t_s/2 of it. The test in
+        // floating point keeps η = 10⁻⁹ (|x|_max + reach) more, 10⁶ times the
+        // round-off of the foot and the box, so that it rejects only faces
+        // that the closest-point test below rejects too: the same bits.
+        let reach = 0.5 * self.slave_t[si] + self.eta;
+        let r2 = reach * reach;
+        // Only faces the node penetrates (g > 0) matter: a node whose best g is
+        // ≤ 0 is open whether or not some face was evaluated, and a tracked initial
+        // penetration g₀ then drops to 0 either way.
+        let list = &self.cand[self.cand_ptr[si] as usize..self.cand_ptr[si + 1] as usize];
+        sums.tested += list.len() as u64;
+        for block in list.chunks(32) {
+            let nn = filter_block::<NF>(
+                p[0],
+                p[1],
+                p[2],
+                reach,
+                r2,
+                block,
+                self.face_box,
+                self.face_dir,
+                near,
+            );
+            sums.evaluated += nn as u64;
+            for &fi in &near[..nn] {
+                let Some(hit) = evaluate_face::<NF>(
+                    p[0],
+                    p[1],
+                    p[2],
+                    self.slave_t[si],
+                    &self.faces[fi as usize],
+                    &self.face_t[fi as usize],
+                    self.x,
+                ) else {
+                    continue;
+                };
+                sums.penetrated += 1;
+                found.add(fi, hit, pen);
+            }
+        }
+        found
+    }
+
+    /// The contact of slave `si` (node `s`) with its deepest face `fi` of normal `n`, at
+    /// the penetration `g` beyond its tracked initial one, over the penetrated faces `pen`
+    /// (of total penetration `g_pen`): the normal (their penetration-weighted mean where
+    /// it penetrates several), the penalty and friction force, the envelope's slope and
+    /// the normal dashpot, into the slave's result.
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    fn contact<const NF: usize>(
+        &self,
+        si: usize,
+        s: usize,
+        fi: u32,
+        mut n: [f64; 3],
+        g: f64,
+        found: &Found,
+        pen: &[(u32, [f64; 4], f64)],
+        g_pen: f64,
+        st: &mut SlaveState,
+    ) -> PairOut {
+        let (n_sum, tg_sum, g_sum) = (found.n_sum, found.tg_sum, found.g_sum);
+        if found.n_count > 1 {
+            let l = dot(&n_sum, &n_sum).sqrt();
+            if l > 0.0 {
+                n = [n_sum[0] / l, n_sum[1] / l, n_sum[2] / l];
+            }
+        }
+        let (mf, vf) = self.foot::<NF>(pen, g_pen);
+        let ms = self.slave_m[si];
+        let mstar = if ms > 0.0 { ms.min(mf) } else { mf };
+        let k = self.kappa * mstar / self.dt2;
+        let vr = sub(&self.v[s], &vf);
+        let vn = dot(&vr, &n);
+        let vt = [vr[0] - vn * n[0], vr[1] - vn * n[1], vr[2] - vn * n[2]];
+        let (mut force, stored, mut diss) = pair_force(g, &n, k, &vt, self.dt_prev, &self.fr, st);
+        // Where the face's thickness varies (a lenticular band), the
+        // contact distance depends on where the foot lies: the force is
+        // −∂(½kg²)/∂x_s = k g (n − ½∇t_F), normal to the thickness
+        // envelope rather than to the mid-surface; ∇t_F is weighted over
+        // the penetrated faces like n, so that it turns continuously over
+        // the ridge of a band's centre line.
+        if g_sum > 0.0 {
+            for d in 0..3 {
+                force[d] -= 0.5 * k * g * tg_sum[d] / g_sum;
+            }
+        }
+        if self.zeta > 0.0 {
+            // Normal dashpot, never pulling the surfaces together.
+            let c = 2.0 * self.zeta * (k * mstar).sqrt();
+            let fd = (-c * vn).max(-k * g);
+            for d in 0..3 {
+                force[d] += fd * n[d];
+            }
+            diss -= fd * vn * self.dt_prev;
+        }
+        PairOut {
+            face: fi,
+            f: force,
+            stored,
+            dissipated: diss,
+            g,
+        }
+    }
+
+    /// The foot's mass and velocity: over the penetrated faces `pen` (of total
+    /// penetration `g_pen`) in the shares λ_F = g_F/Σg, their nodes' masses and
+    /// velocities interpolated at their feet, so that the penalty and the friction slip
+    /// are continuous as faces come and go, and the power of the shared reaction is
+    /// −f·v_foot.
+    #[inline(always)]
+    fn foot<const NF: usize>(&self, pen: &[(u32, [f64; 4], f64)], g_pen: f64) -> (f64, [f64; 3]) {
+        let (mut mf, mut vf) = (0.0f64, [0.0f64; 3]);
+        for &(fj, wj, gj) in pen {
+            let lam = gj / g_pen;
+            let fn_ = &self.faces[fj as usize];
+            let fm = &self.face_m[fj as usize];
+            for a in 0..NF {
+                let la = lam * wj[a];
+                mf += la * fm[a];
+                let va = &self.v[fn_[a] as usize];
+                for d in 0..3 {
+                    vf[d] += la * va[d];
+                }
+            }
+        }
+        (mf, vf)
+    }
+
+    /// The shares of slave `si`'s reaction over the faces it penetrates (`pen`, of total
+    /// penetration `g_pen`), in the same shares λ_F = g_F/Σg as its foot.
+    #[inline(always)]
+    fn share_reaction(
+        &self,
+        si: usize,
+        pen: &[(u32, [f64; 4], f64)],
+        g_pen: f64,
+        reactions: &mut Vec<Reaction>,
+    ) {
+        for &(fj, wj, gj) in pen {
+            let lam = gj / g_pen;
+            reactions.push(Reaction {
+                slave: si as u32,
+                face: fj,
+                w: std::array::from_fn(|a| lam * wj[a]),
+            });
+        }
+    }
+}
