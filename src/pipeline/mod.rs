@@ -6,9 +6,12 @@ pub mod engine;
 pub mod exec;
 pub mod gather;
 pub mod hash;
+pub mod host;
 pub mod record;
 pub mod slurm;
 pub mod spec;
+pub mod workspace;
 
-pub use engine::{run, ExecutorKind, RunOptions, Verdict, Workspace};
+pub use engine::{run, ExecutorKind, RunOptions};
 pub use spec::Pipeline;
+pub use workspace::{Verdict, Workspace};

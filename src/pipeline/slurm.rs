@@ -26,12 +26,12 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 use serde::{Deserialize, Serialize};
 
-use super::engine::{Verdict, Workspace};
 use super::exec::{
     finish, now_unix, prepare, process_tag, run_command, stage_path, Event, Executor, Finish,
     Launch,
 };
 use super::spec::{file_name_of, shell_quote, ExecutorSpec, Instance, Pipeline};
+use super::workspace::{Verdict, Workspace};
 use crate::error::{Result, WeftError};
 
 /// What the controller writes when it submits an instance.
