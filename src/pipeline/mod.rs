@@ -7,6 +7,7 @@ pub mod exec;
 pub mod gather;
 pub mod hash;
 pub mod host;
+pub mod progress;
 pub mod record;
 pub mod slurm;
 pub mod spec;
