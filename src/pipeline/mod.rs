@@ -9,6 +9,7 @@ pub mod hash;
 pub mod host;
 pub mod progress;
 pub mod record;
+pub mod show;
 pub mod slurm;
 pub mod spec;
 pub mod workspace;

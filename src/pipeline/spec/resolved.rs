@@ -109,6 +109,45 @@ impl ExecutorSpec {
 }
 
 impl Pipeline {
+    /// The instances `weft run TARGETS` selects: every one without targets, else the
+    /// targets (stages or instances) with everything upstream of them, or with `single`
+    /// only the targets.
+    pub fn selection(&self, targets: &[String], single: bool) -> Result<Vec<bool>> {
+        let n = self.instances.len();
+        if targets.is_empty() {
+            return Ok(vec![true; n]);
+        }
+        let mut sel = vec![];
+        for t in targets {
+            sel.extend(self.select(t)?);
+        }
+        if single {
+            let mut v = vec![false; n];
+            for i in sel {
+                v[i] = true;
+            }
+            Ok(v)
+        } else {
+            Ok(self.with_ancestors(&sel))
+        }
+    }
+
+    /// The instances `--force` forces: an empty name every selected instance, a stage or
+    /// instance name its instances.
+    pub fn forced(&self, force: &[String], selected: &[bool]) -> Result<Vec<bool>> {
+        let mut forced = vec![false; self.instances.len()];
+        for f in force {
+            if f.is_empty() {
+                forced = selected.to_vec();
+            } else {
+                for i in self.select(f)? {
+                    forced[i] = true;
+                }
+            }
+        }
+        Ok(forced)
+    }
+
     /// Instances matching a selector: an instance name, or a stage name (all its instances).
     pub fn select(&self, sel: &str) -> Result<Vec<usize>> {
         let v: Vec<usize> = (0..self.instances.len())
