@@ -467,12 +467,16 @@ fn split_task(job: &str) -> Option<(&str, usize)> {
     Some((a, t.parse().ok()?))
 }
 
-/// How the instances of one stage waiting on `handles` are submitted, in order:
-/// (tasks, dependency) of each submission, arrays at most `max_array` tasks.
-fn submissions<'a>(
-    mine: Vec<&(&'a Launch, Vec<String>)>,
-    max_array: usize,
-) -> Vec<(Tasks<'a>, Option<String>)> {
+/// One `sbatch` of a stage's instances: a job or an array, and what it waits on.
+struct Submission<'a> {
+    tasks: Tasks<'a>,
+    /// `--dependency`: `afterok:...` or `aftercorr:ARRAY`; `None` when it waits on nothing.
+    dependency: Option<String>,
+}
+
+/// How the instances of one stage are submitted, in order (`mine`: each instance with the
+/// job handles it waits on), arrays at most `max_array` tasks.
+fn submissions<'a>(mine: Vec<&(&'a Launch, Vec<String>)>, max_array: usize) -> Vec<Submission<'a>> {
     // Aligned: each instance waits on exactly one task of one array A. Either
     // `aftercorr:A` arrays, task t of which waits on task t of A (one array per
     // instance waiting on the same task: `simulate@e,s` for both s after
@@ -491,7 +495,7 @@ fn submissions<'a>(
             _ => grouped.entry(h.clone()).or_default().push(*l),
         }
     }
-    let mut subs: Vec<(Tasks, Option<String>)> = vec![];
+    let mut subs: Vec<Submission> = vec![];
     for (a, by_task) in aligned {
         let rounds = by_task.values().map(Vec::len).max().unwrap_or(0);
         if rounds > by_task.len() {
@@ -510,17 +514,26 @@ fn submissions<'a>(
                 .collect();
             if let [(t, l)] = m.as_slice() {
                 let dep = format!("afterok:{a}_{t}");
-                subs.push((vec![(None, *l)], Some(dep)));
+                subs.push(Submission {
+                    tasks: vec![(None, *l)],
+                    dependency: Some(dep),
+                });
             } else {
                 let tasks = m.into_iter().map(|(t, l)| (Some(t), l)).collect();
-                subs.push((tasks, Some(format!("aftercorr:{a}"))));
+                subs.push(Submission {
+                    tasks,
+                    dependency: Some(format!("aftercorr:{a}")),
+                });
             }
         }
     }
     for (h, ls) in grouped {
         let dep = (!h.is_empty()).then(|| format!("afterok:{}", h.join(":")));
         if ls.len() == 1 {
-            subs.push((vec![(None, ls[0])], dep));
+            subs.push(Submission {
+                tasks: vec![(None, ls[0])],
+                dependency: dep,
+            });
             continue;
         }
         for chunk in ls.chunks(max_array.saturating_sub(1).max(1)) {
@@ -529,7 +542,10 @@ fn submissions<'a>(
                 .enumerate()
                 .map(|(t, l)| (Some(t), *l))
                 .collect();
-            subs.push((tasks, dep.clone()));
+            subs.push(Submission {
+                tasks,
+                dependency: dep.clone(),
+            });
         }
     }
     subs
@@ -570,8 +586,8 @@ impl Executor for SlurmExecutor {
                 .iter()
                 .filter(|(l, _)| p.instances[l.idx].stage == stage)
                 .collect();
-            for (tasks, dep) in submissions(mine, self.max_array) {
-                self.submit(p, stage, tasks, dep, say)?;
+            for s in submissions(mine, self.max_array) {
+                self.submit(p, stage, s.tasks, s.dependency, say)?;
             }
         }
         Ok(())

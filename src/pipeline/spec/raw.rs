@@ -36,6 +36,7 @@ pub(super) struct RawExecutor {
     pub(super) stages: BTreeMap<String, Spanned<RawResources>>,
 }
 
+/// A table of Slurm resources: `[executor.stages.NAME]`, or `[executor]`'s own fields.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct RawResources {
@@ -47,6 +48,7 @@ pub(super) struct RawResources {
     pub(super) sbatch_args: Option<Spanned<Vec<String>>>,
 }
 
+/// `[pipeline]`: the project root (relative to the file) and a description.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct RawMeta {
@@ -55,6 +57,7 @@ pub(super) struct RawMeta {
     pub(super) description: Option<String>,
 }
 
+/// `[stages.NAME]`: a command template, its paths, params and sweep.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct RawStage {
@@ -69,6 +72,7 @@ pub(super) struct RawStage {
     pub(super) foreach: Option<Spanned<Vec<BTreeMap<String, toml::Value>>>>,
 }
 
+/// A stage's `inputs` or `outputs`: a list of paths or a table of named paths.
 #[derive(Debug, Deserialize)]
 #[serde(untagged)]
 pub(super) enum Paths {
@@ -77,6 +81,7 @@ pub(super) enum Paths {
 }
 
 impl Paths {
+    /// (name, path) pairs; a list's paths are named `0`, `1`, ...
     pub(super) fn named(&self) -> Vec<(String, String)> {
         match self {
             Paths::List(v) => v
