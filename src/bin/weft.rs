@@ -4,11 +4,12 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use anyhow::{bail, Context};
-use clap::{Parser, Subcommand, ValueEnum};
+use clap::{Args, Parser, Subcommand, ValueEnum};
 
-use weft::pipeline::engine::Outcome;
+use weft::pipeline::engine::Tally;
 use weft::pipeline::gather::{gather, records_table};
-use weft::pipeline::{run, ExecutorKind, Pipeline, RunOptions, Verdict, Workspace};
+use weft::pipeline::show;
+use weft::pipeline::{run, ExecutorKind, Pipeline, RunOptions, Workspace};
 use weft::table::{write_table, Provenance};
 
 #[derive(Parser)]
@@ -32,37 +33,7 @@ struct Cli {
 #[derive(Subcommand)]
 enum Cmd {
     /// Run the stale stages (all, or the named stages and what they need).
-    Run {
-        /// Pipeline file [default: the only file in pipelines/].
-        pipeline: Option<PathBuf>,
-        /// Stages (all instances) or instances to run, with their upstream stages.
-        targets: Vec<String>,
-        /// Parallel stages [default: number of cores] (local executor; Slurm decides for its jobs).
-        #[arg(short, long)]
-        jobs: Option<usize>,
-        /// Where stages run: `local` (children of this process) or `slurm` (one Slurm job
-        /// per stale instance, a job array per sweep stage, resources from the pipeline's
-        /// [executor] table; `weft run` waits for the jobs and Ctrl-C cancels them; the
-        /// project folder must be on a file system the compute nodes share).
-        #[arg(long, value_enum, default_value_t = Exec::Local)]
-        executor: Exec,
-        /// After a failure, keep running stages that do not depend on it.
-        #[arg(short, long)]
-        keep_going: bool,
-        /// Say what would run and why; run nothing (with `--executor slurm`, also print
-        /// the sbatch commands it would submit).
-        #[arg(short = 'n', long)]
-        dry_run: bool,
-        /// Run even if fresh: every selected stage, or the named stage (repeatable).
-        #[arg(long, num_args = 0..=1, default_missing_value = "")]
-        force: Vec<String>,
-        /// Run only the targets, not their upstream stages (their inputs must exist).
-        #[arg(long)]
-        single: bool,
-        /// No progress view or stage lines.
-        #[arg(short, long)]
-        quiet: bool,
-    },
+    Run(RunArgs),
     /// Say for each stage instance whether it is fresh, or why it would run (and its
     /// Slurm job, while one of an interrupted `weft run --executor slurm` is queued or running).
     Status { pipeline: Option<PathBuf> },
@@ -108,6 +79,41 @@ enum Cmd {
     },
 }
 
+// The options of `weft run` (a plain comment: clap would print a doc comment as the
+// subcommand's help).
+#[derive(Args)]
+struct RunArgs {
+    /// Pipeline file [default: the only file in pipelines/].
+    pipeline: Option<PathBuf>,
+    /// Stages (all instances) or instances to run, with their upstream stages.
+    targets: Vec<String>,
+    /// Parallel stages [default: number of cores] (local executor; Slurm decides for its jobs).
+    #[arg(short, long)]
+    jobs: Option<usize>,
+    /// Where stages run: `local` (children of this process) or `slurm` (one Slurm job
+    /// per stale instance, a job array per sweep stage, resources from the pipeline's
+    /// [executor] table; `weft run` waits for the jobs and Ctrl-C cancels them; the
+    /// project folder must be on a file system the compute nodes share).
+    #[arg(long, value_enum, default_value_t = Exec::Local)]
+    executor: Exec,
+    /// After a failure, keep running stages that do not depend on it.
+    #[arg(short, long)]
+    keep_going: bool,
+    /// Say what would run and why; run nothing (with `--executor slurm`, also print
+    /// the sbatch commands it would submit).
+    #[arg(short = 'n', long)]
+    dry_run: bool,
+    /// Run even if fresh: every selected stage, or the named stage (repeatable).
+    #[arg(long, num_args = 0..=1, default_missing_value = "")]
+    force: Vec<String>,
+    /// Run only the targets, not their upstream stages (their inputs must exist).
+    #[arg(long)]
+    single: bool,
+    /// No progress view or stage lines.
+    #[arg(short, long)]
+    quiet: bool,
+}
+
 #[derive(Clone, Copy, ValueEnum)]
 enum Exec {
     Local,
@@ -125,6 +131,7 @@ fn main() -> ExitCode {
     weft::cli::main(main_inner)
 }
 
+/// The pipeline file given, else the only one in `pipelines/`.
 fn find_pipeline(p: Option<PathBuf>) -> anyhow::Result<PathBuf> {
     if let Some(p) = p {
         return Ok(p);
@@ -149,6 +156,7 @@ fn find_pipeline(p: Option<PathBuf>) -> anyhow::Result<PathBuf> {
     }
 }
 
+/// Load and validate the pipeline file given (or the only one in `pipelines/`).
 fn load(p: Option<PathBuf>) -> anyhow::Result<Pipeline> {
     let f = find_pipeline(p)?;
     Ok(Pipeline::load(&f)?)
@@ -157,203 +165,10 @@ fn load(p: Option<PathBuf>) -> anyhow::Result<Pipeline> {
 fn main_inner() -> anyhow::Result<ExitCode> {
     let cli: Cli = weft::cli::parse();
     match cli.cmd {
-        Cmd::Run {
-            pipeline,
-            targets,
-            jobs,
-            keep_going,
-            dry_run,
-            force,
-            single,
-            quiet,
-            executor,
-        } => {
-            let p = load(pipeline)?;
-            let n = p.instances.len();
-            let selected = if targets.is_empty() {
-                vec![true; n]
-            } else {
-                let mut sel = vec![];
-                for t in &targets {
-                    sel.extend(p.select(t)?);
-                }
-                if single {
-                    let mut v = vec![false; n];
-                    for i in sel {
-                        v[i] = true;
-                    }
-                    v
-                } else {
-                    p.with_ancestors(&sel)
-                }
-            };
-            let mut forced = vec![false; n];
-            for f in &force {
-                if f.is_empty() {
-                    forced = selected.clone();
-                } else {
-                    for i in p.select(f)? {
-                        forced[i] = true;
-                    }
-                }
-            }
-            let jobs = jobs.unwrap_or_else(|| {
-                std::thread::available_parallelism()
-                    .map(|n| n.get())
-                    .unwrap_or(1)
-            });
-            let mut ws = Workspace::open(&p);
-            let opts = RunOptions {
-                jobs,
-                keep_going,
-                dry_run,
-                quiet,
-                executor: match executor {
-                    Exec::Local => ExecutorKind::Local,
-                    Exec::Slurm => ExecutorKind::Slurm,
-                },
-            };
-            let rep = run(&p, &mut ws, &selected, &forced, &opts)?;
-            if dry_run {
-                return Ok(ExitCode::SUCCESS);
-            }
-            let ran = rep.ran().len();
-            let fresh = rep
-                .outcomes
-                .iter()
-                .filter(|o| o.1 == Outcome::Fresh)
-                .count();
-            let failed = rep.failed();
-            let skipped = rep
-                .outcomes
-                .iter()
-                .filter(|o| matches!(o.1, Outcome::Skipped | Outcome::NotStarted))
-                .count();
-            if !quiet {
-                eprintln!("weft: {ran} ran, {fresh} fresh, {failed} failed, {skipped} not run");
-            }
-            if failed > 0 {
-                if !keep_going && skipped > 0 {
-                    eprintln!(
-                        "  hint: `--keep-going` runs the stages that do not depend on the failure"
-                    );
-                }
-                return Ok(ExitCode::FAILURE);
-            }
-            Ok(ExitCode::SUCCESS)
-        }
-        Cmd::Status { pipeline } => {
-            let p = load(pipeline)?;
-            let mut ws = Workspace::open(&p);
-            let n = p.instances.len();
-            let plan = ws.plan(&p, &vec![true; n], &vec![false; n])?;
-            ws.cache.save()?;
-            let jobs = match weft::pipeline::slurm::live_jobs(&p) {
-                Ok(j) => j,
-                Err(e) => {
-                    eprintln!("weft: cannot ask Slurm about the jobs of an earlier run: {e}");
-                    Default::default()
-                }
-            };
-            let mut stale = 0;
-            for &i in &p.order {
-                let name = &p.instances[i].name;
-                let job = jobs
-                    .get(name)
-                    .map(|(j, s)| format!(" (Slurm job {j} {s})"))
-                    .unwrap_or_default();
-                match &plan[i] {
-                    Verdict::Fresh => println!("fresh  {name}{job}"),
-                    Verdict::Stale(r) | Verdict::Waiting(r) => {
-                        stale += 1;
-                        println!("stale  {name}: {r}{job}")
-                    }
-                }
-            }
-            eprintln!("weft: {stale} of {n} stage instances would run");
-            Ok(ExitCode::SUCCESS)
-        }
-        Cmd::Dag { pipeline, format } => {
-            let p = load(pipeline)?;
-            let id = |i: usize| format!("n{i}");
-            match format {
-                DagFormat::Text => {
-                    for &i in &p.order {
-                        let inst = &p.instances[i];
-                        let deps: Vec<&str> = inst
-                            .deps
-                            .iter()
-                            .map(|&d| p.instances[d].name.as_str())
-                            .collect();
-                        if deps.is_empty() {
-                            println!("{}", inst.name);
-                        } else {
-                            println!("{} <- {}", inst.name, deps.join(", "));
-                        }
-                    }
-                }
-                DagFormat::Dot => {
-                    println!("digraph weft {{\n  rankdir=LR;\n  node [shape=box];");
-                    for (i, inst) in p.instances.iter().enumerate() {
-                        println!(
-                            "  {} [label=\"{}\"];",
-                            id(i),
-                            inst.name.replace('"', "\\\"")
-                        );
-                    }
-                    for (i, inst) in p.instances.iter().enumerate() {
-                        for &d in &inst.deps {
-                            println!("  {} -> {};", id(d), id(i));
-                        }
-                    }
-                    println!("}}");
-                }
-                DagFormat::Mermaid => {
-                    println!("graph LR");
-                    for (i, inst) in p.instances.iter().enumerate() {
-                        println!("  {}[\"{}\"]", id(i), inst.name.replace('"', "'"));
-                    }
-                    for (i, inst) in p.instances.iter().enumerate() {
-                        for &d in &inst.deps {
-                            println!("  {} --> {}", id(d), id(i));
-                        }
-                    }
-                }
-            }
-            Ok(ExitCode::SUCCESS)
-        }
-        Cmd::Records { pipeline, out } => {
-            let p = load(pipeline)?;
-            let b = records_table(&p);
-            match out {
-                Some(o) => {
-                    let prov = Provenance::new(
-                        "records",
-                        serde_json::json!({ "pipeline": p.file.display().to_string() }),
-                    );
-                    write_table(&o, &b, &prov)
-                        .with_context(|| format!("cannot write `{}`", o.display()))?;
-                    eprintln!("weft: {} records -> {}", b.num_rows(), o.display());
-                }
-                None => {
-                    let store = weft::pipeline::record::RecordStore::new(&p.root, &p.file);
-                    println!("instance\texit_status\tstart\tduration_s\tcommand");
-                    for inst in &p.instances {
-                        if let Some(r) = store.get(&inst.name) {
-                            println!(
-                                "{}\t{}\t{}\t{:.3}\t{}",
-                                r.instance,
-                                r.exit_status,
-                                r.start,
-                                r.end_unix - r.start_unix,
-                                r.command
-                            );
-                        }
-                    }
-                }
-            }
-            Ok(ExitCode::SUCCESS)
-        }
+        Cmd::Run(a) => run_stale(a),
+        Cmd::Status { pipeline } => status(pipeline),
+        Cmd::Dag { pipeline, format } => dag(pipeline, format),
+        Cmd::Records { pipeline, out } => records(pipeline, out),
         Cmd::Job { manifest, task } => {
             let status = weft::pipeline::slurm::run_job(&manifest, task)?;
             Ok(ExitCode::from(status as u8))
@@ -374,4 +189,100 @@ fn main_inner() -> anyhow::Result<ExitCode> {
             Ok(ExitCode::SUCCESS)
         }
     }
+}
+
+/// `weft run`: the selected stale instances, then a closing line of counts.
+fn run_stale(a: RunArgs) -> anyhow::Result<ExitCode> {
+    let p = load(a.pipeline)?;
+    let selected = p.selection(&a.targets, a.single)?;
+    let forced = p.forced(&a.force, &selected)?;
+    let jobs = a.jobs.unwrap_or_else(|| {
+        std::thread::available_parallelism()
+            .map(|n| n.get())
+            .unwrap_or(1)
+    });
+    let mut ws = Workspace::open(&p);
+    let opts = RunOptions {
+        jobs,
+        keep_going: a.keep_going,
+        dry_run: a.dry_run,
+        quiet: a.quiet,
+        executor: match a.executor {
+            Exec::Local => ExecutorKind::Local,
+            Exec::Slurm => ExecutorKind::Slurm,
+        },
+    };
+    let rep = run(&p, &mut ws, &selected, &forced, &opts)?;
+    if a.dry_run {
+        return Ok(ExitCode::SUCCESS);
+    }
+    let Tally {
+        ran,
+        fresh,
+        failed,
+        not_run,
+    } = rep.tally();
+    if !a.quiet {
+        eprintln!("weft: {ran} ran, {fresh} fresh, {failed} failed, {not_run} not run");
+    }
+    if failed > 0 {
+        if !a.keep_going && not_run > 0 {
+            eprintln!("  hint: `--keep-going` runs the stages that do not depend on the failure");
+        }
+        return Ok(ExitCode::FAILURE);
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// `weft status`: fresh or why it would run, for every instance.
+fn status(pipeline: Option<PathBuf>) -> anyhow::Result<ExitCode> {
+    let p = load(pipeline)?;
+    let mut ws = Workspace::open(&p);
+    let n = p.instances.len();
+    let plan = ws.plan(&p, &vec![true; n], &vec![false; n])?;
+    ws.cache.save()?;
+    let jobs = match weft::pipeline::slurm::live_jobs(&p) {
+        Ok(j) => j,
+        Err(e) => {
+            eprintln!("weft: cannot ask Slurm about the jobs of an earlier run: {e}");
+            Default::default()
+        }
+    };
+    let s = show::status(&p, &plan, &jobs);
+    print!("{}", s.text);
+    eprintln!("weft: {} of {n} stage instances would run", s.stale);
+    Ok(ExitCode::SUCCESS)
+}
+
+/// `weft dag`: the stage graph.
+fn dag(pipeline: Option<PathBuf>, format: DagFormat) -> anyhow::Result<ExitCode> {
+    let p = load(pipeline)?;
+    print!(
+        "{}",
+        match format {
+            DagFormat::Text => show::dag_text(&p),
+            DagFormat::Dot => show::dag_dot(&p),
+            DagFormat::Mermaid => show::dag_mermaid(&p),
+        }
+    );
+    Ok(ExitCode::SUCCESS)
+}
+
+/// `weft records`: printed, or written as a Parquet table.
+fn records(pipeline: Option<PathBuf>, out: Option<PathBuf>) -> anyhow::Result<ExitCode> {
+    let p = load(pipeline)?;
+    let b = records_table(&p);
+    match out {
+        Some(o) => {
+            let prov = Provenance::new(
+                "records",
+                serde_json::json!({ "pipeline": p.file.display().to_string() }),
+            );
+            write_table(&o, &b, &prov)
+                .with_context(|| format!("cannot write `{}`", o.display()))?;
+            eprintln!("weft: {} records -> {}", b.num_rows(), o.display());
+        }
+        None => print!("{}", show::records_text(&p)),
+    }
+    Ok(ExitCode::SUCCESS)
 }

@@ -8,7 +8,8 @@ use arrow_array::RecordBatch;
 use serde::Serialize;
 
 use super::{
-    fit, parse_param, ArrivalTerm, Case, Evaluation, FitResult, Method, Objective, Options, Problem,
+    fit, parse_param, ArrivalTerm, Case, Evaluation, FitResult, Method, Objective, Options,
+    Parameter, Problem,
 };
 use crate::analysis::{components, read_series_of, Level};
 use crate::error::{Result, WeftError};
@@ -151,6 +152,40 @@ pub fn budget(c: &Config) -> u64 {
 
 /// Run the stage. `on_eval` sees every evaluation as it completes (progress).
 pub fn run(c: &Config, on_eval: &(dyn Fn(&Evaluation) + Sync)) -> Result<Report> {
+    check_counts(c)?;
+    let comps = compared_components(c)?;
+    let objective = objective(c)?;
+    let read = read_cases(c, &comps, &objective)?;
+    let params = parse_params(c, &read.cases)?;
+    let expected = expected_values(c, &params)?;
+    let problem = Problem {
+        cases: read.cases,
+        params,
+        components: comps,
+        tolerance: c.tolerance,
+        matching: c.matching,
+        static_mode: c.static_mode,
+        objective,
+    };
+    let (result, wall_seconds) = minimise(c, &problem, on_eval)?;
+    let mut prov = Provenance::new("fit", serde_json::to_value(c).expect("config serialises"));
+    for p in &read.inputs {
+        prov = prov.with_input(p)?;
+    }
+    let report = Report {
+        solver_runs: result.evaluations.len() * problem.cases.len(),
+        problem,
+        result,
+        expected,
+        wall_seconds,
+    };
+    write_outputs(c, &report, &prov)?;
+    Ok(report)
+}
+
+/// As many reference models, reference histories and candidate models (and case names,
+/// if any), at least one start and two evaluations.
+fn check_counts(c: &Config) -> Result<()> {
     let n = c.model.len();
     check(
         c.reference_model.len() == n && c.reference_history.len() == n,
@@ -175,7 +210,11 @@ pub fn run(c: &Config, on_eval: &(dyn Fn(&Evaluation) + Sync)) -> Result<Report>
             "--starts {} and --max-evaluations {}: expected at least 1 start and 2 evaluations",
             c.starts, c.max_evaluations
         ),
-    )?;
+    )
+}
+
+/// The displacement components T compares (`--components`).
+fn compared_components(c: &Config) -> Result<Vec<usize>> {
     let comps = components(&c.components)?;
     check(
         comps.iter().all(|&k| k < 3),
@@ -184,7 +223,12 @@ pub fn run(c: &Config, on_eval: &(dyn Fn(&Evaluation) + Sync)) -> Result<Report>
             c.components
         ),
     )?;
-    let objective = match c.objective {
+    Ok(comps)
+}
+
+/// What the fit matches (`--objective`), with its arrival terms, slack and weight checked.
+fn objective(c: &Config) -> Result<Objective> {
+    Ok(match c.objective {
         ObjectiveKind::Displacement => {
             check(
                 c.arrival.is_empty(),
@@ -224,11 +268,23 @@ pub fn run(c: &Config, on_eval: &(dyn Fn(&Evaluation) + Sync)) -> Result<Report>
                 }
             }
         }
-    };
+    })
+}
+
+/// The cases as read, and the files the provenance records as the fit's inputs.
+struct ReadCases {
+    cases: Vec<Case>,
+    /// Each case's reference history, then its candidate model's tables.
+    inputs: Vec<PathBuf>,
+}
+
+/// Read each case: the reference's series of the components the objective needs (the
+/// compared ones, then the arrival terms' others) and the candidate model.
+fn read_cases(c: &Config, comps: &[usize], objective: &Objective) -> Result<ReadCases> {
     let mut cases = vec![];
     let mut prov_inputs: Vec<PathBuf> = vec![];
-    for k in 0..n {
-        let mut needed = comps.clone();
+    for k in 0..c.model.len() {
+        let mut needed = comps.to_vec();
         for a in objective.arrival_terms() {
             if !needed.contains(&a.component) {
                 needed.push(a.component);
@@ -252,7 +308,15 @@ pub fn run(c: &Config, on_eval: &(dyn Fn(&Evaluation) + Sync)) -> Result<Report>
             set: c.candidate_set.clone().unwrap_or_else(|| c.set.clone()),
         });
     }
-    // Parameters are parsed against the first candidate; every case must have the parts.
+    Ok(ReadCases {
+        cases,
+        inputs: prov_inputs,
+    })
+}
+
+/// The fitted parameters, parsed against the first candidate; every case must have the
+/// parts.
+fn parse_params(c: &Config, cases: &[Case]) -> Result<Vec<Parameter>> {
     let params = c
         .params
         .iter()
@@ -263,6 +327,11 @@ pub fn run(c: &Config, on_eval: &(dyn Fn(&Evaluation) + Sync)) -> Result<Report>
             parse_param(s, &case.model).map_err(|e| e.context(format!("case `{}`", case.name)))?;
         }
     }
+    Ok(params)
+}
+
+/// Per parameter, the value `--expected NAME=VALUE` gives it.
+fn expected_values(c: &Config, params: &[Parameter]) -> Result<Vec<Option<f64>>> {
     let mut expected = vec![None; params.len()];
     for e in &c.expected {
         let (name, value) = e.split_once('=').ok_or_else(|| {
@@ -295,15 +364,15 @@ pub fn run(c: &Config, on_eval: &(dyn Fn(&Evaluation) + Sync)) -> Result<Report>
             })?;
         expected[k] = Some(v);
     }
-    let problem = Problem {
-        cases,
-        params,
-        components: comps,
-        tolerance: c.tolerance,
-        matching: c.matching,
-        static_mode: c.static_mode,
-        objective,
-    };
+    Ok(expected)
+}
+
+/// Minimise the objective on `c.threads` worker threads: the result and its wall time [s].
+fn minimise(
+    c: &Config,
+    problem: &Problem,
+    on_eval: &(dyn Fn(&Evaluation) + Sync),
+) -> Result<(FitResult, f64)> {
     let opts = Options {
         method: c.method,
         starts: c.starts,
@@ -320,43 +389,28 @@ pub fn run(c: &Config, on_eval: &(dyn Fn(&Evaluation) + Sync)) -> Result<Report>
 
     let t0 = Instant::now();
     let result = pool
-        .install(|| fit(&problem, &opts, on_eval))
+        .install(|| fit(problem, &opts, on_eval))
         .map_err(|e| e.context("the fit failed; nothing was written"))?;
-    let wall_seconds = t0.elapsed().as_secs_f64();
+    Ok((result, t0.elapsed().as_secs_f64()))
+}
 
-    let mut prov = Provenance::new("fit", serde_json::to_value(c).expect("config serialises"));
-    for p in &prov_inputs {
-        prov = prov.with_input(p)?;
-    }
-    let report = Report {
-        solver_runs: result.evaluations.len() * problem.cases.len(),
-        problem,
-        result,
-        expected,
-        wall_seconds,
-    };
-    write_table(
-        &c.out.join("fit_trace.parquet"),
-        &trace_table(&report),
-        &prov,
-    )?;
+/// Write `fit_trace.parquet`, `fit_result.parquet`, `fit_row.parquet` and the fitted
+/// model of each case under `models/CASE`.
+fn write_outputs(c: &Config, report: &Report, prov: &Provenance) -> Result<()> {
+    write_table(&c.out.join("fit_trace.parquet"), &trace_table(report), prov)?;
     write_table(
         &c.out.join("fit_result.parquet"),
-        &result_table(&report, c),
-        &prov,
+        &result_table(report, c),
+        prov,
     )?;
-    write_table(
-        &c.out.join("fit_row.parquet"),
-        &row_table(&report, c),
-        &prov,
-    )?;
+    write_table(&c.out.join("fit_row.parquet"), &row_table(report, c), prov)?;
     for (k, case) in report.problem.cases.iter().enumerate() {
         let m = report.problem.model_at(k, &report.result.x);
         let dir = c.out.join("models").join(&case.name);
-        write_model(&m, &dir, &prov)
+        write_model(&m, &dir, prov)
             .map_err(|e| e.context(format!("cannot write the fitted model `{}`", dir.display())))?;
     }
-    Ok(report)
+    Ok(())
 }
 
 /// Case `k`'s name: as given, else its candidate folder's name (numbered when two

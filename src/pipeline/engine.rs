@@ -1,11 +1,8 @@
-//! Deciding what is stale (and why), and running it.
-//!
-//! An instance reruns when it never ran or its last run failed, a param it uses or its
-//! command changed, its binary changed, an input's content changed, or an output is
-//! missing or was changed since the run. Before its upstream instances have run, an
-//! instance downstream of a stale one is reported as waiting on it; when the upstream
-//! has run, the instance is judged again on the new content of its inputs, so an
-//! upstream rerun that reproduces the same bytes reruns nothing below it.
+//! Running what is stale: `weft run`'s scheduling loop, the project lock and the run's
+//! report. What is stale, and why, is judged in [`super::workspace`]; an instance
+//! waiting on a stale upstream one is judged again here when the upstream has run, on the
+//! new content of its inputs, so an upstream rerun that reproduces the same bytes reruns
+//! nothing below it.
 //!
 //! Execution: the scheduling loop here hands ready instances to an executor
 //! (`super::exec`): the local one runs them in parallel (`-j`) as children of `weft`,
@@ -18,243 +15,14 @@
 
 use std::collections::BTreeMap;
 use std::io::Write;
-use std::path::{Path, PathBuf};
-
-use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
+use std::path::Path;
 
 use super::exec::{log_tail, Event, Executor, Finish, Launch, LocalExecutor};
-use super::hash::HashCache;
-use super::record::RecordStore;
+use super::progress::View;
 use super::slurm::SlurmExecutor;
-use super::spec::{shell_quote, Instance, Pipeline};
+use super::spec::{shell_quote, Pipeline};
+pub use super::workspace::{Verdict, Workspace};
 use crate::error::{Result, WeftError};
-
-/// Why an instance must run, or that it need not.
-#[derive(Debug, Clone, PartialEq)]
-pub enum Verdict {
-    Fresh,
-    Stale(String),
-    /// Stale because an upstream instance will run first.
-    Waiting(String),
-}
-
-impl Verdict {
-    pub fn is_fresh(&self) -> bool {
-        matches!(self, Verdict::Fresh)
-    }
-}
-
-/// Where the engine keeps its state for a pipeline.
-pub struct Workspace {
-    pub root: PathBuf,
-    pub records: RecordStore,
-    pub logs: PathBuf,
-    pub cache: HashCache,
-    /// Directory of the running `weft` binary: stage binaries are looked up there first.
-    pub exe_dir: Option<PathBuf>,
-    /// Resolved executables by command word.
-    bin_memo: std::cell::RefCell<std::collections::HashMap<String, Option<PathBuf>>>,
-}
-
-impl Workspace {
-    pub fn open(p: &Pipeline) -> Workspace {
-        let dot = p.root.join(".weft");
-        let _ = std::fs::create_dir_all(&dot);
-        let gi = dot.join(".gitignore");
-        if !gi.exists() {
-            let _ = std::fs::write(
-                &gi,
-                "# records/ is meant to be committed; the rest is local\nlogs/\ncache/\njobs/\nlock\n",
-            );
-        } else if let Ok(s) = std::fs::read_to_string(&gi) {
-            // Projects from before the Slurm executor: its job files are local too.
-            if !s.lines().any(|l| l.trim() == "jobs/") {
-                let _ = std::fs::write(
-                    &gi,
-                    format!(
-                        "{}jobs/\n",
-                        if s.ends_with('\n') || s.is_empty() {
-                            s
-                        } else {
-                            s + "\n"
-                        }
-                    ),
-                );
-            }
-        }
-        let stem = p
-            .file
-            .file_stem()
-            .map(|s| s.to_string_lossy().to_string())
-            .unwrap_or_default();
-        Workspace {
-            root: p.root.clone(),
-            records: RecordStore::new(&p.root, &p.file),
-            logs: dot.join("logs").join(stem),
-            cache: HashCache::load(&dot.join("cache").join("hashes.tsv")),
-            exe_dir: std::env::current_exe()
-                .ok()
-                .and_then(|e| e.parent().map(Path::to_path_buf)),
-            bin_memo: Default::default(),
-        }
-    }
-
-    /// The executable a command starts with, resolved like the shell would (the
-    /// directory of `weft` first, then PATH).
-    pub fn binary_of(&self, command: &str) -> Option<PathBuf> {
-        let first = command
-            .split_whitespace()
-            .next()?
-            .trim_matches(|c| c == '\'' || c == '"');
-        if let Some(hit) = self.bin_memo.borrow().get(first) {
-            return hit.clone();
-        }
-        let found = self.resolve(first);
-        self.bin_memo
-            .borrow_mut()
-            .insert(first.to_string(), found.clone());
-        found
-    }
-
-    fn resolve(&self, first: &str) -> Option<PathBuf> {
-        if first.contains('/') {
-            let p = self.root.join(first);
-            return p.is_file().then_some(p);
-        }
-        let path = std::env::var_os("PATH").unwrap_or_default();
-        self.exe_dir
-            .iter()
-            .cloned()
-            .chain(std::env::split_paths(&path))
-            .map(|d| d.join(first))
-            .find(|p| p.is_file())
-    }
-
-    pub fn abs(&self, p: &Path) -> PathBuf {
-        if p.is_absolute() {
-            p.to_path_buf()
-        } else {
-            self.root.join(p)
-        }
-    }
-
-    /// Judge one instance against its record, on the current content of its inputs.
-    pub fn verdict(&mut self, inst: &Instance) -> Result<Verdict> {
-        let Some(rec) = self.records.get(&inst.name) else {
-            return Ok(Verdict::Stale("never run".into()));
-        };
-        if rec.exit_status != 0 {
-            return Ok(Verdict::Stale(format!(
-                "last run failed (exit status {})",
-                rec.exit_status
-            )));
-        }
-        for (k, v) in &inst.params {
-            match rec.params.get(k) {
-                Some(old) if old != v => {
-                    return Ok(Verdict::Stale(format!("param `{k}` {old} → {v}")))
-                }
-                None => return Ok(Verdict::Stale(format!("param `{k}` added ({v})"))),
-                _ => {}
-            }
-        }
-        if let Some(k) = rec.params.keys().find(|k| !inst.params.contains_key(*k)) {
-            return Ok(Verdict::Stale(format!("param `{k}` no longer used")));
-        }
-        if rec.command != inst.command {
-            return Ok(Verdict::Stale("command changed".into()));
-        }
-        let bin = self.binary_of(&inst.command);
-        let bin_hash = match &bin {
-            Some(b) => Some(self.cache.file(b)?),
-            None => None,
-        };
-        if bin_hash != rec.binary_hash {
-            let name = inst
-                .command
-                .split_whitespace()
-                .next()
-                .unwrap_or("")
-                .to_string();
-            return Ok(Verdict::Stale(match bin {
-                None => format!("binary `{name}` not found"),
-                Some(_) => format!("binary `{name}` changed"),
-            }));
-        }
-        for (_, p) in &inst.inputs {
-            let key = p.display().to_string();
-            let h = self.cache.path(&self.abs(p))?;
-            match (h, rec.inputs.get(&key)) {
-                (None, _) => return Ok(Verdict::Stale(format!("input `{key}` missing"))),
-                (Some(h), Some(old)) if &h.hash == old => {}
-                (Some(h), Some(_)) => {
-                    // Name the file inside a folder input that changed, when known.
-                    let changed = h
-                        .files
-                        .iter()
-                        .find(|(f, fh)| rec.input_files.get(&format!("{key}/{f}")) != Some(*fh));
-                    let removed = rec
-                        .input_files
-                        .keys()
-                        .filter_map(|f| f.strip_prefix(&format!("{key}/")))
-                        .find(|f| !h.files.contains_key(*f));
-                    return Ok(Verdict::Stale(match (changed, removed) {
-                        (Some((f, _)), _) => format!("input `{key}/{f}` changed"),
-                        (None, Some(f)) => format!("input `{key}/{f}` removed"),
-                        _ => format!("input `{key}` changed"),
-                    }));
-                }
-                (Some(_), None) => return Ok(Verdict::Stale(format!("input `{key}` added"))),
-            }
-        }
-        for (_, p) in &inst.outputs {
-            let key = p.display().to_string();
-            match (self.cache.path(&self.abs(p))?, rec.outputs.get(&key)) {
-                (None, _) => return Ok(Verdict::Stale(format!("output `{key}` missing"))),
-                (Some(h), Some(old)) if &h.hash == old => {}
-                _ => {
-                    return Ok(Verdict::Stale(format!(
-                        "output `{key}` changed since it was written"
-                    )))
-                }
-            }
-        }
-        Ok(Verdict::Fresh)
-    }
-
-    /// Verdicts for all selected instances, in topological order, without running.
-    pub fn plan(
-        &mut self,
-        p: &Pipeline,
-        selected: &[bool],
-        force: &[bool],
-    ) -> Result<Vec<Verdict>> {
-        let mut v = vec![Verdict::Fresh; p.instances.len()];
-        for &i in &p.order {
-            if !selected[i] {
-                continue;
-            }
-            let inst = &p.instances[i];
-            v[i] = if force[i] {
-                Verdict::Stale("forced".into())
-            } else {
-                match self.verdict(inst)? {
-                    Verdict::Fresh => {
-                        match inst.deps.iter().find(|&&d| selected[d] && !v[d].is_fresh()) {
-                            Some(&d) => Verdict::Waiting(format!(
-                                "upstream `{}` reruns",
-                                p.instances[d].name
-                            )),
-                            None => Verdict::Fresh,
-                        }
-                    }
-                    s => s,
-                }
-            };
-        }
-        Ok(v)
-    }
-}
 
 /// Options of `weft run`.
 #[derive(Debug, Clone)]
@@ -292,11 +60,40 @@ pub enum Outcome {
     NotStarted,
 }
 
+/// Each selected instance's outcome, in a dependency order.
 pub struct RunReport {
     pub outcomes: Vec<(String, Outcome)>,
 }
 
+/// How many instances of a run ran, were fresh, failed, or were not run.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Tally {
+    pub ran: usize,
+    pub fresh: usize,
+    pub failed: usize,
+    /// Skipped after an upstream failure, or not started after a failure.
+    pub not_run: usize,
+}
+
 impl RunReport {
+    /// The counts `weft run` ends with.
+    pub fn tally(&self) -> Tally {
+        Tally {
+            ran: self.ran().len(),
+            fresh: self
+                .outcomes
+                .iter()
+                .filter(|o| o.1 == Outcome::Fresh)
+                .count(),
+            failed: self.failed(),
+            not_run: self
+                .outcomes
+                .iter()
+                .filter(|o| matches!(o.1, Outcome::Skipped | Outcome::NotStarted))
+                .count(),
+        }
+    }
+
     pub fn ran(&self) -> Vec<&str> {
         self.outcomes
             .iter()
@@ -361,62 +158,93 @@ pub fn run(
 ) -> Result<RunReport> {
     let plan = ws.plan(p, selected, force)?;
     if o.dry_run {
-        let mut outcomes = vec![];
-        for &i in &p.order {
-            if selected[i] {
-                let inst = &p.instances[i];
-                match &plan[i] {
-                    Verdict::Fresh => println!("fresh      {}", inst.name),
-                    Verdict::Stale(r) | Verdict::Waiting(r) => {
-                        println!("would run  {}: {r}", inst.name)
-                    }
-                }
-                outcomes.push((inst.name.clone(), Outcome::Fresh));
-            }
-        }
-        if o.executor == ExecutorKind::Slurm && plan.iter().any(|v| !v.is_fresh()) {
-            println!("\n# the sbatch commands `weft run --executor slurm` would submit:");
-            let mut ex = SlurmExecutor::new(p, true)?;
-            let quiet = RunOptions {
-                quiet: true,
-                ..o.clone()
-            };
-            schedule(p, ws, selected, force, &plan, &quiet, &mut ex, vec![])?;
-        }
-        ws.cache.save()?;
-        return Ok(RunReport { outcomes });
+        return dry_run(p, ws, selected, force, &plan, o);
     }
     let _lock = lock(&p.root)?;
     match o.executor {
         ExecutorKind::Local => {
-            let live = super::slurm::live_jobs(p).unwrap_or_default();
-            if let Some((inst, (job, state))) = live.iter().next() {
-                return Err(WeftError::input(format!(
-                    "{} Slurm jobs of an earlier `weft run --executor slurm` are still queued or running (`{inst}`: job {job}, {state})",
-                    live.len()
-                ))
-                .in_file(&p.file)
-                .hint("running them here too would race them; `weft run --executor slurm` waits for them, or cancel them with scancel"));
-            }
+            refuse_live_slurm_jobs(p)?;
             let mut ex = LocalExecutor::new(ws);
             schedule(p, ws, selected, force, &plan, o, &mut ex, vec![])
         }
-        ExecutorKind::Slurm => {
-            let mut ex = SlurmExecutor::new(p, false)?;
-            let adopted = ex.adopt(p, selected, force, &plan)?;
-            if ex.cancelled_at_start > 0 && !o.quiet {
-                eprintln!(
-                    "cancel {} Slurm jobs of an earlier `weft run` (their work changed, they were forced, something they need is stale again, or the run died before noting them)",
-                    ex.cancelled_at_start
-                );
+        ExecutorKind::Slurm => run_on_slurm(p, ws, selected, force, &plan, o),
+    }
+}
+
+/// `--dry-run`: say what would run and why (with `--executor slurm`, print the sbatch
+/// commands too); run nothing.
+fn dry_run(
+    p: &Pipeline,
+    ws: &mut Workspace,
+    selected: &[bool],
+    force: &[bool],
+    plan: &[Verdict],
+    o: &RunOptions,
+) -> Result<RunReport> {
+    let mut outcomes = vec![];
+    for &i in &p.order {
+        if selected[i] {
+            let inst = &p.instances[i];
+            match &plan[i] {
+                Verdict::Fresh => println!("fresh      {}", inst.name),
+                Verdict::Stale(r) | Verdict::Waiting(r) => {
+                    println!("would run  {}: {r}", inst.name)
+                }
             }
-            let r = schedule(p, ws, selected, force, &plan, o, &mut ex, adopted);
-            if r.is_err() {
-                ex.cancel_all();
-            }
-            r
+            outcomes.push((inst.name.clone(), Outcome::Fresh));
         }
     }
+    if o.executor == ExecutorKind::Slurm && plan.iter().any(|v| !v.is_fresh()) {
+        println!("\n# the sbatch commands `weft run --executor slurm` would submit:");
+        let mut ex = SlurmExecutor::new(p, true)?;
+        let quiet = RunOptions {
+            quiet: true,
+            ..o.clone()
+        };
+        schedule(p, ws, selected, force, plan, &quiet, &mut ex, vec![])?;
+    }
+    ws.cache.save()?;
+    Ok(RunReport { outcomes })
+}
+
+/// A local run refuses to start while Slurm jobs of an earlier run are live: it would
+/// race them.
+fn refuse_live_slurm_jobs(p: &Pipeline) -> Result<()> {
+    let live = super::slurm::live_jobs(p).unwrap_or_default();
+    if let Some((inst, (job, state))) = live.iter().next() {
+        return Err(WeftError::input(format!(
+            "{} Slurm jobs of an earlier `weft run --executor slurm` are still queued or running (`{inst}`: job {job}, {state})",
+            live.len()
+        ))
+        .in_file(&p.file)
+        .hint("running them here too would race them; `weft run --executor slurm` waits for them, or cancel them with scancel"));
+    }
+    Ok(())
+}
+
+/// `--executor slurm`: adopt the live jobs of an earlier run, submit the rest, wait; on
+/// an error, cancel the jobs of this run.
+fn run_on_slurm(
+    p: &Pipeline,
+    ws: &mut Workspace,
+    selected: &[bool],
+    force: &[bool],
+    plan: &[Verdict],
+    o: &RunOptions,
+) -> Result<RunReport> {
+    let mut ex = SlurmExecutor::new(p, false)?;
+    let adopted = ex.adopt(p, selected, force, plan)?;
+    if ex.cancelled_at_start > 0 && !o.quiet {
+        eprintln!(
+            "cancel {} Slurm jobs of an earlier `weft run` (their work changed, they were forced, something they need is stale again, or the run died before noting them)",
+            ex.cancelled_at_start
+        );
+    }
+    let r = schedule(p, ws, selected, force, plan, o, &mut ex, adopted);
+    if r.is_err() {
+        ex.cancel_all();
+    }
+    r
 }
 
 /// The scheduling loop, the same for every executor: hand over each instance when it is
@@ -434,233 +262,288 @@ fn schedule(
     ex: &mut dyn Executor,
     adopted: Vec<(usize, String, String)>,
 ) -> Result<RunReport> {
-    let n = p.instances.len();
-    let stale_count = (0..n)
-        .filter(|&i| selected[i] && !plan[i].is_fresh())
-        .count();
-    let mp = MultiProgress::with_draw_target(if o.quiet {
-        ProgressDrawTarget::hidden()
-    } else {
-        ProgressDrawTarget::stderr()
-    });
-    let attended = !o.quiet && !mp.is_hidden();
-    let main = mp.add(ProgressBar::new(stale_count as u64));
-    main.set_style(
-        ProgressStyle::with_template(
-            "{spinner} stages [{bar:30}] {pos}/{len} {elapsed_precise} {msg}",
-        )
-        .expect("template"),
-    );
-    if !ex.dry() {
-        main.enable_steady_tick(std::time::Duration::from_millis(250));
-    }
-    let say = |s: String| {
-        if attended {
-            let _ = mp.println(s);
-        } else if !o.quiet {
-            eprintln!("{s}");
-        }
-    };
-    #[derive(Clone, Copy, PartialEq)]
-    enum St {
-        Pending,
-        Running,
-        Ok,
-        Failed,
-        Skipped,
-    }
-    let mut st = vec![St::Pending; n];
-    let mut outcome: BTreeMap<usize, Outcome> = BTreeMap::new();
-    let mut running = 0usize;
-    let mut stop = false;
-    let mut bars: BTreeMap<usize, ProgressBar> = BTreeMap::new();
-    for (i, job, state) in adopted {
-        st[i] = St::Running;
-        running += 1;
-        say(format!(
-            "adopt {}: Slurm job {job} ({state}) of an earlier `weft run`",
-            p.instances[i].name
-        ));
-    }
+    let mut s = Schedule::new(p, selected, force, plan, o, ex.dry());
+    s.adopt(adopted);
     loop {
         // Hand over every ready instance; those it needs must be done or, for an eager
         // executor, handed over in an earlier pass (so that they have a job to wait on).
-        let mut progressed = false;
-        let mut batch: Vec<Launch> = vec![];
-        let mut this_pass = vec![false; n];
-        for &i in &p.order {
-            if !selected[i] || st[i] != St::Pending {
-                continue;
-            }
-            let inst = &p.instances[i];
-            let deps = || inst.deps.iter().copied().filter(|&d| selected[d]);
-            if deps().any(|d| matches!(st[d], St::Failed | St::Skipped)) {
-                st[i] = St::Skipped;
-                outcome.insert(i, Outcome::Skipped);
-                say(format!("skip  {} (an upstream stage failed)", inst.name));
-                progressed = true;
-                continue;
-            }
-            if deps().any(|d| st[d] == St::Pending || this_pass[d]) {
-                continue;
-            }
-            let waiting_on: Vec<usize> = deps().filter(|&d| st[d] == St::Running).collect();
-            if stop || (!waiting_on.is_empty() && !ex.eager()) {
-                continue;
-            }
-            if !ex.eager() && running + batch.len() >= o.jobs.max(1) {
-                continue;
-            }
-            let reason = if force[i] {
-                "forced".to_string()
-            } else if !waiting_on.is_empty() {
-                match &plan[i] {
-                    Verdict::Stale(r) | Verdict::Waiting(r) => r.clone(),
-                    Verdict::Fresh => "upstream reruns".into(),
-                }
-            } else {
-                match ws.verdict(inst)? {
-                    Verdict::Fresh => {
-                        st[i] = St::Ok;
-                        outcome.insert(i, Outcome::Fresh);
-                        progressed = true;
-                        continue;
-                    }
-                    Verdict::Stale(r) | Verdict::Waiting(r) => r,
-                }
-            };
-            if ws.binary_of(&inst.command).is_none() {
-                let name = inst.command.split_whitespace().next().unwrap_or("");
-                return Err(WeftError::input(format!(
-                    "stage `{}`: command `{name}` not found",
-                    inst.name
-                ))
-                .in_file(&p.file)
-                .at_line(inst.line)
-                .at_key(format!("stages.{}.cmd", inst.stage))
-                .hint(
-                    "build the weft binaries (`cargo build --release`) or put the tool on PATH",
-                ));
-            }
-            st[i] = St::Running;
-            this_pass[i] = true;
-            batch.push(Launch {
-                idx: i,
-                reason,
-                force: force[i],
-                waiting_on,
-            });
-        }
+        let (batch, mut progressed) = s.ready(ws, &*ex)?;
         if !batch.is_empty() {
-            running += batch.len();
-            ex.launch(p, ws, batch, &say)?;
+            s.running += batch.len();
+            ex.launch(p, ws, batch, &|m| s.view.say(m))?;
             progressed = true;
         }
         if progressed {
             continue;
         }
-        if running == 0 || ex.dry() {
+        if s.running == 0 || ex.dry() {
             break;
         }
         for ev in ex.wait(p, ws)? {
-            match ev {
-                Event::Started(i) => {
-                    let bar = mp.insert_before(&main, ProgressBar::new(1000));
-                    bar.set_style(
-                        ProgressStyle::with_template(
-                            "  {spinner} {msg:40!} [{bar:20}] {percent:>3}% {elapsed}",
-                        )
-                        .expect("template"),
-                    );
-                    bar.set_message(p.instances[i].name.clone());
-                    bar.enable_steady_tick(std::time::Duration::from_millis(200));
-                    bars.insert(i, bar);
-                }
-                Event::Note(s) => say(s),
-                Event::Progress(i, f) => {
-                    if let Some(b) = bars.get(&i) {
-                        b.set_position((f.clamp(0.0, 1.0) * 1000.0) as u64);
-                    }
-                }
-                Event::Done(i, fin) => {
-                    running -= 1;
-                    main.inc(1);
-                    if let Some(b) = bars.remove(&i) {
-                        b.finish_and_clear();
-                        mp.remove(&b);
-                    }
-                    let inst = &p.instances[i];
-                    match fin {
-                        Finish::Ran { seconds } => {
-                            st[i] = St::Ok;
-                            outcome.insert(i, Outcome::Ran { seconds });
-                            say(format!("done  {} ({seconds:.2} s)", inst.name));
-                        }
-                        Finish::Fresh => {
-                            st[i] = St::Ok;
-                            outcome.insert(i, Outcome::Fresh);
-                            say(format!(
-                                "fresh {} (its upstream reproduced the same inputs)",
-                                inst.name
-                            ));
-                        }
-                        Finish::Lost { why, .. }
-                            if inst.deps.iter().any(|&d| {
-                                selected[d] && matches!(st[d], St::Failed | St::Skipped)
-                            }) =>
-                        {
-                            st[i] = St::Skipped;
-                            outcome.insert(i, Outcome::Skipped);
-                            say(format!(
-                                "skip  {} (an upstream stage failed; {why})",
-                                inst.name
-                            ));
-                        }
-                        Finish::Lost { .. } if stop => {
-                            st[i] = St::Skipped;
-                            outcome.insert(i, Outcome::NotStarted);
-                        }
-                        Finish::Lost { why, more } => {
-                            st[i] = St::Failed;
-                            outcome.insert(i, Outcome::Failed { status: 1 });
-                            say(format!("FAIL  {} ({why}); {more}", inst.name));
-                            if !o.keep_going && !stop {
-                                stop = true;
-                                ex.stop_pending(&say)?;
-                            }
-                        }
-                        Finish::Failed { status, why, log } => {
-                            st[i] = St::Failed;
-                            outcome.insert(i, Outcome::Failed { status });
-                            let tail = log_tail(&ws.root.join(&log), 6);
-                            say(format!(
-                                "FAIL  {} (exit status {status}{}); log: {log}{tail}",
-                                inst.name,
-                                why.map(|w| format!(": {w}")).unwrap_or_default()
-                            ));
-                            if !o.keep_going && !stop {
-                                stop = true;
-                                ex.stop_pending(&say)?;
-                            }
-                        }
-                    }
-                }
-            }
+            s.on_event(ev, ws, ex)?;
         }
     }
-    main.finish_and_clear();
+    s.view.finish();
     ex.close(ws)?;
     ws.cache.save()?;
-    let mut outcomes = vec![];
-    for &i in &p.order {
-        if selected[i] {
-            outcomes.push((
-                p.instances[i].name.clone(),
-                outcome.get(&i).cloned().unwrap_or(Outcome::NotStarted),
+    Ok(s.report())
+}
+
+/// Where a selected instance stands in the scheduling loop.
+#[derive(Clone, Copy, PartialEq)]
+enum State {
+    Pending,
+    Running,
+    Ok,
+    Failed,
+    Skipped,
+}
+
+/// The scheduling loop's state: what the run was asked (the selected and the forced
+/// instances, the plan, the options), where each instance stands, and the progress view.
+struct Schedule<'a> {
+    p: &'a Pipeline,
+    selected: &'a [bool],
+    force: &'a [bool],
+    plan: &'a [Verdict],
+    o: &'a RunOptions,
+    st: Vec<State>,
+    outcome: BTreeMap<usize, Outcome>,
+    /// Instances handed over and not done yet.
+    running: usize,
+    /// A failure stopped the run (without `--keep-going`): nothing new starts.
+    stop: bool,
+    view: View,
+}
+
+impl<'a> Schedule<'a> {
+    fn new(
+        p: &'a Pipeline,
+        selected: &'a [bool],
+        force: &'a [bool],
+        plan: &'a [Verdict],
+        o: &'a RunOptions,
+        dry: bool,
+    ) -> Schedule<'a> {
+        let n = p.instances.len();
+        let stale_count = (0..n)
+            .filter(|&i| selected[i] && !plan[i].is_fresh())
+            .count();
+        Schedule {
+            p,
+            selected,
+            force,
+            plan,
+            o,
+            st: vec![State::Pending; n],
+            outcome: BTreeMap::new(),
+            running: 0,
+            stop: false,
+            view: View::new(o.quiet, stale_count as u64, !dry),
+        }
+    }
+
+    /// The live jobs of an earlier run that the executor took over: running already.
+    fn adopt(&mut self, adopted: Vec<(usize, String, String)>) {
+        for (i, job, state) in adopted {
+            self.st[i] = State::Running;
+            self.running += 1;
+            self.view.say(format!(
+                "adopt {}: Slurm job {job} ({state}) of an earlier `weft run`",
+                self.p.instances[i].name
             ));
         }
     }
-    Ok(RunReport { outcomes })
+
+    /// Instance `i` is over: where it stands, and its outcome.
+    fn settle(&mut self, i: usize, state: State, outcome: Outcome) {
+        self.st[i] = state;
+        self.outcome.insert(i, outcome);
+    }
+
+    /// Whether a selected upstream instance of `i` failed or was skipped.
+    fn upstream_failed(&self, i: usize) -> bool {
+        self.p.instances[i]
+            .deps
+            .iter()
+            .any(|&d| self.selected[d] && matches!(self.st[d], State::Failed | State::Skipped))
+    }
+
+    /// One pass over the instances in order: skip those a failure cut off, settle those
+    /// judged fresh now, and return those ready to hand over, with whether anything
+    /// changed.
+    fn ready(&mut self, ws: &mut Workspace, ex: &dyn Executor) -> Result<(Vec<Launch>, bool)> {
+        let (p, selected) = (self.p, self.selected);
+        let mut progressed = false;
+        let mut batch: Vec<Launch> = vec![];
+        let mut this_pass = vec![false; p.instances.len()];
+        for &i in &p.order {
+            if !selected[i] || self.st[i] != State::Pending {
+                continue;
+            }
+            let inst = &p.instances[i];
+            let deps = || inst.deps.iter().copied().filter(|&d| selected[d]);
+            if self.upstream_failed(i) {
+                self.settle(i, State::Skipped, Outcome::Skipped);
+                self.view
+                    .say(format!("skip  {} (an upstream stage failed)", inst.name));
+                progressed = true;
+                continue;
+            }
+            if deps().any(|d| self.st[d] == State::Pending || this_pass[d]) {
+                continue;
+            }
+            let waiting_on: Vec<usize> = deps().filter(|&d| self.st[d] == State::Running).collect();
+            if self.stop || (!waiting_on.is_empty() && !ex.eager()) {
+                continue;
+            }
+            if !ex.eager() && self.running + batch.len() >= self.o.jobs.max(1) {
+                continue;
+            }
+            let Some(reason) = self.reason(i, &waiting_on, ws)? else {
+                self.settle(i, State::Ok, Outcome::Fresh);
+                progressed = true;
+                continue;
+            };
+            check_command(p, ws, i)?;
+            self.st[i] = State::Running;
+            this_pass[i] = true;
+            batch.push(Launch {
+                idx: i,
+                reason,
+                force: self.force[i],
+                waiting_on,
+            });
+        }
+        Ok((batch, progressed))
+    }
+
+    /// Why instance `i` runs now (`waiting_on`: the upstream instances it waits on);
+    /// `None` when, its upstream done, it is fresh on the current content of its inputs.
+    fn reason(&self, i: usize, waiting_on: &[usize], ws: &mut Workspace) -> Result<Option<String>> {
+        Ok(Some(if self.force[i] {
+            "forced".to_string()
+        } else if !waiting_on.is_empty() {
+            match &self.plan[i] {
+                Verdict::Stale(r) | Verdict::Waiting(r) => r.clone(),
+                Verdict::Fresh => "upstream reruns".into(),
+            }
+        } else {
+            match ws.verdict(&self.p.instances[i])? {
+                Verdict::Fresh => return Ok(None),
+                Verdict::Stale(r) | Verdict::Waiting(r) => r,
+            }
+        }))
+    }
+
+    /// What an executor reports: the progress view follows it, a done instance settles.
+    fn on_event(&mut self, ev: Event, ws: &Workspace, ex: &mut dyn Executor) -> Result<()> {
+        match ev {
+            Event::Started(i) => self.view.started(i, &self.p.instances[i].name),
+            Event::Note(s) => self.view.say(s),
+            Event::Progress(i, f) => self.view.progress(i, f),
+            Event::Done(i, fin) => {
+                self.running -= 1;
+                self.view.done(i);
+                self.on_done(i, fin, ws, ex)?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Settle a finished instance: ran, fresh after all, skipped (its job lost after an
+    /// upstream failure or a stop) or failed (which stops the run without `--keep-going`).
+    fn on_done(
+        &mut self,
+        i: usize,
+        fin: Finish,
+        ws: &Workspace,
+        ex: &mut dyn Executor,
+    ) -> Result<()> {
+        let p = self.p;
+        let inst = &p.instances[i];
+        match fin {
+            Finish::Ran { seconds } => {
+                self.settle(i, State::Ok, Outcome::Ran { seconds });
+                self.view
+                    .say(format!("done  {} ({seconds:.2} s)", inst.name));
+            }
+            Finish::Fresh => {
+                self.settle(i, State::Ok, Outcome::Fresh);
+                self.view.say(format!(
+                    "fresh {} (its upstream reproduced the same inputs)",
+                    inst.name
+                ));
+            }
+            Finish::Lost { why, .. } if self.upstream_failed(i) => {
+                self.settle(i, State::Skipped, Outcome::Skipped);
+                self.view.say(format!(
+                    "skip  {} (an upstream stage failed; {why})",
+                    inst.name
+                ));
+            }
+            Finish::Lost { .. } if self.stop => {
+                self.settle(i, State::Skipped, Outcome::NotStarted);
+            }
+            Finish::Lost { why, more } => {
+                self.settle(i, State::Failed, Outcome::Failed { status: 1 });
+                self.view
+                    .say(format!("FAIL  {} ({why}); {more}", inst.name));
+                self.stop_after_failure(ex)?;
+            }
+            Finish::Failed { status, why, log } => {
+                self.settle(i, State::Failed, Outcome::Failed { status });
+                let tail = log_tail(&ws.root.join(&log), 6);
+                self.view.say(format!(
+                    "FAIL  {} (exit status {status}{}); log: {log}{tail}",
+                    inst.name,
+                    why.map(|w| format!(": {w}")).unwrap_or_default()
+                ));
+                self.stop_after_failure(ex)?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Without `--keep-going`, the first failure stops the run: nothing new starts.
+    fn stop_after_failure(&mut self, ex: &mut dyn Executor) -> Result<()> {
+        if !self.o.keep_going && !self.stop {
+            self.stop = true;
+            ex.stop_pending(&|s| self.view.say(s))?;
+        }
+        Ok(())
+    }
+
+    /// Each selected instance's outcome, in order; not started when it has none.
+    fn report(&self) -> RunReport {
+        let mut outcomes = vec![];
+        for &i in &self.p.order {
+            if self.selected[i] {
+                outcomes.push((
+                    self.p.instances[i].name.clone(),
+                    self.outcome.get(&i).cloned().unwrap_or(Outcome::NotStarted),
+                ));
+            }
+        }
+        RunReport { outcomes }
+    }
+}
+
+/// A stage whose command's program is found neither beside `weft` nor on PATH is an
+/// error of the pipeline, not a failure of the stage.
+fn check_command(p: &Pipeline, ws: &Workspace, i: usize) -> Result<()> {
+    let inst = &p.instances[i];
+    if ws.binary_of(&inst.command).is_none() {
+        let name = inst.command.split_whitespace().next().unwrap_or("");
+        return Err(
+            WeftError::input(format!("stage `{}`: command `{name}` not found", inst.name))
+                .in_file(&p.file)
+                .at_line(inst.line)
+                .at_key(format!("stages.{}.cmd", inst.stage))
+                .hint("build the weft binaries (`cargo build --release`) or put the tool on PATH"),
+        );
+    }
+    Ok(())
 }
 
 /// Shell-quoted path for messages.

@@ -86,7 +86,7 @@ impl HashCache {
         }
         let tmp = self
             .file
-            .with_extension(format!("tmp-{}", super::exec::process_tag()));
+            .with_extension(format!("tmp-{}", super::host::process_tag()));
         let mut w = std::io::BufWriter::new(
             std::fs::File::create(&tmp).map_err(|e| WeftError::io(&tmp, e))?,
         );

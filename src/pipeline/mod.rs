@@ -6,9 +6,14 @@ pub mod engine;
 pub mod exec;
 pub mod gather;
 pub mod hash;
+pub mod host;
+pub mod progress;
 pub mod record;
+pub mod show;
 pub mod slurm;
 pub mod spec;
+pub mod workspace;
 
-pub use engine::{run, ExecutorKind, RunOptions, Verdict, Workspace};
+pub use engine::{run, ExecutorKind, RunOptions};
 pub use spec::Pipeline;
+pub use workspace::{Verdict, Workspace};

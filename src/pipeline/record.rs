@@ -65,7 +65,7 @@ impl RecordStore {
     pub fn put(&self, r: &Record) -> Result<()> {
         std::fs::create_dir_all(&self.dir).map_err(|e| WeftError::io(&self.dir, e))?;
         let p = self.path(&r.instance);
-        let tmp = p.with_extension(format!("json.tmp-{}", super::exec::process_tag()));
+        let tmp = p.with_extension(format!("json.tmp-{}", super::host::process_tag()));
         let s = serde_json::to_string_pretty(r).expect("record serialises");
         std::fs::write(&tmp, s).map_err(|e| WeftError::io(&tmp, e))?;
         std::fs::rename(&tmp, &p).map_err(|e| WeftError::io(&p, e))?;
