@@ -149,7 +149,7 @@ pub(super) fn read(src: &str, at: &Source) -> Result<RawFile> {
         } else if msg.contains("did not match any variant") {
             "inputs and outputs are a list of paths or a table of named paths"
         } else {
-            "see the pipeline file format in src/pipeline/spec/mod.rs or the README"
+            "see the pipeline file format in docs/pipelines.md"
         };
         WeftError::input(format!("invalid pipeline file: {msg}"))
             .in_file(at.file)
