@@ -169,6 +169,10 @@ const fn null(means: &'static str, reason: &'static str) -> Option<Null> {
 
 const NO_SPRING: Option<Null> = null("0", "no spring along that axis");
 const NO_DASHPOT: Option<Null> = null("0", "no dashpot along that axis");
+const NO_FAILURE: Option<Null> = null(
+    "no failure",
+    "elements stay elastic unless a failure law is given, as in the paper's studies",
+);
 
 part_properties! {
     youngs_modulus: f64 {
@@ -369,6 +373,55 @@ part_properties! {
         null: null("false", "a link joins its two nodes, as the paper's links"),
         aliases: [],
         meaning: "true: each end of the link is a point of a yarn (the chain of trusses through `n1`, and through `n2`) that stays put while the link sticks and moves along the yarn when its slider slips, so that the yarns slide across each other; the link acts in the frame of the two yarns' tangents at those points (e₁ along node 1's yarn, n ⟂ both towards node 2); needs `n1`, `n2` on truss chains; not with `local_frame`",
+    },
+    failure_strain: f64 {
+        unit: "",
+        kinds: [Truss: Rule::Positive, Tri: Rule::Positive, Quad: Rule::Positive],
+        null: NO_FAILURE,
+        aliases: ["eps_f"],
+        meaning: "failure strain ε_f: a truss fails when its axial engineering strain (L − L_ref)/L_ref reaches it, a membrane when the engineering strain of its fibres along material direction 1, √(1 + 2E₁₁) − 1, does; times the element's `failure_strain_factor`",
+    },
+    failure_strain_2: f64 {
+        unit: "",
+        kinds: [Tri: Rule::Positive, Quad: Rule::Positive],
+        null: null("no failure across", "a yarn band fails along its yarn; across, only where asked"),
+        aliases: [],
+        meaning: "failure strain along material direction 2, √(1 + 2E₂₂) − 1 (membranes), times the element's `failure_strain_factor`",
+    },
+    failure_all_directions: bool {
+        unit: "",
+        kinds: [Tri: Rule::Free, Quad: Rule::Free],
+        null: null("false", "the first direction to fail removes the element (OpenRadioss /FAIL/FABRIC NDIR = 1)"),
+        aliases: [],
+        meaning: "true: a membrane is removed only when every direction with a failure strain has failed, and a direction that has failed carries no normal stress from then on (NDIR = 2)",
+    },
+    failure_rate_coefficient: f64 {
+        unit: "",
+        kinds: [Truss: Rule::NonNegative, Tri: Rule::NonNegative, Quad: Rule::NonNegative],
+        null: null("0", "a rate-independent failure strain"),
+        aliases: [],
+        meaning: "C of the failure strain's rate law ε_f(ε̇) = ε_f (1 + C ln(ε̇/ε̇₀)) for ε̇ > ε̇₀ (ε̇ the element's strain rate along the failing direction)",
+    },
+    failure_reference_rate: f64 {
+        unit: "1/s",
+        kinds: [Truss: Rule::Positive, Tri: Rule::Positive, Quad: Rule::Positive],
+        null: null("1", "the rate law's reference ε̇₀ matters only with `failure_rate_coefficient`"),
+        aliases: [],
+        meaning: "ε̇₀ of the failure strain's rate law",
+    },
+    failure_force: f64 {
+        unit: "N",
+        kinds: [Link: Rule::Positive],
+        null: NO_FAILURE,
+        aliases: [],
+        meaning: "a link breaks when the length of its spring force reaches it (times the element's `failure_strain_factor`)",
+    },
+    failure_opening: f64 {
+        unit: "m",
+        kinds: [Link: Rule::Positive],
+        null: NO_FAILURE,
+        aliases: [],
+        meaning: "a link breaks when the length of its relative displacement d = x₂ − x₁ − d₀ reaches it (times the element's `failure_strain_factor`)",
     },
 }
 

@@ -44,6 +44,16 @@ pub struct ElementBlock {
     /// yarn directions); empty when no link carries them. Read only by links whose part
     /// has `local_frame`.
     pub frame: Vec<[usize; 4]>,
+    /// Elements that can fail: the factor on their part's failure strain (or force, or
+    /// opening) [-], one per element (statistical strengths drawn by a generator);
+    /// empty when every element has its part's.
+    pub failure_factor: Vec<f64>,
+    /// The layer of a fabric each element belongs to (1 = the strike face), one per
+    /// element (null: none); empty when the table has no `layer` column.
+    pub layer: Vec<Option<i64>>,
+    /// The yarn each element belongs to within its part, one per element (null: none);
+    /// empty when the table has no `yarn` column.
+    pub yarn: Vec<Option<i64>>,
 }
 
 impl ElementBlock {
@@ -52,6 +62,18 @@ impl ElementBlock {
     }
     pub fn is_empty(&self) -> bool {
         self.id.is_empty()
+    }
+    /// The factor on element `e`'s failure strain (1 when the block has none).
+    pub fn failure_factor(&self, e: usize) -> f64 {
+        self.failure_factor.get(e).copied().unwrap_or(1.0)
+    }
+    /// The layer of element `e`, when the block has one for it.
+    pub fn layer_of(&self, e: usize) -> Option<i64> {
+        self.layer.get(e).copied().flatten()
+    }
+    /// The yarn of element `e` within its part, when the block has one for it.
+    pub fn yarn_of(&self, e: usize) -> Option<i64> {
+        self.yarn.get(e).copied().flatten()
     }
     /// Trusses: the cross-section area of element `e` [m²], its own or its part's.
     pub fn truss_area(&self, parts: &[Part], e: usize) -> f64 {
@@ -349,6 +371,15 @@ impl Model {
         }
         if !b.stress0.is_empty() {
             b.stress0.push([0.0; 3]);
+        }
+        if !b.failure_factor.is_empty() {
+            b.failure_factor.push(1.0);
+        }
+        if !b.layer.is_empty() {
+            b.layer.push(None);
+        }
+        if !b.yarn.is_empty() {
+            b.yarn.push(None);
         }
         if !b.frame.is_empty() {
             // A link without frame nodes of its own: the link's nodes twice (a frame

@@ -359,12 +359,14 @@ impl Model {
     }
 
     /// Per-element columns of the element tables, table by table: initial stresses,
-    /// cross-section areas, nodal thicknesses.
+    /// cross-section areas, nodal thicknesses, failure-strain factors, layers and yarns.
     fn validate_element_columns(&self) -> Result<()> {
         for (kind, b) in &self.elements {
             validate_initial_stress(*kind, b)?;
             validate_truss_areas(*kind, b)?;
             validate_nodal_thickness(*kind, b)?;
+            validate_failure_factors(*kind, b)?;
+            validate_layers_and_yarns(*kind, b)?;
         }
         Ok(())
     }
@@ -431,6 +433,79 @@ fn validate_truss_areas(kind: ElementKind, b: &ElementBlock) -> Result<()> {
             .in_column("area")
             .at_row(e)
             .expected("an area > 0 in m², or null for the part's area"));
+        }
+    }
+    Ok(())
+}
+
+/// Failure-strain factors of a block: on kinds that can fail, one finite value > 0 per
+/// element.
+fn validate_failure_factors(kind: ElementKind, b: &ElementBlock) -> Result<()> {
+    if b.failure_factor.is_empty() {
+        return Ok(());
+    }
+    let file = format!("elements_{}.parquet", kind.name());
+    let can_fail = matches!(
+        kind,
+        ElementKind::Truss | ElementKind::Tri | ElementKind::Quad | ElementKind::Link
+    );
+    if !can_fail || b.failure_factor.len() != b.len() {
+        return Err(WeftError::input(format!(
+            "{} elements carry {} failure-strain factors for {} elements",
+            kind.name(),
+            b.failure_factor.len(),
+            b.len()
+        ))
+        .in_file(file)
+        .in_column("failure_strain_factor")
+        .expected("the column on the truss, link, tri and quad tables only, one per element"));
+    }
+    for (e, &f) in b.failure_factor.iter().enumerate() {
+        if !(f.is_finite() && f > 0.0) {
+            return Err(WeftError::input(format!(
+                "{} `{}` has failure_strain_factor `{f}`",
+                kind.name(),
+                b.id[e]
+            ))
+            .in_file(file)
+            .in_column("failure_strain_factor")
+            .at_row(e)
+            .expected("a factor > 0 on the part's failure strain, or null for 1")
+            .hint(
+                "a generator's statistical strengths (--weibull-modulus) draw factors around 1",
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Layers and yarns of a block: one per element when the column is there, layers ≥ 1.
+fn validate_layers_and_yarns(kind: ElementKind, b: &ElementBlock) -> Result<()> {
+    let file = format!("elements_{}.parquet", kind.name());
+    for (col, v) in [("layer", &b.layer), ("yarn", &b.yarn)] {
+        if !v.is_empty() && v.len() != b.len() {
+            return Err(WeftError::input(format!(
+                "{} elements carry {} {col} values for {} elements",
+                kind.name(),
+                v.len(),
+                b.len()
+            ))
+            .in_file(file)
+            .in_column(col)
+            .expected("one per element"));
+        }
+    }
+    for (e, l) in b.layer.iter().enumerate() {
+        if let Some(l) = l.filter(|&l| l < 1) {
+            return Err(WeftError::input(format!(
+                "{} `{}` is in layer `{l}`",
+                kind.name(),
+                b.id[e]
+            ))
+            .in_file(file)
+            .in_column("layer")
+            .at_row(e)
+            .expected("a layer number ≥ 1 (1 = the strike face), or null"));
         }
     }
     Ok(())

@@ -22,8 +22,12 @@ pub struct Energies {
     pub hourglass: f64,
     /// Contact energy: stored penalty energy and friction work in contact.
     pub contact: f64,
+    /// Strain energy taken out of the model by failed elements (docs/theory.md,
+    /// "Failure, perforation and the ballistic limit").
+    pub eroded: f64,
     pub external_work: f64,
-    /// kinetic + internal + damping + friction + hourglass + contact − initial − external work.
+    /// kinetic + internal + damping + friction + hourglass + contact + eroded − initial −
+    /// external work.
     pub balance_error: f64,
     /// |balance_error| over the energy scale so far, [`Energies::scale`].
     pub balance_error_relative: f64,
@@ -43,6 +47,7 @@ impl Energies {
             friction: l(self.friction, o.friction),
             hourglass: l(self.hourglass, o.hourglass),
             contact: l(self.contact, o.contact),
+            eroded: l(self.eroded, o.eroded),
             external_work: l(self.external_work, o.external_work),
             balance_error: l(self.balance_error, o.balance_error),
             balance_error_relative: l(self.balance_error_relative, o.balance_error_relative),
@@ -61,6 +66,8 @@ pub struct ElementEnergies {
     /// Dissipated by link sliders so far.
     pub friction: f64,
     pub hourglass: f64,
+    /// Taken by failed elements so far.
+    pub eroded: f64,
 }
 
 /// The energy ledger: the running balance E_kin + E_int + dissipated + contact − E₀ −
@@ -92,7 +99,10 @@ impl Ledger {
         step: u64,
     ) -> Energies {
         let (ie, damp, fric, hg) = (el.internal, el.damping, el.friction, el.hourglass);
-        let total = ke + ie + damp + self.mass_damping + fric + hg + contact;
+        let mut total = ke + ie + damp + self.mass_damping + fric + hg + contact;
+        if el.eroded != 0.0 {
+            total += el.eroded;
+        }
         let e_init = *self.e0.get_or_insert(total);
         let err = total - e_init - w_ext;
         // |E_int|: with initial stresses the stored energy ½E·DE + S₀·E can be negative.
@@ -118,6 +128,7 @@ impl Ledger {
             friction: fric,
             hourglass: hg,
             contact,
+            eroded: el.eroded,
             external_work: w_ext,
             balance_error: err,
             balance_error_relative: rel,

@@ -17,6 +17,7 @@
 //! is the order of the force slots, of the masses' accumulation and of the sums, so it
 //! is part of what makes results reproducible bit for bit.
 
+use super::failure::Failure;
 use super::rotations::Rotations;
 use super::vec3::{Mat3, Vec3};
 use crate::error::Result;
@@ -100,8 +101,23 @@ pub trait Family: Sized + Send + Sync {
     /// Adds the family's row sums S_i, C_i (and the rotational rows) of the stable-step
     /// bound.
     fn stiffness_sums(&self, ctx: &StiffCtx, s: &mut [f64], c: &mut [f64], rot_row: &mut [f64]);
-    /// Per-chunk energy partials at the positions in `ctx`.
+    /// Per-chunk energy partials at the positions in `ctx` (eroded elements hold none).
     fn energies(&mut self, ctx: &ForceCtx) -> &[EnergyPartial];
+    /// Moves the failures of the last force pass, in element order, to `out` (a family
+    /// whose elements cannot fail has none).
+    fn collect_failures(&mut self, _out: &mut Vec<Failure>) {}
+    /// Whether element e is still in the model (not eroded).
+    fn alive(&self, _e: usize) -> bool {
+        true
+    }
+    /// The strain energy its failures have taken so far [J].
+    fn eroded_energy(&self) -> f64 {
+        0.0
+    }
+    /// Whether any of its elements can fail.
+    fn can_fail(&self) -> bool {
+        false
+    }
 }
 
 /// Totals of the energy ledger's groups (see [`EnergyGroup`]).
@@ -202,6 +218,35 @@ macro_rules! families {
                 rot_row: &mut [f64],
             ) {
                 $($crate::solver::family::Family::stiffness_sums(&self.$field, ctx, s, c, rot_row);)*
+            }
+            /// The failures of the last force pass, family by family in list order, each
+            /// in element order, with the element's id and nodes (its force slots').
+            /// `scratch` is reused between calls.
+            pub fn collect_failures(
+                &mut self,
+                scratch: &mut Vec<$crate::solver::failure::Failure>,
+                out: &mut Vec<$crate::solver::failure::Collected>,
+            ) {
+                $(
+                    scratch.clear();
+                    $crate::solver::family::Family::collect_failures(&mut self.$field, scratch);
+                    for f in scratch.iter() {
+                        let nodes = $crate::solver::family::Family::slot_nodes(&self.$field, f.element);
+                        out.push($crate::solver::failure::Collected {
+                            failure: *f,
+                            id: $crate::solver::family::Family::id(&self.$field, f.element),
+                            nodes: nodes.to_vec(),
+                        });
+                    }
+                )*
+            }
+            /// Whether any element of any family can fail.
+            pub fn can_fail(&self) -> bool {
+                false $(|| $crate::solver::family::Family::can_fail(&self.$field))*
+            }
+            /// The strain energy every failure has taken so far [J], in list order.
+            pub fn eroded_energy(&self) -> f64 {
+                0.0 $(+ $crate::solver::family::Family::eroded_energy(&self.$field))*
             }
             /// Element energies summed by group (see `EnergyGroup`).
             pub fn energies(&mut self, ctx: &$crate::solver::family::ForceCtx) -> $crate::solver::family::EnergySums {

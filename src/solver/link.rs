@@ -365,6 +365,7 @@ pub fn framed_elastic_forces(
 
 use rayon::prelude::*;
 
+use super::failure::{taken_energy, Criterion, Erosion, Failure, FailureLaw, Fate};
 use super::family::{
     chunk_partials, Build, EnergyGroup, EnergyPartial, Family, ForceCtx, StiffCtx, CHUNK,
 };
@@ -439,7 +440,138 @@ pub struct LinkGroup {
     /// Initial offset X₂ − X₁ [m].
     pub d0: Vec<[f64; 3]>,
     pub state: Vec<LinkState>,
+    /// Failure: per link its breaking force (`erosion.law[e].strain`, N) and opening
+    /// (`break_opening`, m), each `f64::INFINITY` when not given; empty when no link can
+    /// break.
+    pub erosion: Erosion,
+    pub break_opening: Vec<f64>,
     partials: Vec<EnergyPartial>,
+}
+
+/// A link's breaking force and opening from its part, × its factor (∞: not given).
+fn break_limits(p: &PartProps, factor: f64) -> (f64, f64) {
+    (
+        p.failure_force.map_or(f64::INFINITY, |f| f * factor),
+        p.failure_opening.map_or(f64::INFINITY, |o| o * factor),
+    )
+}
+
+impl LinkGroup {
+    /// The force pass of a group whose links can break: a live link breaks when its
+    /// opening |d| reaches its breaking opening, or the length of its spring force (after
+    /// the slider's update) its breaking force; a broken link exerts no force from that
+    /// step on, and the stored energy it held is kept in its fate.
+    fn forces_with_failure(&mut self, ctx: &ForceCtx, fe: &mut [[f64; 3]]) {
+        let (x, v, dt_prev) = (ctx.x, ctx.v, ctx.dt_prev);
+        let LinkGroup {
+            nodes,
+            props,
+            law,
+            d0,
+            state,
+            erosion,
+            break_opening,
+            ..
+        } = self;
+        let Erosion {
+            law: force_limit,
+            fate,
+            any,
+            ..
+        } = erosion;
+        let (nodes, props, law, d0, force_limit, break_opening, any) = (
+            &*nodes,
+            &*props,
+            &*law,
+            &*d0,
+            &*force_limit,
+            &*break_opening,
+            &*any,
+        );
+        let n = nodes.len();
+        let body = |(ci, ((out, st), fates)): (
+            usize,
+            ((&mut [[f64; 3]], &mut [LinkState]), &mut [Fate]),
+        )| {
+            let e0 = ci * CHUNK;
+            for (j, ((pair, s), fate)) in out
+                .chunks_exact_mut(2)
+                .zip(st.iter_mut())
+                .zip(fates.iter_mut())
+                .enumerate()
+            {
+                let e = e0 + j;
+                if fate.eroded {
+                    pair[0] = [0.0; 3];
+                    pair[1] = [0.0; 3];
+                    continue;
+                }
+                let [a, b] = nodes[e];
+                let (a, b) = (a as usize, b as usize);
+                let d = rel_disp(&x[a], &x[b], &d0[e]);
+                let lw = law_of(law, e);
+                let opening = norm(&d);
+                let broken = if opening >= break_opening[e] {
+                    Some((Criterion::Opening, opening, break_opening[e]))
+                } else {
+                    None
+                };
+                let dd = [v[b][0] - v[a][0], v[b][1] - v[a][1], v[b][2] - v[a][2]];
+                let broken = broken.or_else(|| {
+                    let mut trial = *s;
+                    let (fs, _) = force_update_parts(&d, &dd, &props[e], lw, &mut trial, dt_prev);
+                    let f = norm(&fs);
+                    (f >= force_limit[e].strain).then_some((
+                        Criterion::Force,
+                        f,
+                        force_limit[e].strain,
+                    ))
+                });
+                if let Some((criterion, value, limit)) = broken {
+                    // Its stored energy, with the half step of its spring's work (see
+                    // `failure::taken_energy`).
+                    let f2 = elastic_force_law(&d, &props[e], lw, &s.slip);
+                    let w = taken_energy(
+                        energy_law(&d, &props[e], lw, &s.slip),
+                        dt_prev,
+                        &[v[a], v[b]],
+                        &[[-f2[0], -f2[1], -f2[2]], f2],
+                    );
+                    fate.eroded = true;
+                    fate.energy = w;
+                    fate.fresh = Some(Failure {
+                        kind: ElementKind::Link,
+                        element: e,
+                        criterion,
+                        value,
+                        limit,
+                        eroded: true,
+                        energy: w,
+                    });
+                    any.store(true, std::sync::atomic::Ordering::Relaxed);
+                    pair[0] = [0.0; 3];
+                    pair[1] = [0.0; 3];
+                    continue;
+                }
+                let f2 = force_update_law(&d, &dd, &props[e], lw, s, dt_prev);
+                pair[0] = [-f2[0], -f2[1], -f2[2]];
+                pair[1] = f2;
+            }
+        };
+        if n <= CHUNK {
+            fe.chunks_mut(2 * CHUNK)
+                .zip(state.chunks_mut(CHUNK))
+                .zip(fate.chunks_mut(CHUNK))
+                .enumerate()
+                .for_each(body);
+        } else {
+            fe.par_chunks_mut(2 * CHUNK)
+                .zip(state.par_chunks_mut(CHUNK))
+                .zip(fate.par_chunks_mut(CHUNK))
+                .enumerate()
+                .for_each(body);
+        }
+    }
 }
 
 impl Family for LinkGroup {
@@ -453,9 +585,11 @@ impl Family for LinkGroup {
         let Some(b) = m.block(ElementKind::Link) else {
             return Ok(g);
         };
+        let mut limits = Vec::new();
         for e in (0..b.len()).filter(|&e| !is_framed(m, e) && !is_sliding(m, e)) {
             let (a, c) = (b.nodes[2 * e], b.nodes[2 * e + 1]);
             let (props, law) = link_props(&m.parts[b.part[e]].props);
+            limits.push(break_limits(&m.parts[b.part[e]].props, b.failure_factor(e)));
             g.id.push(b.id[e]);
             g.nodes.push([a as u32, c as u32]);
             g.props.push(props);
@@ -465,6 +599,19 @@ impl Family for LinkGroup {
         }
         if g.law.iter().all(|l| *l == DEFAULT_LAW) {
             g.law.clear();
+        }
+        if limits.iter().any(|l| l.0.is_finite() || l.1.is_finite()) {
+            // `law.strain` holds the breaking force (∞: none).
+            g.erosion = Erosion::watching(
+                limits
+                    .iter()
+                    .map(|&(f, _)| FailureLaw {
+                        strain: f,
+                        ..FailureLaw::NONE
+                    })
+                    .collect(),
+            );
+            g.break_opening = limits.iter().map(|l| l.1).collect();
         }
         Ok(g)
     }
@@ -483,6 +630,9 @@ impl Family for LinkGroup {
         k.iter().chain(p.c.iter()).cloned().fold(0.0, f64::max)
     }
     fn forces(&mut self, ctx: &ForceCtx, fe: &mut [[f64; 3]]) {
+        if self.erosion.active() {
+            return self.forces_with_failure(ctx, fe);
+        }
         let (x, v, dt_prev) = (ctx.x, ctx.v, ctx.dt_prev);
         let (nodes, props, law, d0) = (&self.nodes, &self.props, &self.law, &self.d0);
         // Plain links (the default law: the group stores none) take the kernel without
@@ -543,19 +693,33 @@ impl Family for LinkGroup {
     }
     fn energies(&mut self, ctx: &ForceCtx) -> &[EnergyPartial] {
         let (x, nodes, d0, props, state) = (ctx.x, &self.nodes, &self.d0, &self.props, &self.state);
-        let law = &self.law;
+        let (law, er) = (&self.law, &self.erosion);
         chunk_partials(&mut self.partials, nodes.len(), |r| {
             let mut acc = [0.0; 4];
             for k in r {
                 let [a, b] = nodes[k];
                 let d = rel_disp(&x[a as usize], &x[b as usize], &d0[k]);
-                acc[0] += energy_law(&d, &props[k], law_of(law, k), &state[k].slip);
+                if er.alive(k) {
+                    acc[0] += energy_law(&d, &props[k], law_of(law, k), &state[k].slip);
+                }
                 acc[1] += state[k].damping_energy;
                 acc[2] += state[k].friction_energy;
             }
             acc
         });
         &self.partials
+    }
+    fn collect_failures(&mut self, out: &mut Vec<Failure>) {
+        self.erosion.collect(out);
+    }
+    fn alive(&self, e: usize) -> bool {
+        self.erosion.alive(e)
+    }
+    fn eroded_energy(&self) -> f64 {
+        self.erosion.eroded_energy()
+    }
+    fn can_fail(&self) -> bool {
+        self.erosion.active()
     }
 }
 

@@ -74,6 +74,22 @@ impl Material {
     pub fn e_max(&self) -> f64 {
         self.d[0][0].max(self.d[1][1])
     }
+    /// The material with the material directions in `failed` (bit i: direction i + 1)
+    /// carrying no normal stress: their rows and columns of D and their initial stress
+    /// zeroed, the shear kept (OpenRadioss' /FAIL/FABRIC with NDIR = 2).
+    pub fn with_failed(&self, failed: u8) -> Material {
+        let mut m = *self;
+        for i in 0..2 {
+            if failed & (1 << i) != 0 {
+                for j in 0..3 {
+                    m.d[i][j] = 0.0;
+                    m.d[j][i] = 0.0;
+                }
+                m.s0[i] = 0.0;
+            }
+        }
+        m
+    }
 }
 
 /// Reference geometry of one membrane element with `N` nodes.
@@ -433,11 +449,71 @@ pub fn max_stiffness<const N: usize>(
 // ---------------------------------------------------------------------------------------
 // The membrane families (triangles and quads).
 
+use super::failure::{fibre_strain, taken_energy, Criterion, Erosion, Failure, FailureLaw, Fate};
 use super::family::{
     chunk_partials, for_chunks, Build, EnergyGroup, EnergyPartial, Family, ForceCtx, StiffCtx,
     CHUNK,
 };
 use crate::model::ElementKind;
+
+/// The fibre strains √(1 + 2E_ii) − 1 along the two material directions, and their rates
+/// (Ė_ii/√(1 + 2E_ii), Ė_ii = f_i·ḟ_i with ḟ_i = Σ_a v_a ∇̂N_{a,i}), at positions `x` and
+/// velocities `v`.
+#[inline(always)]
+pub fn fibre_strains<const N: usize>(
+    x: &[[f64; 3]; N],
+    v: &[[f64; 3]; N],
+    r: &Reference<N>,
+    with_rate: bool,
+) -> ([f64; 2], [f64; 2]) {
+    let (f, e) = kinematics(x, r);
+    let eps = [fibre_strain(e[0]), fibre_strain(e[1])];
+    if !with_rate {
+        return (eps, [0.0; 2]);
+    }
+    let mut fd = [[0.0; 3]; 2];
+    for a in 0..N {
+        for c in 0..2 {
+            let g = r.grad[a][c];
+            for d in 0..3 {
+                fd[c][d] += v[a][d] * g;
+            }
+        }
+    }
+    let rate = std::array::from_fn(|i| {
+        let lam = 1.0 + eps[i];
+        if lam > 0.0 {
+            dot(&f[i], &fd[i]) / lam
+        } else {
+            0.0
+        }
+    });
+    (eps, rate)
+}
+
+/// A membrane element's failure laws: direction 1 and 2, and whether every direction
+/// must fail before the element goes.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MembraneFailure {
+    pub dir: [FailureLaw; 2],
+    pub all_directions: bool,
+}
+
+/// The directions that fail now (bits), given those failed before.
+#[inline(always)]
+fn failing(lw: &MembraneFailure, eps: [f64; 2], rate: [f64; 2], before: u8) -> (u8, [f64; 2]) {
+    let mut now = 0u8;
+    let mut limit = [f64::INFINITY; 2];
+    for i in 0..2 {
+        if lw.dir[i].can_fail() && before & (1 << i) == 0 {
+            limit[i] = lw.dir[i].threshold(rate[i]);
+            if eps[i] >= limit[i] {
+                now |= 1 << i;
+            }
+        }
+    }
+    (now, limit)
+}
 
 /// Membrane elements with `N` nodes (3: triangles, 4: quads), struct-of-arrays.
 #[derive(Debug, Clone, Default)]
@@ -453,6 +529,10 @@ pub struct MembraneGroup<const N: usize> {
     pub k_max: Vec<f64>,
     /// Element mass ρ s A₀ [kg].
     pub mass: Vec<f64>,
+    /// Failure laws and fates (empty when no element can fail), and per element its
+    /// directions' laws (`erosion.law` holds direction 1's, to say who can fail).
+    pub erosion: Erosion,
+    pub failure: Vec<MembraneFailure>,
     partials: Vec<EnergyPartial>,
 }
 
@@ -478,7 +558,7 @@ impl<const N: usize> MembraneGroup<N> {
             })
             .collect();
         for (e, (ns, &(r, strain))) in self.nodes.iter().zip(&ratios).enumerate() {
-            if r <= 1.0 {
+            if r <= 1.0 || !self.erosion.alive(e) {
                 continue;
             }
             let add = (r - 1.0) * self.k_max[e];
@@ -513,6 +593,8 @@ impl<const N: usize> Family for MembraneGroup<N> {
             k_hg: vec![],
             k_max: vec![],
             mass: vec![],
+            erosion: Erosion::default(),
+            failure: vec![],
             partials: vec![],
         };
         let Some(b) = m.block(kind) else { return Ok(g) };
@@ -582,6 +664,27 @@ impl<const N: usize> Family for MembraneGroup<N> {
             g.material.push(mat);
             g.thickness.push(s);
             g.k_hg.push(k_hg);
+            g.failure.push(failure_laws(p, b.failure_factor(e)));
+        }
+        if g.failure
+            .iter()
+            .any(|f| f.dir.iter().any(FailureLaw::can_fail))
+        {
+            // Who can fail: any direction.
+            g.erosion = Erosion::new(
+                g.failure
+                    .iter()
+                    .map(|f| {
+                        if f.dir[0].can_fail() {
+                            f.dir[0]
+                        } else {
+                            f.dir[1]
+                        }
+                    })
+                    .collect(),
+            );
+        } else {
+            g.failure.clear();
         }
         Ok(g)
     }
@@ -598,6 +701,9 @@ impl<const N: usize> Family for MembraneGroup<N> {
         self.k_max[e]
     }
     fn forces(&mut self, ctx: &ForceCtx, fe: &mut [[f64; 3]]) {
+        if self.erosion.active() {
+            return self.forces_with_failure(ctx, fe);
+        }
         let (g, x) = (&*self, ctx.x);
         for_chunks(fe, N, g.id.len(), |ci, out| {
             let e0 = ci * CHUNK;
@@ -633,17 +739,178 @@ impl<const N: usize> Family for MembraneGroup<N> {
             &self.thickness,
             &self.k_hg,
         );
+        let er = &self.erosion;
         chunk_partials(&mut self.partials, nodes.len(), |r| {
             let mut acc = [0.0; 4];
             for e in r {
+                if !er.alive(e) {
+                    continue;
+                }
                 let ns = &nodes[e];
                 let xe: [[f64; 3]; N] = std::array::from_fn(|a| x[ns[a] as usize]);
-                let (w, h) = energy(&xe, &reference[e], &material[e], thickness[e], k_hg[e]);
+                let dirs = er.fate.get(e).map_or(0, |f| f.dirs);
+                let mat = if dirs == 0 {
+                    material[e]
+                } else {
+                    material[e].with_failed(dirs)
+                };
+                let (w, h) = energy(&xe, &reference[e], &mat, thickness[e], k_hg[e]);
                 acc[0] += w;
                 acc[3] += h;
             }
             acc
         });
         &self.partials
+    }
+    fn collect_failures(&mut self, out: &mut Vec<Failure>) {
+        self.erosion.collect(out);
+    }
+    fn alive(&self, e: usize) -> bool {
+        self.erosion.alive(e)
+    }
+    fn eroded_energy(&self) -> f64 {
+        self.erosion.eroded_energy()
+    }
+    fn can_fail(&self) -> bool {
+        self.erosion.active()
+    }
+}
+
+/// A membrane's failure laws from its part: `failure_strain` along direction 1,
+/// `failure_strain_2` along 2, each × the element's factor, with the rate law.
+fn failure_laws(p: &crate::model::PartProps, factor: f64) -> MembraneFailure {
+    let law = |eps: Option<f64>| match eps {
+        Some(e) => FailureLaw {
+            strain: e * factor,
+            rate_coefficient: p.failure_rate_coefficient.unwrap_or(0.0),
+            reference_rate: p.failure_reference_rate.unwrap_or(1.0),
+        },
+        None => FailureLaw::NONE,
+    };
+    MembraneFailure {
+        dir: [law(p.failure_strain), law(p.failure_strain_2)],
+        all_directions: p.failure_all_directions.unwrap_or(false),
+    }
+}
+
+impl<const N: usize> MembraneGroup<N> {
+    /// The force pass of a group whose elements can fail. Per live element: the fibre
+    /// strains; a direction that reaches its limit fails. Without
+    /// `failure_all_directions` the element then leaves the model (no force from this
+    /// step on); with it, the direction stops carrying normal stress
+    /// ([`Material::with_failed`]) and the element leaves once every direction that can
+    /// fail has. The strain energy a failure takes (the element's, or what the failed
+    /// direction held) is kept in its fate.
+    fn forces_with_failure(&mut self, ctx: &ForceCtx, fe: &mut [[f64; 3]]) {
+        use rayon::prelude::*;
+        let (x, v) = (ctx.x, ctx.v);
+        let MembraneGroup {
+            nodes,
+            reference,
+            material,
+            thickness,
+            k_hg,
+            erosion,
+            failure,
+            ..
+        } = self;
+        let Erosion { fate, any, .. } = erosion;
+        let (nodes, reference, material, thickness, k_hg, failure, any) = (
+            &*nodes,
+            &*reference,
+            &*material,
+            &*thickness,
+            &*k_hg,
+            &*failure,
+            &*any,
+        );
+        let body = |(ci, (out, fates)): (usize, (&mut [[f64; 3]], &mut [Fate]))| {
+            let e0 = ci * CHUNK;
+            for (j, (el, fate)) in out.chunks_exact_mut(N).zip(fates.iter_mut()).enumerate() {
+                let e = e0 + j;
+                if fate.eroded {
+                    el.fill([0.0; 3]);
+                    continue;
+                }
+                let ns = &nodes[e];
+                let xe: [[f64; 3]; N] = std::array::from_fn(|a| x[ns[a] as usize]);
+                let lw = &failure[e];
+                let with_rate = lw.dir.iter().any(|d| d.rate_coefficient != 0.0);
+                let ve: [[f64; 3]; N] = if with_rate {
+                    std::array::from_fn(|a| v[ns[a] as usize])
+                } else {
+                    [[0.0; 3]; N]
+                };
+                let (eps, rate) = fibre_strains(&xe, &ve, &reference[e], with_rate);
+                let (now, limit) = failing(lw, eps, rate, fate.dirs);
+                let before = fate.dirs;
+                let mat_before = if before == 0 {
+                    material[e]
+                } else {
+                    material[e].with_failed(before)
+                };
+                if now != 0 {
+                    let (w0, h0) = energy(&xe, &reference[e], &mat_before, thickness[e], k_hg[e]);
+                    let dirs = before | now;
+                    let can = (lw.dir[0].can_fail() as u8) | ((lw.dir[1].can_fail() as u8) << 1);
+                    let eroded = !lw.all_directions || dirs & can == can;
+                    // The energy and the forces that leave: all of them, or what the
+                    // failed direction carried (see `failure::taken_energy`).
+                    let f0 = forces(&xe, &reference[e], &mat_before, thickness[e], k_hg[e]);
+                    let vn: [[f64; 3]; N] = std::array::from_fn(|a| v[ns[a] as usize]);
+                    let taken = if eroded {
+                        taken_energy(w0 + h0, ctx.dt_prev, &vn, &f0)
+                    } else {
+                        let mat1 = material[e].with_failed(dirs);
+                        let (w1, _) = energy(&xe, &reference[e], &mat1, thickness[e], k_hg[e]);
+                        let f1 = forces(&xe, &reference[e], &mat1, thickness[e], k_hg[e]);
+                        let df: [[f64; 3]; N] =
+                            std::array::from_fn(|a| std::array::from_fn(|c| f0[a][c] - f1[a][c]));
+                        taken_energy(w0 - w1, ctx.dt_prev, &vn, &df)
+                    };
+                    // The first direction that failed now names the criterion.
+                    let i = if now & 1 != 0 { 0 } else { 1 };
+                    fate.dirs = dirs;
+                    fate.eroded = eroded;
+                    fate.energy += taken;
+                    fate.fresh = Some(Failure {
+                        kind: Self::KIND,
+                        element: e,
+                        criterion: if i == 0 {
+                            Criterion::Direction1
+                        } else {
+                            Criterion::Direction2
+                        },
+                        value: eps[i],
+                        limit: limit[i],
+                        eroded,
+                        energy: taken,
+                    });
+                    any.store(true, std::sync::atomic::Ordering::Relaxed);
+                    if eroded {
+                        el.fill([0.0; 3]);
+                        continue;
+                    }
+                }
+                let mat = if fate.dirs == 0 {
+                    material[e]
+                } else {
+                    material[e].with_failed(fate.dirs)
+                };
+                let f = forces(&xe, &reference[e], &mat, thickness[e], k_hg[e]);
+                el.copy_from_slice(&f);
+            }
+        };
+        if nodes.len() <= CHUNK {
+            fe.chunks_mut(N * CHUNK)
+                .zip(fate.chunks_mut(CHUNK))
+                .enumerate()
+                .for_each(body);
+        } else {
+            fe.par_chunks_mut(N * CHUNK)
+                .zip(fate.par_chunks_mut(CHUNK))
+                .enumerate()
+                .for_each(body);
+        }
     }
 }

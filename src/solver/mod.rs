@@ -32,6 +32,7 @@
 pub mod beam;
 pub mod contact;
 pub mod energy;
+pub mod failure;
 pub mod families;
 pub mod family;
 pub mod integrator;
@@ -127,6 +128,42 @@ pub struct Solver {
     pub scaling: Option<MassScaling>,
     pub analysis: crate::model::Analysis,
     ledger: Ledger,
+    /// Element failures and what they leave (empty when nothing can fail).
+    pub failures: FailureLog,
+}
+
+/// What the failures of a run leave: every failure in order, and per node how many live
+/// elements it still has (a node with none is a free mass).
+#[derive(Debug, Clone, Default)]
+pub struct FailureLog {
+    /// Whether any element can fail.
+    pub active: bool,
+    pub events: Vec<failure::FailureEvent>,
+    /// Per node, its live elements (force slots of elements that have not failed).
+    pub attached: Vec<u32>,
+    scratch: Vec<failure::Failure>,
+    collected: Vec<failure::Collected>,
+}
+
+impl FailureLog {
+    fn new(el: &Families, nodes: usize) -> FailureLog {
+        if !el.can_fail() {
+            return FailureLog::default();
+        }
+        let mut attached = vec![0u32; nodes];
+        for n in el.slot_nodes() {
+            attached[n as usize] += 1;
+        }
+        FailureLog {
+            active: true,
+            attached,
+            ..Default::default()
+        }
+    }
+    /// Whether node i still has a live element.
+    pub fn is_attached(&self, i: usize) -> bool {
+        self.attached.get(i).is_none_or(|&a| a > 0)
+    }
 }
 
 /// Fixed translations: constraints and symmetry planes.
@@ -257,7 +294,9 @@ impl Solver {
             scaling: None,
             analysis: m.analysis.clone(),
             ledger: Ledger::default(),
+            failures: FailureLog::default(),
         };
+        s.failures = FailureLog::new(&s.op.el, nn);
         let kappa = contact::surface::guard_kappa(m);
         s.set_time_step(kappa)?;
         s.ledger.floor = energy_floor(&s.x0, &s.mass, s.stable.dt);
@@ -472,6 +511,11 @@ impl Solver {
             damping: sums.total(1),
             friction: sums.total(2),
             hourglass: sums.total(3),
+            eroded: if self.failures.active {
+                self.op.el.eroded_energy()
+            } else {
+                0.0
+            },
         }
     }
 
@@ -659,6 +703,9 @@ impl Solver {
         self.op.apply_loads(&self.state);
         let t1 = Instant::now();
         self.op.element_forces(&self.state);
+        if self.failures.active {
+            self.apply_failures();
+        }
         let t1c = Instant::now();
         self.op.contact_and_ties(&self.state, &self.mass, dt);
         let t2 = Instant::now();
@@ -666,6 +713,39 @@ impl Solver {
         times.loads += t1 - t0;
         times.forces += t2 - t1;
         t2
+    }
+
+    /// The failures of the force pass just done: logged, their nodes' attachments
+    /// counted down, and the failed elements' faces and segments out of the contact
+    /// surfaces (projectiles' and between parts) before contact is computed.
+    fn apply_failures(&mut self) {
+        let log = &mut self.failures;
+        log.collected.clear();
+        self.op
+            .el
+            .collect_failures(&mut log.scratch, &mut log.collected);
+        for c in log.collected.drain(..) {
+            let f = c.failure;
+            log.events.push(failure::FailureEvent {
+                time: self.state.t,
+                step: self.state.step,
+                id: c.id,
+                failure: f,
+            });
+            if f.eroded {
+                for &n in &c.nodes {
+                    let a = &mut log.attached[n as usize];
+                    *a = a.saturating_sub(1);
+                }
+                if matches!(
+                    f.kind,
+                    ElementKind::Truss | ElementKind::Tri | ElementKind::Quad
+                ) {
+                    self.op.surfaces.erode(f.kind, f.element);
+                    self.op.projectiles.erode(f.kind, f.element);
+                }
+            }
+        }
     }
 
     /// The nodes' update over `dt` (at a sample step, `snap`, also x^n and v^n kept): the

@@ -259,6 +259,7 @@ impl ParquetSink {
             Col::F64("friction", col(|x| x.friction)),
             Col::F64("hourglass", col(|x| x.hourglass)),
             Col::F64("contact", col(|x| x.contact)),
+            Col::F64("eroded", col(|x| x.eroded)),
             Col::F64("external_work", col(|x| x.external_work)),
             Col::F64("balance_error", col(|x| x.balance_error)),
             Col::F64("balance_error_relative", relative),

@@ -71,10 +71,8 @@ use super::vec3::{dot, mv, norm, scale, sub, Vec3};
 use crate::error::{Result, WeftError};
 use crate::model::ElementKind;
 
-/// Nodes of a window on each side of the link's node. Four: a crossing's yarns may
-/// slide three spacings past each other (the yarn-level reference's crossings under
-/// the nose rim slid 2.7 mm at a 1 mm spacing by 50 µs, measured), and an anchor needs
-/// the chord beyond its segment.
+/// Nodes of a window on each side of the link's node (owned by the model, which builds
+/// the windows: [`crate::model::yarn::HALF`]).
 pub use crate::model::yarn::HALF;
 /// Nodes of a window.
 pub const WIN: usize = 2 * HALF + 1;

@@ -62,6 +62,27 @@ pub fn axial_force(x1: &[f64; 3], x2: &[f64; 3], k: f64, l0: f64, tension_only: 
 // ---------------------------------------------------------------------------------------
 // The truss family.
 
+/// The engineering axial strain (L − L_ref)/L_ref and its rate ε̇ = e·(v₂ − v₁)/L_ref.
+#[inline(always)]
+pub fn strain_and_rate(
+    x1: &[f64; 3],
+    x2: &[f64; 3],
+    v1: &[f64; 3],
+    v2: &[f64; 3],
+    l0: f64,
+) -> (f64, f64) {
+    let d = [x2[0] - x1[0], x2[1] - x1[1], x2[2] - x1[2]];
+    let l = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+    let dv = [v2[0] - v1[0], v2[1] - v1[1], v2[2] - v1[2]];
+    let rate = if l > 0.0 {
+        (d[0] * dv[0] + d[1] * dv[1] + d[2] * dv[2]) / (l * l0)
+    } else {
+        0.0
+    };
+    ((l - l0) / l0, rate)
+}
+
+use super::failure::{taken_energy, Criterion, Erosion, Failure, FailureLaw, Fate};
 use super::family::{
     chunk_partials, for_chunks, Build, EnergyGroup, EnergyPartial, Family, ForceCtx, StiffCtx,
     CHUNK,
@@ -80,7 +101,101 @@ pub struct TrussGroup {
     /// Unstressed length L_ref = L₀/(1 + ε₀) [m].
     pub l0: Vec<f64>,
     pub tension_only: Vec<bool>,
+    /// Failure laws and fates (empty when no truss can fail).
+    pub erosion: Erosion,
     partials: Vec<EnergyPartial>,
+}
+
+/// A truss's failure law: its part's `failure_strain` × its factor, with the rate law.
+fn failure_law(p: &crate::model::PartProps, factor: f64) -> FailureLaw {
+    match p.failure_strain {
+        Some(eps) => FailureLaw {
+            strain: eps * factor,
+            rate_coefficient: p.failure_rate_coefficient.unwrap_or(0.0),
+            reference_rate: p.failure_reference_rate.unwrap_or(1.0),
+        },
+        None => FailureLaw::NONE,
+    }
+}
+
+impl TrussGroup {
+    /// The force pass of a group whose trusses can fail: a live truss whose strain has
+    /// reached its limit fails (no force from this step on; its strain energy is kept
+    /// in its fate), the others as [`force`].
+    fn forces_with_failure(&mut self, ctx: &ForceCtx, fe: &mut [[f64; 3]]) {
+        use rayon::prelude::*;
+        let (x, v) = (ctx.x, ctx.v);
+        let TrussGroup {
+            nodes,
+            k,
+            l0,
+            tension_only,
+            erosion,
+            ..
+        } = self;
+        let Erosion { law, fate, any, .. } = erosion;
+        let (nodes, k, l0, tension_only, law, any) =
+            (&*nodes, &*k, &*l0, &*tension_only, &*law, &*any);
+        let body = |(ci, (out, fates)): (usize, (&mut [[f64; 3]], &mut [Fate]))| {
+            let e0 = ci * CHUNK;
+            for (j, (pair, fate)) in out.chunks_exact_mut(2).zip(fates.iter_mut()).enumerate() {
+                let e = e0 + j;
+                if fate.eroded {
+                    pair[0] = [0.0; 3];
+                    pair[1] = [0.0; 3];
+                    continue;
+                }
+                let [a, b] = nodes[e];
+                let (a, b) = (a as usize, b as usize);
+                let lw = &law[e];
+                if lw.can_fail() {
+                    let (eps, rate) = strain_and_rate(&x[a], &x[b], &v[a], &v[b], l0[e]);
+                    let limit = lw.threshold(rate);
+                    if eps >= limit {
+                        // Its strain energy, and the half step of work its force would
+                        // have done (the central difference's trapezoid): what the
+                        // failure takes (see `failure::taken_energy`).
+                        let f2 = force(&x[a], &x[b], k[e], l0[e], tension_only[e]);
+                        let w = taken_energy(
+                            energy(&x[a], &x[b], k[e], l0[e], tension_only[e]),
+                            ctx.dt_prev,
+                            &[v[a], v[b]],
+                            &[[-f2[0], -f2[1], -f2[2]], f2],
+                        );
+                        fate.eroded = true;
+                        fate.energy = w;
+                        fate.fresh = Some(Failure {
+                            kind: ElementKind::Truss,
+                            element: e,
+                            criterion: Criterion::Axial,
+                            value: eps,
+                            limit,
+                            eroded: true,
+                            energy: w,
+                        });
+                        any.store(true, std::sync::atomic::Ordering::Relaxed);
+                        pair[0] = [0.0; 3];
+                        pair[1] = [0.0; 3];
+                        continue;
+                    }
+                }
+                let f2 = force(&x[a], &x[b], k[e], l0[e], tension_only[e]);
+                pair[0] = [-f2[0], -f2[1], -f2[2]];
+                pair[1] = f2;
+            }
+        };
+        if nodes.len() <= CHUNK {
+            fe.chunks_mut(2 * CHUNK)
+                .zip(fate.chunks_mut(CHUNK))
+                .enumerate()
+                .for_each(body);
+        } else {
+            fe.par_chunks_mut(2 * CHUNK)
+                .zip(fate.par_chunks_mut(CHUNK))
+                .enumerate()
+                .for_each(body);
+        }
+    }
 }
 
 impl Family for TrussGroup {
@@ -94,6 +209,7 @@ impl Family for TrussGroup {
         let Some(b) = m.block(ElementKind::Truss) else {
             return Ok(g);
         };
+        let mut laws = Vec::with_capacity(b.len());
         for e in 0..b.len() {
             let p = &m.parts[b.part[e]].props;
             let (a, c) = (b.nodes[2 * e], b.nodes[2 * e + 1]);
@@ -114,7 +230,9 @@ impl Family for TrussGroup {
             g.k.push(e_mod * area / lref);
             g.l0.push(lref);
             g.tension_only.push(p.tension_only.unwrap_or(false));
+            laws.push(failure_law(p, b.failure_factor(e)));
         }
+        g.erosion = Erosion::new(laws);
         Ok(g)
     }
     fn len(&self) -> usize {
@@ -130,6 +248,9 @@ impl Family for TrussGroup {
         self.k[e]
     }
     fn forces(&mut self, ctx: &ForceCtx, fe: &mut [[f64; 3]]) {
+        if self.erosion.active() {
+            return self.forces_with_failure(ctx, fe);
+        }
         let (g, x) = (&*self, ctx.x);
         for_chunks(fe, 2, g.id.len(), |ci, out| {
             let e0 = ci * CHUNK;
@@ -163,14 +284,30 @@ impl Family for TrussGroup {
     }
     fn energies(&mut self, ctx: &ForceCtx) -> &[EnergyPartial] {
         let (x, nodes, k, l0, to) = (ctx.x, &self.nodes, &self.k, &self.l0, &self.tension_only);
+        let er = &self.erosion;
         chunk_partials(&mut self.partials, nodes.len(), |r| {
             let mut e = 0.0;
             for i in r {
+                if !er.alive(i) {
+                    continue;
+                }
                 let [a, b] = nodes[i];
                 e += energy(&x[a as usize], &x[b as usize], k[i], l0[i], to[i]);
             }
             [e, 0.0, 0.0, 0.0]
         });
         &self.partials
+    }
+    fn collect_failures(&mut self, out: &mut Vec<Failure>) {
+        self.erosion.collect(out);
+    }
+    fn alive(&self, e: usize) -> bool {
+        self.erosion.alive(e)
+    }
+    fn eroded_energy(&self) -> f64 {
+        self.erosion.eroded_energy()
+    }
+    fn can_fail(&self) -> bool {
+        self.erosion.active()
     }
 }

@@ -88,6 +88,7 @@ pub enum Col {
     F64(&'static str, Vec<f64>),
     OptF64(&'static str, Vec<Option<f64>>),
     I64(&'static str, Vec<i64>),
+    OptI64(&'static str, Vec<Option<i64>>),
     Str(&'static str, Vec<String>),
     Bool(&'static str, Vec<bool>),
     OptBool(&'static str, Vec<Option<bool>>),
@@ -111,6 +112,10 @@ impl Col {
             ),
             Col::I64(n, v) => (
                 Field::new(n, DataType::Int64, false),
+                Arc::new(Int64Array::from(v)),
+            ),
+            Col::OptI64(n, v) => (
+                Field::new(n, DataType::Int64, true),
                 Arc::new(Int64Array::from(v)),
             ),
             Col::Str(n, v) => (
@@ -448,6 +453,26 @@ impl Table {
             .expect("cast to i64")
             .values()
             .to_vec())
+    }
+
+    /// An optional nullable integer column: `None` when the column is absent.
+    pub fn i64_opt(&self, col: &str) -> Result<Option<Vec<Option<i64>>>> {
+        let Some(a) = self.batch.column_by_name(col) else {
+            return Ok(None);
+        };
+        let c = self.cast(
+            col,
+            a,
+            &DataType::Int64,
+            "an integer column (Int64 or Int32)",
+        )?;
+        Ok(Some(
+            c.as_any()
+                .downcast_ref::<Int64Array>()
+                .expect("cast to i64")
+                .iter()
+                .collect(),
+        ))
     }
 
     /// A required, non-null string column.

@@ -1,6 +1,7 @@
 //! `elements_<kind>.parquet`, one table per element kind: element ids, parts and nodes,
 //! with the per-element columns some kinds carry (membranes' nodal thickness and initial
-//! stress, trusses' area, links' frame nodes).
+//! stress, trusses' area, links' frame nodes; any kind's failure-strain factor, layer and
+//! yarn).
 
 use super::codec::{Reading, Writing};
 use crate::error::{Result, WeftError};
@@ -39,6 +40,11 @@ struct ElementColumns {
     area: Option<Vec<Option<f64>>>,
     /// Links: the frame node columns f1…f4 as node indices; empty when the table has none.
     frame: Vec<Vec<usize>>,
+    /// Elements that can fail: `failure_strain_factor` (null: 1).
+    failure_factor: Option<Vec<Option<f64>>>,
+    /// `layer` and `yarn` (null: none).
+    layer: Option<Vec<Option<i64>>>,
+    yarn: Option<Vec<Option<i64>>>,
 }
 
 /// Reads every element table the folder has (refusing one of an unknown kind) into a
@@ -118,6 +124,9 @@ fn read_columns(r: &Reading, t: &Table, kind: ElementKind) -> Result<ElementColu
         stress0,
         area,
         frame,
+        failure_factor: t.f64_opt("failure_strain_factor")?,
+        layer: t.i64_opt("layer")?,
+        yarn: t.i64_opt("yarn")?,
     })
 }
 
@@ -223,6 +232,15 @@ fn block(r: &Reading, t: &Table, cols: &ElementColumns) -> Result<ElementBlock> 
         if !cols.frame.is_empty() {
             b.frame.push(std::array::from_fn(|k| cols.frame[k][row]));
         }
+        if let Some(c) = &cols.failure_factor {
+            b.failure_factor.push(c[row].unwrap_or(1.0));
+        }
+        if let Some(c) = &cols.layer {
+            b.layer.push(c[row]);
+        }
+        if let Some(c) = &cols.yarn {
+            b.yarn.push(c[row]);
+        }
     }
     Ok(b)
 }
@@ -264,6 +282,15 @@ pub fn write(m: &Model, w: &Writing) -> Result<()> {
                 let v: Vec<usize> = b.frame.iter().map(|f| f[j]).collect();
                 cols.push(Col::I64(c, ids(&v)));
             }
+        }
+        if !b.failure_factor.is_empty() {
+            cols.push(Col::F64("failure_strain_factor", b.failure_factor.clone()));
+        }
+        if !b.layer.is_empty() {
+            cols.push(Col::OptI64("layer", b.layer.clone()));
+        }
+        if !b.yarn.is_empty() {
+            cols.push(Col::OptI64("yarn", b.yarn.clone()));
         }
         w.table(&format!("elements_{}.parquet", kind.name()), &batch(cols))?;
     }

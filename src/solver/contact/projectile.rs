@@ -182,7 +182,7 @@ pub fn friction(n: &[f64; 3], fnorm: f64, vr: &[f64; 3], mu: f64) -> ([f64; 3], 
 
 use rayon::prelude::*;
 
-use crate::model::Model;
+use crate::model::{ElementKind, Model};
 use crate::solver::vec3::{add, dot};
 
 /// Skin of the projectile's list of nearby face triangles, as a fraction of its radius:
@@ -260,6 +260,14 @@ pub struct ProjectileContact {
     samples: Vec<SamplePoint>,
     /// Face triangles (quads split along both diagonals), for spherical noses.
     face_tris: Vec<FaceTri>,
+    /// Erosion: per face (the triangles' elements, then the quads'), its triangles
+    /// (first, end) in `face_tris` and its samples (centroid, then its edges') with its
+    /// mass; per triangle whether it is live, per sample how many live faces it samples.
+    n_tri_faces: usize,
+    face_tri_range: Vec<(u32, u32)>,
+    face_samples: Vec<([u32; 5], f64)>,
+    tri_alive: Vec<bool>,
+    sample_faces: Vec<u16>,
     /// Default penalty stiffness per node κ_c m/Δt² [N/m].
     k_node: Vec<f64>,
     /// Friction work dissipated in contact [J].
@@ -284,8 +292,12 @@ impl ProjectileContact {
         // depend on what lies beyond it (a symmetry plane, a free edge).
         let mut samples = Vec::new();
         let mut edge_at: std::collections::BTreeMap<(u32, u32), usize> = Default::default();
+        let mut face_samples = Vec::with_capacity(faces.len());
+        let mut sample_faces: Vec<u16> = Vec::new();
         for &(f, mf) in faces {
             let n = f.len();
+            let mut own = [u32::MAX; 5];
+            own[0] = samples.len() as u32;
             let mut nodes = [0u32; 4];
             nodes[..n].copy_from_slice(f);
             let mut w = [0.0; 4];
@@ -310,10 +322,18 @@ impl ProjectileContact {
                     samples.len() - 1
                 });
                 samples[k].mass += 0.5 * mf / n as f64;
+                own[1 + a] = k as u32;
+            }
+            face_samples.push((own, mf));
+            sample_faces.resize(samples.len(), 0);
+            for &k in own.iter().filter(|&&k| k != u32::MAX) {
+                sample_faces[k as usize] += 1;
             }
         }
         let mut face_tris = Vec::new();
+        let mut face_tri_range = Vec::with_capacity(faces.len());
         for &(f, m) in faces {
+            let first = face_tris.len() as u32;
             if f.len() == 3 {
                 face_tris.push(FaceTri {
                     nodes: [f[0], f[1], f[2]],
@@ -334,8 +354,15 @@ impl ProjectileContact {
                     });
                 }
             }
+            face_tri_range.push((first, face_tris.len() as u32));
         }
+        let n_tri_faces = faces.iter().take_while(|f| f.0.len() == 3).count();
         ProjectileContact {
+            n_tri_faces,
+            face_tri_range,
+            face_samples,
+            tri_alive: vec![true; face_tris.len()],
+            sample_faces,
             projectiles: m.projectiles.iter().map(Projectile::new).collect(),
             samples,
             face_tris,
@@ -351,6 +378,35 @@ impl ProjectileContact {
 
     pub fn is_empty(&self) -> bool {
         self.projectiles.is_empty()
+    }
+
+    /// Membrane element `e` of kind `kind` has failed: its face triangles and centroid
+    /// leave the projectiles' targets, its edges keep the mass of the faces still on them
+    /// and leave with the last.
+    pub fn erode(&mut self, kind: ElementKind, e: usize) {
+        let f = match kind {
+            ElementKind::Tri => e,
+            ElementKind::Quad => self.n_tri_faces + e,
+            _ => return,
+        };
+        let Some(&(first, end)) = self.face_tri_range.get(f) else {
+            return;
+        };
+        if !self.tri_alive[first as usize] {
+            return;
+        }
+        for t in first..end {
+            self.tri_alive[t as usize] = false;
+        }
+        let (own, mf) = self.face_samples[f];
+        let n = own[1..].iter().filter(|&&k| k != u32::MAX).count();
+        for (j, &k) in own.iter().enumerate().filter(|(_, &k)| k != u32::MAX) {
+            let k = k as usize;
+            self.sample_faces[k] -= 1;
+            if j > 0 {
+                self.samples[k].mass -= 0.5 * mf / n as f64;
+            }
+        }
     }
 
     /// Node penalties κ_c m_i/Δt², once the step is known.
@@ -414,11 +470,14 @@ impl ProjectileContact {
                 // whatever the threads; measured, this loop alone was ~3 % of a woven
                 // impact's CPU time and ran on one thread).
                 let pp = &*p;
-                let tris = &self.face_tris;
+                let (tris, tri_alive) = (&self.face_tris, &self.tri_alive);
                 let hits: Vec<(u32, [f64; 3], [f64; 3], f64, f64)> = self.near[k]
                     .par_iter()
                     .with_min_len(256)
                     .filter_map(|&ti| {
+                        if !tri_alive[ti as usize] {
+                            return None;
+                        }
                         sphere_face(pp, &c, &tris[ti as usize], x, dt2)
                             .map(|(w, n, g, kp)| (ti, w, n, g, kp))
                     })
@@ -444,7 +503,10 @@ impl ProjectileContact {
                     ftot = [ftot[0] - f[0], ftot[1] - f[1], ftot[2] - f[2]];
                 }
             } else if p.segments {
-                for sp in &self.samples {
+                for (sp, &live) in self.samples.iter().zip(&self.sample_faces) {
+                    if live == 0 {
+                        continue;
+                    }
                     let nodes = &sp.nodes[..sp.n];
                     let pos: [f64; 3] = std::array::from_fn(|d| {
                         (0..sp.n).map(|a| sp.w[a] * x[nodes[a] as usize][d]).sum()
@@ -567,8 +629,12 @@ impl ProjectileContact {
                 let terms: Vec<f64> = self
                     .face_tris
                     .par_iter()
+                    .zip(self.tri_alive.par_iter())
                     .with_min_len(4096)
-                    .filter_map(|t| {
+                    .filter_map(|(t, &live)| {
+                        if !live {
+                            return None;
+                        }
                         sphere_face(p, &c, t, x, dt2).map(|(_, _, g, kp)| 0.5 * kp * g.powi(2))
                     })
                     .collect();
@@ -577,7 +643,10 @@ impl ProjectileContact {
                 }
                 continue;
             }
-            for sp in &self.samples {
+            for (sp, &live) in self.samples.iter().zip(&self.sample_faces) {
+                if live == 0 {
+                    continue;
+                }
                 let nodes = &sp.nodes[..sp.n];
                 let pos: [f64; 3] = std::array::from_fn(|d| {
                     (0..sp.n).map(|a| sp.w[a] * x[nodes[a] as usize][d]).sum()
@@ -625,8 +694,10 @@ impl ProjectileContact {
                     }
                 });
                 let vn: [f64; 3] = std::array::from_fn(|d| p.v[d] + 0.5 * dt_prev * a[d]);
-                ke += 0.5 * p.mass * dot(&vn, &vn);
-                p.v = std::array::from_fn(|d| vn[d] + 0.5 * dt_next * a[d]);
+                let v_new: [f64; 3] = std::array::from_fn(|d| vn[d] + 0.5 * dt_next * a[d]);
+                // ½ M v^{n−½}·v^{n+½}, as the nodes' (`integrator::advance_nodes`).
+                ke += 0.5 * p.mass * dot(&p.v, &v_new);
+                p.v = v_new;
                 p.v_full = vn;
             }
             for d in 0..3 {

@@ -316,17 +316,28 @@ impl Side {
         // was within this of it per component at the build (see `super::staleness`).
         let r = 0.5 * self.slave_t_max + skin + self.box_margin;
         let nf = self.nf;
-        let boxes: Vec<([f64; 3], [f64; 3])> = self
-            .face_box
-            .par_iter()
-            .map(|b| {
-                (
-                    [b[0] - r, b[1] - r, b[2] - r],
-                    [b[3] + r, b[4] + r, b[5] + r],
-                )
-            })
-            .collect();
+        // Eroded faces stay out of the grid: it lists the live ones, `live` maps its
+        // entries back to face indices (in face order, so the candidates keep it).
+        let live: Option<Vec<u32>> = (self.dead_faces > 0).then(|| {
+            (0..self.faces.len() as u32)
+                .filter(|&f| self.face_alive[f as usize])
+                .collect()
+        });
+        let inflate = |b: &[f64; 8]| {
+            (
+                [b[0] - r, b[1] - r, b[2] - r],
+                [b[3] + r, b[4] + r, b[5] + r],
+            )
+        };
+        let boxes: Vec<([f64; 3], [f64; 3])> = match &live {
+            None => self.face_box.par_iter().map(inflate).collect(),
+            Some(l) => l
+                .iter()
+                .map(|&f| inflate(&self.face_box[f as usize]))
+                .collect(),
+        };
         let grid = Grid::new(&boxes);
+        let to_face = |g: u32| live.as_ref().map_or(g, |l| l[g as usize]);
         // Candidates: count, then fill, each in parallel over fixed slave chunks.
         let faces = &self.faces;
         let slaves = &self.slaves;
@@ -338,7 +349,8 @@ impl Side {
             let s = slaves[si];
             let p = &x[s as usize];
             let mut near = f64::INFINITY;
-            for &fi in grid.cell_of(p) {
+            for &gi in grid.cell_of(p) {
+                let fi = to_face(gi);
                 // (The inflated box, as `boxes` holds it.)
                 let b = &face_box[fi as usize];
                 if (0..3).all(|d| p[d] >= b[d] - r && p[d] <= b[d + 3] + r)

@@ -86,7 +86,7 @@ use super::projectile::PENALTY_FACTOR;
 use super::staleness::Staleness;
 use crate::error::{Result, WeftError};
 use crate::model::contacts::{InitialPenetration, Slave};
-use crate::model::Model;
+use crate::model::{ElementKind, Model};
 use crate::solver::vec3::add;
 pub use kernels::{pair_force, thickness_gradient, Friction, SlaveState, MAX_THICKNESS_GRADIENT};
 use side::{part_nodes, ChunkSums};
@@ -293,6 +293,14 @@ impl SurfaceContact {
 
     pub fn is_empty(&self) -> bool {
         self.sides.is_empty()
+    }
+
+    /// Element `e` of kind `kind` has failed: its faces (or segments) leave every side
+    /// whose master surface they belong to.
+    pub fn erode(&mut self, kind: ElementKind, e: usize) {
+        for s in self.sides.iter_mut().filter(|s| s.master_kind == kind) {
+            s.erode(e);
+        }
     }
 
     /// Normal viscous damping ζ (fraction of critical) on every pair of every side.

@@ -13,6 +13,19 @@ use crate::solver::contact::projectile::PENALTY_FACTOR;
 /// Slaves per parallel chunk of the narrow phase.
 pub(super) const SLAVE_CHUNK: usize = 256;
 
+/// The thickness box of an eroded face: lo = +∞, hi = −∞ and envelope bounds −∞, so that
+/// every box test and envelope filter rejects it.
+pub(super) const DEAD_BOX: [f64; 8] = [
+    f64::INFINITY,
+    f64::INFINITY,
+    f64::INFINITY,
+    f64::NEG_INFINITY,
+    f64::NEG_INFINITY,
+    f64::NEG_INFINITY,
+    f64::NEG_INFINITY,
+    f64::NEG_INFINITY,
+];
+
 /// Round-off allowance of the thickness-box tests relative to the largest coordinate of a
 /// side's nodes: its foot and box are computed within ~10⁻¹⁵ of that.
 const BOX_MARGIN: f64 = 1e-9;
@@ -58,6 +71,14 @@ pub struct Side {
     /// contact point, continuous from face to face).
     pub(super) face_m: Vec<[f64; 4]>,
     pub face_id: Vec<i64>,
+    /// The kind of the master part's elements, and each face's element (its index in the
+    /// model's block of that kind, ascending).
+    pub master_kind: ElementKind,
+    pub(super) face_elem: Vec<u32>,
+    /// Per face, whether its element is still in the model; an eroded face has an empty
+    /// thickness box (no slave passes its box test) and leaves the grid at the next build.
+    pub(super) face_alive: Vec<bool>,
+    pub(super) dead_faces: usize,
     pub(super) friction: Friction,
     pub(super) kappa: f64,
     /// Normal viscous damping as a fraction ζ of the pair's critical damping
@@ -214,6 +235,7 @@ struct MasterFaces {
     face_t: Vec<[f64; 4]>,
     face_m: Vec<[f64; 4]>,
     face_id: Vec<i64>,
+    face_elem: Vec<u32>,
 }
 
 impl MasterFaces {
@@ -231,6 +253,7 @@ impl MasterFaces {
             face_t: vec![],
             face_m: vec![],
             face_id: vec![],
+            face_elem: vec![],
         };
         for e in 0..b.len() {
             if b.part[e] != master {
@@ -254,6 +277,7 @@ impl MasterFaces {
             mf.face_t.push(t);
             mf.face_m.push(fm);
             mf.face_id.push(b.id[e]);
+            mf.face_elem.push(e as u32);
         }
         mf
     }
@@ -282,6 +306,7 @@ impl Side {
             face_t,
             face_m,
             face_id,
+            face_elem,
         } = MasterFaces::new(m, d, master, mass);
         let ts_max = slave_t.iter().cloned().fold(0.0, f64::max);
         let tf_max = face_t.iter().flatten().cloned().fold(0.0, f64::max);
@@ -312,6 +337,10 @@ impl Side {
             face_t,
             face_m,
             face_id,
+            master_kind: m.parts[master].kind,
+            face_alive: vec![true; face_elem.len()],
+            face_elem,
+            dead_faces: 0,
             friction: Friction {
                 mu_s: d.static_friction,
                 mu_d: d.dynamic_friction,
@@ -355,16 +384,31 @@ impl Side {
     /// those gathers were ~40 % of the narrow phase of the woven patch).
     pub(super) fn update_boxes(&mut self, x: &[[f64; 3]]) {
         let (faces, face_t, nf) = (&self.faces, &self.face_t, self.nf);
-        let dirs = &self.face_dir;
+        let (dirs, alive, any_dead) = (&self.face_dir, &self.face_alive, self.dead_faces > 0);
         self.face_box
             .par_chunks_mut(4096)
             .enumerate()
             .for_each(|(c, bs)| {
                 for (j, b) in bs.iter_mut().enumerate() {
                     let fi = c * 4096 + j;
-                    *b = thickness_box(&faces[fi], &face_t[fi], &dirs[fi], nf, x);
+                    *b = if any_dead && !alive[fi] {
+                        DEAD_BOX
+                    } else {
+                        thickness_box(&faces[fi], &face_t[fi], &dirs[fi], nf, x)
+                    };
                 }
             });
+    }
+
+    /// The face of element `e` (of the master's kind) leaves the surface.
+    pub(super) fn erode(&mut self, e: usize) {
+        if let Ok(f) = self.face_elem.binary_search(&(e as u32)) {
+            if self.face_alive[f] {
+                self.face_alive[f] = false;
+                self.face_box[f] = DEAD_BOX;
+                self.dead_faces += 1;
+            }
+        }
     }
 
     /// The directions of the faces' envelope bounds at `x`, then their bounds (at a broad
@@ -380,6 +424,7 @@ impl Side {
             return;
         }
         // (The boxes are up to date: only the bounds along the new directions change.)
+        let (alive, any_dead) = (&self.face_alive, self.dead_faces > 0);
         self.face_dir
             .par_chunks_mut(4096)
             .zip(self.face_box.par_chunks_mut(4096))
@@ -387,6 +432,9 @@ impl Side {
             .for_each(|(c, (ds, bs))| {
                 for (j, (d, b)) in ds.iter_mut().zip(bs.iter_mut()).enumerate() {
                     let fi = c * 4096 + j;
+                    if any_dead && !alive[fi] {
+                        continue;
+                    }
                     *d = envelope_directions(&faces[fi], &face_t[fi], nf, x);
                     let fb = thickness_box(&faces[fi], &face_t[fi], d, nf, x);
                     (b[6], b[7]) = (fb[6], fb[7]);
