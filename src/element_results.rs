@@ -394,4 +394,7 @@ impl<S: Sink> Sink for WithElementResults<'_, S> {
     fn projectile(&mut self, t: f64, id: i64, state: &[f64; 9]) -> Result<()> {
         self.inner.projectile(t, id, state)
     }
+    fn layers(&mut self, t: f64, rows: &[crate::solver::watch::LayerValues]) -> Result<()> {
+        self.inner.layers(t, rows)
+    }
 }

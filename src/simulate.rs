@@ -41,6 +41,13 @@ pub struct Config {
     /// every part); empty: no element results.
     #[serde(default)]
     pub element_results: Vec<String>,
+    /// The striking speed of every projectile [m/s], along its velocity's direction (or
+    /// its axis when it starts at rest): one model, many impacts (a ballistic sweep).
+    #[serde(default)]
+    pub projectile_velocity: Option<f64>,
+    /// End the run once the projectile's outcome is decided (analysis `stop_on_outcome`).
+    #[serde(default)]
+    pub stop_on_outcome: Option<bool>,
 }
 
 /// What a run reports back to the binary.
@@ -55,6 +62,9 @@ pub struct Report {
     pub out: PathBuf,
     /// Contact between parts (`contacts.parquet`), when the model has some.
     pub contact: Option<crate::solver::contact::ContactReport>,
+    /// A line on failures and the projectile's outcome, when the model can fail or has
+    /// fabric layers and a projectile.
+    pub ballistic: Option<String>,
 }
 
 /// Apply command-line overrides to a model's analysis settings.
@@ -84,6 +94,39 @@ pub fn apply_overrides(m: &mut Model, c: &Config) {
     if let Some(v) = c.max_energy_error {
         a.max_energy_error = v;
     }
+    if let Some(v) = c.stop_on_outcome {
+        a.stop_on_outcome = v;
+    }
+    if let Some(speed) = c.projectile_velocity {
+        for p in &mut m.projectiles {
+            let v = p.velocity;
+            let n = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+            let dir = if n > 0.0 {
+                [v[0] / n, v[1] / n, v[2] / n]
+            } else {
+                p.axis
+            };
+            p.velocity = [speed * dir[0], speed * dir[1], speed * dir[2]];
+        }
+    }
+}
+
+/// Checks the overrides that have no home in the model's own validation.
+fn check_overrides(m: &Model, c: &Config) -> Result<()> {
+    if let Some(v) = c.projectile_velocity {
+        if !(v.is_finite() && v >= 0.0) {
+            return Err(WeftError::input(format!("--projectile-velocity = `{v}`"))
+                .expected("a striking speed ≥ 0 in m/s"));
+        }
+        if m.projectiles.is_empty() {
+            return Err(WeftError::input(format!(
+                "--projectile-velocity {v} for a model without a projectile"
+            ))
+            .in_file(c.model.join("projectile.parquet"))
+            .expected("a model with a projectile (weft-weave woven or woven-reduced)"));
+        }
+    }
+    Ok(())
 }
 
 /// Human-readable name of the element controlling the step.
@@ -102,6 +145,7 @@ pub const DEFAULT_MAX_STEPS: u64 = 1_000_000_000;
 pub fn run(c: &Config, progress: &mut (dyn FnMut(f64) + Send)) -> Result<Report> {
     let t_setup = Instant::now();
     let mut m = read_model(&c.model)?;
+    check_overrides(&m, c)?;
     apply_overrides(&mut m, c);
     m.validate()?;
     let threads = c.threads.unwrap_or(0);
@@ -153,26 +197,35 @@ pub fn run(c: &Config, progress: &mut (dyn FnMut(f64) + Send)) -> Result<Report>
     }
     let setup = t_setup.elapsed();
     let sink = ParquetSink::create(&c.out, solver.node_id.clone(), &prov)?;
-    let (sink, mut stats) = match elements.as_mut() {
+    let (sink, result) = match elements.as_mut() {
         Some(results) => {
             let mut w = WithElementResults {
                 inner: sink,
                 results,
             };
-            let stats = pool.install(|| solver.run(&mut w, progress))?;
-            (w.inner, stats)
+            let r = pool.install(|| solver.run(&mut w, progress));
+            (w.inner, r)
         }
         None => {
             let mut sink = sink;
-            let stats = pool.install(|| solver.run(&mut sink, progress))?;
-            (sink, stats)
+            let r = pool.install(|| solver.run(&mut sink, progress));
+            (sink, r)
         }
+    };
+    // A run that stops (NaN, instability, energy error, a step guard) keeps what it
+    // computed: the tables up to the last good output sample, `status = stopped` and the
+    // reason in the summary, and the error still returned (a non-zero exit code).
+    let (mut stats, stopped) = match result {
+        Ok(st) => (st, None),
+        Err(e @ WeftError::Numerical { .. }) => (solver.stats_so_far(), Some(e)),
+        Err(e) => return Err(e),
     };
     stats.threads = pool.current_num_threads();
     stats.times.setup = setup;
     let t_write = Instant::now();
     sink.finish(&c.out, &prov)?;
     write_element_results(&c.out, elements, &prov)?;
+    write_failures(&c.out, &m, &solver, &prov)?;
     stats.times.output += t_write.elapsed();
     let sc = solver.scaling.clone().unwrap_or_default();
     let report = Report {
@@ -184,10 +237,132 @@ pub fn run(c: &Config, progress: &mut (dyn FnMut(f64) + Send)) -> Result<Report>
         out: c.out.clone(),
         contact: (!solver.op.surfaces.is_empty())
             .then(|| solver.op.surfaces.report(&solver.node_id)),
+        ballistic: ballistic_line(&solver),
         stats,
     };
-    write_summary(&c.out, &report, &solver, &prov)?;
+    let status = match &stopped {
+        None => Status::Completed,
+        Some(e) => Status::Stopped(e.to_string()),
+    };
+    write_summary(&c.out, &report, &solver, &m, &status, &prov)?;
+    if let Some(e) = stopped {
+        return Err(e.context(format!(
+            "the run stopped; the tables up to t = {:.6e} s are in `{}` (status = stopped in summary.parquet)",
+            report.stats.end_time,
+            c.out.display()
+        )));
+    }
     Ok(report)
+}
+
+/// The line the binary prints on failures and the outcome.
+fn ballistic_line(s: &Solver) -> Option<String> {
+    use crate::solver::watch::Outcome;
+    let w = &s.watch;
+    if !s.failures.active && !(w.n_layers > 0 && w.axis().is_some()) {
+        return None;
+    }
+    let eroded = s
+        .failures
+        .events
+        .iter()
+        .filter(|e| e.failure.eroded)
+        .count();
+    let broken: u32 = (1..=w.n_layers).map(|l| w.counts(l).1).sum();
+    let outcome = match w.outcome {
+        Outcome::Undecided => "outcome undecided at the end time".to_string(),
+        Outcome::Arrested { time } => format!("projectile arrested at {time:.4e} s"),
+        Outcome::Perforated {
+            time,
+            residual_velocity,
+        } => format!("perforated at {time:.4e} s, residual velocity {residual_velocity:.2} m/s"),
+    };
+    Some(format!(
+        "failures: {eroded} elements, {broken} yarns broken over {} layers; {outcome}; back-face deflection peak {:.3e} m",
+        w.n_layers, w.back_face_peak
+    ))
+}
+
+/// How a run ended.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Status {
+    Completed,
+    /// Stopped by the solver, with the reason.
+    Stopped(String),
+}
+
+/// `failures.parquet`: one row per failure, in the order they happened, when the model
+/// can fail; otherwise a stale one from an earlier run into the same folder is removed.
+fn write_failures(out: &Path, m: &Model, s: &Solver, prov: &Provenance) -> Result<()> {
+    let path = out.join("failures.parquet");
+    if !s.failures.active {
+        if path.exists() {
+            std::fs::remove_file(&path).map_err(|e| WeftError::io(&path, e))?;
+        }
+        return Ok(());
+    }
+    let ev = &s.failures.events;
+    // Each failure's element row in its table: the family's index for trusses and
+    // membranes, the id's row for links (their families split the link table).
+    let row = |e: &crate::solver::failure::FailureEvent| -> Option<usize> {
+        let b = m.block(e.failure.kind)?;
+        if e.failure.kind == crate::model::ElementKind::Link {
+            b.id.iter().position(|&i| i == e.id)
+        } else {
+            Some(e.failure.element)
+        }
+    };
+    let rows: Vec<Option<usize>> = ev.iter().map(row).collect();
+    let block = |e: &crate::solver::failure::FailureEvent| m.block(e.failure.kind);
+    write_table(
+        &path,
+        &batch(vec![
+            Col::F64("t", ev.iter().map(|e| e.time).collect()),
+            Col::I64("step", ev.iter().map(|e| e.step as i64).collect()),
+            Col::Str(
+                "element_kind",
+                ev.iter()
+                    .map(|e| e.failure.kind.name().to_string())
+                    .collect(),
+            ),
+            Col::I64("element_id", ev.iter().map(|e| e.id).collect()),
+            Col::Str(
+                "part",
+                ev.iter()
+                    .zip(&rows)
+                    .map(|(e, r)| {
+                        r.and_then(|r| block(e).map(|b| m.parts[b.part[r]].name.clone()))
+                            .unwrap_or_default()
+                    })
+                    .collect(),
+            ),
+            Col::OptI64(
+                "layer",
+                ev.iter()
+                    .zip(&rows)
+                    .map(|(e, r)| r.and_then(|r| block(e)?.layer_of(r)))
+                    .collect(),
+            ),
+            Col::OptI64(
+                "yarn",
+                ev.iter()
+                    .zip(&rows)
+                    .map(|(e, r)| r.and_then(|r| block(e)?.yarn_of(r)))
+                    .collect(),
+            ),
+            Col::Str(
+                "criterion",
+                ev.iter()
+                    .map(|e| e.failure.criterion.name().to_string())
+                    .collect(),
+            ),
+            Col::F64("value", ev.iter().map(|e| e.failure.value).collect()),
+            Col::F64("limit", ev.iter().map(|e| e.failure.limit).collect()),
+            Col::Bool("eroded", ev.iter().map(|e| e.failure.eroded).collect()),
+            Col::F64("energy", ev.iter().map(|e| e.failure.energy).collect()),
+        ]),
+        prov,
+    )
 }
 
 /// `elements.parquet` when element results were asked for; otherwise a stale one from
@@ -268,73 +443,163 @@ fn run_static(
         added_fraction: 0.0,
         out: c.out.clone(),
         contact: None,
+        ballistic: None,
     })
 }
 
 /// `summary.parquet`: one row describing the run. Written last, so its presence means
 /// the run completed.
-pub fn write_summary(out: &Path, r: &Report, s: &Solver, prov: &Provenance) -> Result<()> {
+pub fn write_summary(
+    out: &Path,
+    r: &Report,
+    s: &Solver,
+    m: &Model,
+    status: &Status,
+    prov: &Provenance,
+) -> Result<()> {
     let st = &r.stats;
+    let mut cols = run_columns(r, s, st);
+    cols.extend(ballistic_columns(s, m, status));
+    write_table(&out.join("summary.parquet"), &batch(cols), prov)
+}
+
+/// The summary's columns about the run itself: step, controlling element, masses, sizes,
+/// wall times, contact, throughput, balance.
+fn run_columns(r: &Report, s: &Solver, st: &RunStats) -> Vec<Col> {
     let (kind, id) = match s.stable.element {
         Some((k, id)) => (k.name().to_string(), id),
         None => (String::new(), -1),
     };
     let sc = s.scaling.clone();
-    write_table(
-        &out.join("summary.parquet"),
-        &batch(vec![
-            Col::Str("analysis", vec!["explicit".into()]),
-            Col::I64("steps", vec![st.steps as i64]),
-            Col::F64("end_time", vec![st.end_time]),
-            Col::F64("dt", vec![r.dt]),
-            Col::F64("dt_stable", vec![r.dt_stable]),
-            Col::Str("controlling_kind", vec![kind]),
-            Col::I64("controlling_element", vec![id]),
-            Col::I64("controlling_node", vec![s.node_id[s.stable.node]]),
-            Col::OptF64(
-                "dt_stable_unscaled",
-                vec![sc.as_ref().map(|x| x.dt_stable_unscaled)],
-            ),
-            Col::F64("added_mass", vec![r.added_mass]),
-            Col::F64("added_mass_fraction", vec![r.added_fraction]),
-            Col::F64("model_mass", vec![s.physical_mass]),
-            Col::I64("nodes", vec![st.nodes as i64]),
-            Col::I64("elements", vec![st.elements as i64]),
-            Col::I64("threads", vec![st.threads as i64]),
-            Col::F64("wall_time_setup", vec![st.times.setup.as_secs_f64()]),
-            Col::F64("wall_time_loads", vec![st.times.loads.as_secs_f64()]),
-            Col::F64("wall_time_forces", vec![st.times.forces.as_secs_f64()]),
-            Col::F64("wall_time_update", vec![st.times.update.as_secs_f64()]),
-            Col::F64("wall_time_output", vec![st.times.output.as_secs_f64()]),
-            Col::F64("wall_time_contact", vec![st.times.contact.as_secs_f64()]),
-            Col::I64(
-                "contact_builds",
-                vec![r.contact.as_ref().map_or(0, |c| c.builds as i64)],
-            ),
-            Col::I64(
-                "contact_active",
-                vec![r.contact.as_ref().map_or(0, |c| c.active as i64)],
-            ),
-            Col::I64(
-                "initial_penetrations",
-                vec![r
-                    .contact
-                    .as_ref()
-                    .map_or(0, |c| c.initial_penetrations as i64)],
-            ),
-            Col::OptF64(
-                "max_initial_penetration",
-                vec![r.contact.as_ref().and_then(|c| c.deepest.map(|d| d.3))],
-            ),
-            Col::F64(
-                "element_updates_per_second",
-                vec![st.element_updates_per_second()],
-            ),
-            Col::F64(
-                "max_balance_error_relative",
-                vec![st.max_balance_error_relative],
-            ),
-        ]),
-        prov,
-    )
+    vec![
+        Col::Str("analysis", vec!["explicit".into()]),
+        Col::I64("steps", vec![st.steps as i64]),
+        Col::F64("end_time", vec![st.end_time]),
+        Col::F64("dt", vec![r.dt]),
+        Col::F64("dt_stable", vec![r.dt_stable]),
+        Col::Str("controlling_kind", vec![kind]),
+        Col::I64("controlling_element", vec![id]),
+        Col::I64("controlling_node", vec![s.node_id[s.stable.node]]),
+        Col::OptF64(
+            "dt_stable_unscaled",
+            vec![sc.as_ref().map(|x| x.dt_stable_unscaled)],
+        ),
+        Col::F64("added_mass", vec![r.added_mass]),
+        Col::F64("added_mass_fraction", vec![r.added_fraction]),
+        Col::F64("model_mass", vec![s.physical_mass]),
+        Col::I64("nodes", vec![st.nodes as i64]),
+        Col::I64("elements", vec![st.elements as i64]),
+        Col::I64("threads", vec![st.threads as i64]),
+        Col::F64("wall_time_setup", vec![st.times.setup.as_secs_f64()]),
+        Col::F64("wall_time_loads", vec![st.times.loads.as_secs_f64()]),
+        Col::F64("wall_time_forces", vec![st.times.forces.as_secs_f64()]),
+        Col::F64("wall_time_update", vec![st.times.update.as_secs_f64()]),
+        Col::F64("wall_time_output", vec![st.times.output.as_secs_f64()]),
+        Col::F64("wall_time_contact", vec![st.times.contact.as_secs_f64()]),
+        Col::I64(
+            "contact_builds",
+            vec![r.contact.as_ref().map_or(0, |c| c.builds as i64)],
+        ),
+        Col::I64(
+            "contact_active",
+            vec![r.contact.as_ref().map_or(0, |c| c.active as i64)],
+        ),
+        Col::I64(
+            "initial_penetrations",
+            vec![r
+                .contact
+                .as_ref()
+                .map_or(0, |c| c.initial_penetrations as i64)],
+        ),
+        Col::OptF64(
+            "max_initial_penetration",
+            vec![r.contact.as_ref().and_then(|c| c.deepest.map(|d| d.3))],
+        ),
+        Col::F64(
+            "element_updates_per_second",
+            vec![st.element_updates_per_second()],
+        ),
+        Col::F64(
+            "max_balance_error_relative",
+            vec![st.max_balance_error_relative],
+        ),
+    ]
+}
+
+/// The summary's columns about how the run ended and what an armour engineer reads:
+/// status and stop reason; the first projectile's striking velocity, outcome, residual
+/// velocity, mass and radius (null without a projectile); the layers, failures, broken
+/// yarns, back-face deflection peak and energy absorbed (docs/tables.md).
+fn ballistic_columns(s: &Solver, m: &Model, status: &Status) -> Vec<Col> {
+    use crate::solver::watch::Outcome;
+    let w = &s.watch;
+    let p = m.projectiles.first();
+    let speed = |v: &[f64; 3]| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+    let (outcome, perforated, residual, when) = match (p, w.outcome) {
+        (None, _) => (None, None, None, None),
+        (Some(_), Outcome::Undecided) => (Some("undecided"), Some(false), None, None),
+        (Some(_), Outcome::Arrested { time }) => {
+            (Some("arrested"), Some(false), Some(0.0), Some(time))
+        }
+        (
+            Some(_),
+            Outcome::Perforated {
+                time,
+                residual_velocity,
+            },
+        ) => (
+            Some("perforated"),
+            Some(true),
+            Some(residual_velocity),
+            Some(time),
+        ),
+    };
+    let layered = w.n_layers > 0;
+    let first_failure = s
+        .failures
+        .events
+        .iter()
+        .find(|e| e.failure.eroded)
+        .map(|e| e.time);
+    let eroded = s
+        .failures
+        .events
+        .iter()
+        .filter(|e| e.failure.eroded)
+        .count();
+    let broken: u32 = (1..=w.n_layers).map(|l| w.counts(l).1).sum();
+    let absorbed: f64 = w.last_rows.iter().map(|r| r[4]).sum();
+    vec![
+        Col::Str(
+            "status",
+            vec![match status {
+                Status::Completed => "completed",
+                Status::Stopped(_) => "stopped",
+            }
+            .into()],
+        ),
+        Col::OptStr(
+            "stop_reason",
+            vec![match status {
+                Status::Completed => None,
+                Status::Stopped(why) => Some(why.clone()),
+            }],
+        ),
+        Col::OptF64("striking_velocity", vec![p.map(|p| speed(&p.velocity))]),
+        Col::OptStr("outcome", vec![outcome.map(String::from)]),
+        Col::OptBool("perforated", vec![perforated]),
+        Col::OptF64("residual_velocity", vec![residual]),
+        Col::OptF64("outcome_time", vec![when]),
+        Col::OptF64("projectile_mass", vec![p.map(|p| p.mass)]),
+        Col::OptF64("projectile_radius", vec![p.map(|p| p.radius)]),
+        Col::I64("layers", vec![w.n_layers as i64]),
+        Col::I64("failed_elements", vec![eroded as i64]),
+        Col::OptI64("broken_yarns", vec![layered.then_some(broken as i64)]),
+        Col::OptF64("first_failure_time", vec![first_failure]),
+        Col::OptF64(
+            "back_face_deflection_peak",
+            vec![layered.then_some(w.back_face_peak)],
+        ),
+        Col::OptF64("energy_absorbed", vec![layered.then_some(absorbed)]),
+    ]
 }

@@ -75,6 +75,7 @@ fn sheet(x0: f64, y0: f64, l: f64, n: usize, mass: f64, quarter: bool) -> Model 
         prescribed_velocity: false,
         contact_stiffness: None,
         friction: 0.0,
+        contact_damping: 0.0,
         segment_contact: true,
     });
     m.analysis.end_time = 40e-6;

@@ -92,6 +92,7 @@ fn smith_transverse_impact_strain_and_kink_speed() {
         prescribed_velocity: true,
         contact_stiffness: None,
         friction: 0.0,
+        contact_damping: 0.0,
         segment_contact: true,
     });
     let t_end = 20e-6;
@@ -150,6 +151,7 @@ fn free_projectile_on_a_pinned_string_conserves_momentum_and_energy() {
         prescribed_velocity: false,
         contact_stiffness: None,
         friction: 0.2,
+        contact_damping: 0.0,
         segment_contact: true,
     });
     // Until the longitudinal wave reaches the pinned ends, nothing outside acts.
@@ -224,6 +226,7 @@ fn coarse_sheet(segments: bool) -> Model {
         prescribed_velocity: false,
         contact_stiffness: None,
         friction: 0.0,
+        contact_damping: 0.0,
         segment_contact: segments,
     });
     m.analysis.end_time = 30e-6;

@@ -345,6 +345,7 @@ fn smith_transverse_impact_of_a_band() {
         prescribed_velocity: true,
         contact_stiffness: None,
         friction: 0.0,
+        contact_damping: 0.0,
         segment_contact: true,
     });
     let t_end = 20e-6;

@@ -17,8 +17,12 @@ use weft::simulate::{run, Config};
                   history.parquet (displacements and velocities on the output time grid), energy.parquet \
                   (energy balance) and summary.parquet (time step, controlling element, wall times) into --out.\n\n\
                   Analysis settings come from the model's analysis.parquet; the flags below override them. \
-                  Tables appear only when the run completes; a NaN or an energy blow-up stops the run with \
-                  the step, time, node and element.\n\nExample:\n  weft-weave rod --out runs/rod && weft-simulate --model runs/rod --out runs/rod-out"
+                  A model whose elements can fail also gets failures.parquet (one row per failure); a model \
+                  with fabric layers and a projectile gets ballistic.parquet (energies, failures and \
+                  deflection per layer against time) and the outcome (perforated or arrested, the residual \
+                  velocity) in summary.parquet. A NaN, an instability or an energy blow-up stops the run \
+                  with the step, time, node and element: the tables up to the last good output sample are \
+                  written with status = stopped in summary.parquet, and the exit code is 1.\n\nExample:\n  weft-weave rod --out runs/rod && weft-simulate --model runs/rod --out runs/rod-out"
 )]
 struct Cli {
     /// Model folder (from weft-weave or written by hand).
@@ -68,6 +72,14 @@ struct Cli {
     /// the element that sets the step (like LS-DYNA's minimum step DTMIN).
     #[arg(long, default_value_t = weft::simulate::DEFAULT_MAX_STEPS)]
     max_steps: u64,
+    /// Striking speed of the projectile [m/s] along its direction: one model folder, many
+    /// impacts (a ballistic-limit sweep).
+    #[arg(long)]
+    projectile_velocity: Option<f64>,
+    /// End the run at the output sample where the projectile's outcome is decided
+    /// (arrested, or perforated and free of the fabric) instead of at the end time.
+    #[arg(long)]
+    stop_on_outcome: bool,
     /// Linear static solve (K u = F with the load amplitudes) instead of the explicit run:
     /// history.parquet gets one sample at t = 0.
     #[arg(long = "static")]
@@ -103,6 +115,8 @@ fn run_cli() -> anyhow::Result<ExitCode> {
         max_steps: Some(cli.max_steps),
         static_solve: cli.static_solve,
         element_results: cli.element_results.clone(),
+        projectile_velocity: cli.projectile_velocity,
+        stop_on_outcome: cli.stop_on_outcome.then_some(true),
     };
     let progress = Progress::new(
         cli.quiet,
@@ -111,13 +125,7 @@ fn run_cli() -> anyhow::Result<ExitCode> {
     );
     let res = run(&cfg, &mut progress.fraction());
     progress.finish();
-    let r = res.with_context(|| {
-        format!(
-            "simulate `{}` failed; no new tables were written to `{}`",
-            cli.model.display(),
-            cli.out.display()
-        )
-    })?;
+    let r = res.with_context(|| format!("simulate `{}` failed", cli.model.display()))?;
     if cli.static_solve {
         eprintln!("  wrote {}/{{history,summary}}.parquet", r.out.display());
         return Ok(ExitCode::SUCCESS);
@@ -155,9 +163,15 @@ fn run_cli() -> anyhow::Result<ExitCode> {
             );
         }
     }
+    if let Some(b) = &r.ballistic {
+        eprintln!("  {b}");
+    }
     eprintln!(
-        "  wrote {}/{{history,energy,summary}}.parquet",
-        r.out.display()
+        "  wrote {}/{{history,energy,summary}}.parquet{}",
+        r.out.display(),
+        r.ballistic
+            .as_ref()
+            .map_or("", |_| " and the failures and ballistic tables")
     );
     Ok(ExitCode::SUCCESS)
 }

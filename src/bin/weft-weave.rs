@@ -14,7 +14,7 @@ use weft::generate::square::{
     GirderParams, GirderZoneOptions, LoadCase, MembraneOptions, MembraneParams, Square,
 };
 use weft::generate::weave::{self, Spec};
-use weft::generate::woven::{Edge, Surround, WovenBandParams, YarnModel};
+use weft::generate::woven::{Edge, StrengthPer, Surround, WovenBandParams, YarnFailure, YarnModel};
 use weft::generate::woven_reduced::{Interface, PretensionStart, SurroundParams, WovenParams};
 use weft::generate::zones::{Centre, CombinedOptions};
 use weft::model::ProjectileShape;
@@ -202,6 +202,44 @@ struct WovenBandArgs {
     /// towards 20 % Green strain by 60 µs and stiffen: 0.8 keeps such runs stable.
     #[arg(long, default_value_t = WovenBandParams::default().dt_safety)]
     dt_safety: f64,
+    /// Yarn failure strain along the yarn (0: the yarns never fail, as in the paper's
+    /// studies). Aramid yarn: 0.036 (Kevlar 29 yarn, 2.92 GPa at 3.6 %; the fibre's 4.0 %
+    /// is an upper bound); with --weibull-modulus, the Weibull scale at the gauge length.
+    #[arg(long, default_value_t = YarnFailure::default().strain)]
+    failure_strain: f64,
+    /// Statistical strengths: the Weibull modulus m of the failure strains (Kevlar yarns:
+    /// 8–22), drawn from --seed per yarn or per element; left out, every yarn fails at
+    /// --failure-strain.
+    #[arg(long)]
+    weibull_modulus: Option<f64>,
+    /// Gauge length L₀ [m] of the Weibull scale [default: each yarn's modelled length].
+    #[arg(long)]
+    weibull_gauge_length: Option<f64>,
+    /// Draw the strengths per yarn or per element (weakest link).
+    #[arg(long, value_enum, default_value_t = YarnFailure::default().per)]
+    strength_per: StrengthPer,
+    /// Seed of the strengths: the same seed gives the same model bit for bit.
+    #[arg(long, default_value_t = YarnFailure::default().seed)]
+    seed: u64,
+    /// Rate law of the failure strain, ε_f(ε̇) = ε_f (1 + C ln(ε̇/ε̇₀)) above ε̇₀: C (0: none).
+    #[arg(long, default_value_t = YarnFailure::default().rate_coefficient)]
+    failure_rate_coefficient: f64,
+    /// The rate law's reference rate ε̇₀ [1/s].
+    #[arg(long, default_value_t = YarnFailure::default().reference_rate)]
+    failure_reference_rate: f64,
+    /// Delay τ of the failure [s]: the strain is compared with the failure strain after
+    /// a low-pass filter of time τ [default: ten element transits, 0.34 µs at 4 elements
+    /// per mm: a struck yarn's first elements overshoot Smith's strain for about ten steps].
+    #[arg(long)]
+    failure_delay: Option<f64>,
+    /// Viscous damping of the projectile's contact springs, a fraction of critical
+    /// [default: 0.5 when the yarns can fail, 0 otherwise].
+    #[arg(long)]
+    projectile_contact_damping: Option<f64>,
+    /// End the run once the projectile is arrested or has perforated (for ballistic
+    /// sweeps; analysis.parquet's stop_on_outcome).
+    #[arg(long)]
+    stop_on_outcome: bool,
 }
 
 #[derive(clap::Args)]
@@ -827,6 +865,18 @@ impl WovenBandArgs {
                 shear_ratio: self.membrane_shear_ratio,
                 thickness: self.membrane_thickness,
             }),
+            failure: YarnFailure {
+                strain: self.failure_strain,
+                weibull_modulus: self.weibull_modulus,
+                gauge_length: self.weibull_gauge_length,
+                per: self.strength_per,
+                seed: self.seed,
+                rate_coefficient: self.failure_rate_coefficient,
+                reference_rate: self.failure_reference_rate,
+                delay: self.failure_delay,
+                contact_damping: self.projectile_contact_damping,
+            },
+            stop_on_outcome: self.stop_on_outcome,
         }
     }
 

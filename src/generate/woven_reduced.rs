@@ -737,6 +737,7 @@ fn add_projectile(m: &mut Model, p: &WovenParams) {
         prescribed_velocity: false,
         contact_stiffness: None,
         friction: p.projectile_friction,
+        contact_damping: 0.0,
         segment_contact: true,
     });
 }

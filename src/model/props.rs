@@ -409,6 +409,13 @@ part_properties! {
         aliases: [],
         meaning: "ε̇₀ of the failure strain's rate law",
     },
+    failure_delay: f64 {
+        unit: "s",
+        kinds: [Truss: Rule::NonNegative, Tri: Rule::NonNegative, Quad: Rule::NonNegative],
+        null: null("0", "the strain itself is compared with the failure strain"),
+        aliases: [],
+        meaning: "delay τ of the failure: the strain is compared after a low-pass filter dε̄/dt = (ε − ε̄)/τ, so that the transient of a discrete yarn struck by a nose (its first elements overshoot the strain of Smith's theory by about 40 % for a few steps) does not break it",
+    },
     failure_force: f64 {
         unit: "N",
         kinds: [Link: Rule::Positive],

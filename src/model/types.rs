@@ -215,6 +215,9 @@ pub struct ProjectileSpec {
     pub contact_stiffness: Option<f64>,
     /// Coulomb friction coefficient μ.
     pub friction: f64,
+    /// Normal viscous damping of the penalty contact, as a fraction ζ of the critical
+    /// damping 2√(k m) of each node's contact spring (LS-DYNA's VDC; 0: none).
+    pub contact_damping: f64,
     /// Also contact the membrane faces (sample points at face centroids and edge
     /// midpoints), so that a projectile smaller than an element cannot pass between
     /// nodes. Default true.
@@ -265,6 +268,11 @@ pub struct Analysis {
     /// Default 0.1: far above the O(Δt²) drift of a stable run, far below the energy
     /// growth of an instability, which is exponential.
     pub max_energy_error: f64,
+    /// End the run once the projectile's outcome is decided (arrested, or perforated and
+    /// free of the fabric), at that output sample, instead of at `end_time`: what a
+    /// ballistic-limit sweep needs (docs/theory.md, "Failure, perforation and the
+    /// ballistic limit"). Default false: the run goes to its end time.
+    pub stop_on_outcome: bool,
 }
 
 impl Default for Analysis {
@@ -278,6 +286,7 @@ impl Default for Analysis {
             target_time_step: None,
             history_sets: Vec::new(),
             max_energy_error: 0.1,
+            stop_on_outcome: false,
         }
     }
 }

@@ -271,6 +271,13 @@ impl Model {
             if !(p.friction >= 0.0 && p.friction.is_finite()) {
                 return bad("friction", p.friction, "μ ≥ 0");
             }
+            if !(p.contact_damping >= 0.0 && p.contact_damping <= 1.0) {
+                return bad(
+                    "contact_damping",
+                    p.contact_damping,
+                    "a fraction 0 ≤ ζ ≤ 1 of the contact spring's critical damping",
+                );
+            }
             if let Some(k) = p.contact_stiffness {
                 if !(k > 0.0 && k.is_finite()) {
                     return bad(
@@ -866,6 +873,21 @@ pub fn validate_part(p: &Part) -> Result<()> {
 /// slider needs, one frame, a normal spring or dashpot for the unilateral law.
 fn validate_link_part(p: &Part) -> Result<()> {
     let q = &p.props;
+    let breaks = q.failure_force.is_some() || q.failure_opening.is_some();
+    if breaks && (q.local_frame == Some(true) || q.sliding == Some(true)) {
+        let (col, what) = if q.sliding == Some(true) {
+            ("sliding", "sliding links")
+        } else {
+            ("local_frame", "links in a local frame")
+        };
+        return Err(WeftError::input(format!(
+            "part `{}` (link) has a failure law (failure_force or failure_opening) and {col} = true",
+            p.name
+        ))
+        .in_column(if q.failure_force.is_some() { "failure_force" } else { "failure_opening" })
+        .expected(format!("failure on links in global axes only: this weft version cannot break {what}"))
+        .hint(format!("set `{col}` of part `{}` to null (global axes), or leave the failure law null", p.name)));
+    }
     if let (Some(f), Some(mu)) = (q.slip_force, q.friction) {
         return Err(WeftError::input(format!(
             "part `{}` (link) has both slip_force = `{f}` and friction = `{mu}`",

@@ -26,6 +26,8 @@ pub struct FailureLaw {
     pub rate_coefficient: f64,
     /// ε̇₀ of the rate law [1/s].
     pub reference_rate: f64,
+    /// Delay τ [s] of the strain compared with the limit (0: the strain itself).
+    pub delay: f64,
 }
 
 impl FailureLaw {
@@ -34,17 +36,31 @@ impl FailureLaw {
         strain: f64::INFINITY,
         rate_coefficient: 0.0,
         reference_rate: 1.0,
+        delay: 0.0,
     };
 
     pub fn can_fail(&self) -> bool {
         self.strain.is_finite()
     }
 
+    /// The strain the limit is compared with: ε itself without a delay, else the filtered
+    /// ε̄ advanced over `dt` by dε̄/dt = (ε − ε̄)/τ (explicit, the step capped at τ), kept
+    /// in `filtered`.
+    #[inline(always)]
+    pub fn filter(&self, eps: f64, dt: f64, filtered: &mut f64) -> f64 {
+        if self.delay > 0.0 {
+            *filtered += (dt / self.delay).min(1.0) * (eps - *filtered);
+            *filtered
+        } else {
+            eps
+        }
+    }
+
     /// ε_f at the strain rate ε̇ [1/s].
     ///
     /// ```
     /// use weft::solver::failure::FailureLaw;
-    /// let law = FailureLaw { strain: 0.03, rate_coefficient: 0.14, reference_rate: 30.0 };
+    /// let law = FailureLaw { strain: 0.03, rate_coefficient: 0.14, reference_rate: 30.0, delay: 0.0 };
     /// assert_eq!(law.threshold(10.0), 0.03); // below the reference rate: ε_f
     /// let e = law.threshold(30.0 * std::f64::consts::E); // one e-fold above it
     /// assert!((e - 0.03 * 1.14).abs() < 1e-15);
@@ -168,6 +184,9 @@ pub struct Fate {
     pub fresh: Option<Failure>,
     /// The strain energy the element's failures took with them so far [J].
     pub energy: f64,
+    /// The filtered strains ε̄ of a delayed failure (a truss's in the first, a membrane's
+    /// two directions).
+    pub filtered: [f64; 2],
 }
 
 /// The erosion state of a family: its elements' failure laws and fates. Empty (and

@@ -118,6 +118,15 @@ pub trait Family: Sized + Send + Sync {
     fn can_fail(&self) -> bool {
         false
     }
+    /// Element e's stored energy at `x` (strain and hourglass) [J]; 0 once it has failed
+    /// (families whose energies `ballistic.parquet` reports by layer: trusses, membranes).
+    fn element_energy(&self, _x: &[Vec3], _e: usize) -> f64 {
+        0.0
+    }
+    /// What element e's failures have taken [J].
+    fn element_eroded(&self, _e: usize) -> f64 {
+        0.0
+    }
 }
 
 /// Totals of the energy ledger's groups (see [`EnergyGroup`]).

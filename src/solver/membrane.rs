@@ -774,6 +774,30 @@ impl<const N: usize> Family for MembraneGroup<N> {
     fn can_fail(&self) -> bool {
         self.erosion.active()
     }
+    fn element_energy(&self, x: &[[f64; 3]], e: usize) -> f64 {
+        if !self.erosion.alive(e) {
+            return 0.0;
+        }
+        let ns = &self.nodes[e];
+        let xe: [[f64; 3]; N] = std::array::from_fn(|a| x[ns[a] as usize]);
+        let dirs = self.erosion.fate.get(e).map_or(0, |f| f.dirs);
+        let mat = if dirs == 0 {
+            self.material[e]
+        } else {
+            self.material[e].with_failed(dirs)
+        };
+        let (w, h) = energy(
+            &xe,
+            &self.reference[e],
+            &mat,
+            self.thickness[e],
+            self.k_hg[e],
+        );
+        w + h
+    }
+    fn element_eroded(&self, e: usize) -> f64 {
+        self.erosion.fate.get(e).map_or(0.0, |f| f.energy)
+    }
 }
 
 /// A membrane's failure laws from its part: `failure_strain` along direction 1,
@@ -784,6 +808,7 @@ fn failure_laws(p: &crate::model::PartProps, factor: f64) -> MembraneFailure {
             strain: e * factor,
             rate_coefficient: p.failure_rate_coefficient.unwrap_or(0.0),
             reference_rate: p.failure_reference_rate.unwrap_or(1.0),
+            delay: p.failure_delay.unwrap_or(0.0),
         },
         None => FailureLaw::NONE,
     };
@@ -842,6 +867,9 @@ impl<const N: usize> MembraneGroup<N> {
                     [[0.0; 3]; N]
                 };
                 let (eps, rate) = fibre_strains(&xe, &ve, &reference[e], with_rate);
+                let eps: [f64; 2] = std::array::from_fn(|i| {
+                    lw.dir[i].filter(eps[i], ctx.dt_prev, &mut fate.filtered[i])
+                });
                 let (now, limit) = failing(lw, eps, rate, fate.dirs);
                 let before = fate.dirs;
                 let mat_before = if before == 0 {

@@ -49,6 +49,7 @@ pub mod statics;
 pub mod ties;
 pub mod truss;
 pub mod vec3;
+pub mod watch;
 
 use std::time::{Duration, Instant};
 
@@ -58,14 +59,15 @@ use crate::model::{ElementKind, Model};
 use energy::{energy_floor, Ledger};
 pub use energy::{ElementEnergies, Energies, ENERGY_CHECK_AFTER};
 pub use families::Families;
-use family::ForceCtx;
 pub use family::CHUNK;
+use family::{Family, ForceCtx};
 use integrator::{Nodal, NodePartial};
 pub use operator::{Operator, State};
 use output::Sampler;
 pub use output::Sink;
 pub use stable::{MassScaling, StableStep};
 pub use ties::tie_weights;
+use vec3::dot;
 
 /// Wall time per phase.
 #[derive(Debug, Clone, Default)]
@@ -130,6 +132,11 @@ pub struct Solver {
     ledger: Ledger,
     /// Element failures and what they leave (empty when nothing can fail).
     pub failures: FailureLog,
+    /// Layers and the projectile's outcome (see [`watch`]).
+    pub watch: watch::Watch,
+    /// The last output time sent to the sink (NaN before the first): where the tables of
+    /// a run that stopped end.
+    pub sampled_to: f64,
 }
 
 /// What the failures of a run leave: every failure in order, and per node how many live
@@ -295,6 +302,8 @@ impl Solver {
             analysis: m.analysis.clone(),
             ledger: Ledger::default(),
             failures: FailureLog::default(),
+            watch: watch::Watch::new(m),
+            sampled_to: f64::NAN,
         };
         s.failures = FailureLog::new(&s.op.el, nn);
         let kappa = contact::surface::guard_kappa(m);
@@ -304,6 +313,10 @@ impl Solver {
         if !m.contacts.is_empty() {
             s.op.surfaces = contact::SurfaceContact::new(m, &s.mass);
             s.op.surfaces.start(m, &s.state.x)?;
+        }
+        if s.watch.n_layers > 0 {
+            s.op.surfaces.track_friction(nn);
+            s.op.projectiles.node_friction = Some(vec![0.0; nn]);
         }
         s.op.ties
             .update_slaves(&mut s.state.x, &mut s.state.v, None);
@@ -663,6 +676,9 @@ impl Solver {
             times.update += t3 - t2;
             if snap {
                 last_e = self.book_sample(ke, &el_e, contact_e, &mut sampler)?;
+                if self.watch.is_active() {
+                    self.watch_sample(&mut sampler.cur.layers);
+                }
                 sampler.emit(
                     &mut k,
                     n_out,
@@ -676,17 +692,29 @@ impl Solver {
                         }
                     },
                 )?;
+                if k > 0 {
+                    self.sampled_to = (k - 1) as f64 * a.output_interval;
+                }
                 times.output += t3.elapsed();
             }
             self.ledger.mass_damping += 0.5 * dt_next * dp;
             self.state.t += dt_next;
             self.state.dt_prev = dt_next;
             self.state.step += 1;
+            if snap && a.stop_on_outcome && self.watch.outcome.is_decided() {
+                // Past the outcome's sample: the output grid ends at the last time sent.
+                break;
+            }
         }
         progress(1.0);
+        let end_time = if self.watch.outcome.is_decided() && a.stop_on_outcome {
+            (k.saturating_sub(1)) as f64 * a.output_interval
+        } else {
+            a.end_time
+        };
         Ok(RunStats {
             steps: self.state.step,
-            end_time: a.end_time,
+            end_time,
             times,
             threads: rayon::current_num_threads(),
             max_balance_error_relative: self.ledger.reported(self.state.step),
@@ -713,6 +741,99 @@ impl Solver {
         times.loads += t1 - t0;
         times.forces += t2 - t1;
         t2
+    }
+
+    /// What the run did so far (for a run that stopped: its steps, the last output time
+    /// sent, its worst balance), without the phase times.
+    pub fn stats_so_far(&self) -> RunStats {
+        RunStats {
+            steps: self.state.step,
+            end_time: if self.sampled_to.is_nan() {
+                0.0
+            } else {
+                self.sampled_to
+            },
+            times: PhaseTimes::default(),
+            threads: rayon::current_num_threads(),
+            max_balance_error_relative: self.ledger.reported(self.state.step),
+            final_energies: Energies::default(),
+            elements: self.op.el.len() - self.op.el.point_mass.id.len(),
+            nodes: self.x0.len(),
+        }
+    }
+
+    /// The watch at a sample step (t_n, x^n, v^n): each layer's values into `rows` (layer
+    /// 1 first), the last layer's deflection peak, and the projectile's outcome.
+    fn watch_sample(&mut self, rows: &mut Vec<watch::LayerValues>) {
+        let w = &self.watch;
+        let axis = w.axis().unwrap_or([0.0, 0.0, -1.0]);
+        let n = w.n_layers;
+        rows.clear();
+        rows.resize(n, [0.0; 9]);
+        let (xn, vn, x0) = (&self.state.xn, &self.state.vn, &self.x0);
+        let fr_s = self.op.surfaces.node_friction.as_deref();
+        let fr_p = self.op.projectiles.node_friction.as_deref();
+        for i in 0..xn.len() {
+            let attached = self.failures.is_attached(i);
+            let l = w.node_layer(i) as usize;
+            if l == 0 {
+                continue;
+            }
+            let r = &mut rows[l - 1];
+            r[0] += 0.5 * self.mass[i] * dot(&vn[i], &vn[i]);
+            r[3] += fr_s.map_or(0.0, |f| f[i]) + fr_p.map_or(0.0, |f| f[i]);
+            if attached {
+                let u = [
+                    xn[i][0] - x0[i][0],
+                    xn[i][1] - x0[i][1],
+                    xn[i][2] - x0[i][2],
+                ];
+                r[7] = r[7].max(dot(&u, &axis));
+            }
+        }
+        let el = &self.op.el;
+        for (kind, len) in [
+            (ElementKind::Truss, el.truss.len()),
+            (ElementKind::Tri, el.tri.len()),
+            (ElementKind::Quad, el.quad.len()),
+        ] {
+            for e in 0..len {
+                let l = w.element_layer(kind, e) as usize;
+                if l == 0 {
+                    continue;
+                }
+                let (stored, eroded) = match kind {
+                    ElementKind::Truss => {
+                        (el.truss.element_energy(xn, e), el.truss.element_eroded(e))
+                    }
+                    ElementKind::Tri => (el.tri.element_energy(xn, e), el.tri.element_eroded(e)),
+                    _ => (el.quad.element_energy(xn, e), el.quad.element_eroded(e)),
+                };
+                rows[l - 1][1] += stored;
+                rows[l - 1][2] += eroded;
+            }
+        }
+        for (l, r) in rows.iter_mut().enumerate() {
+            r[4] = r[0] + r[1] + r[2] + r[3];
+            let (failed, broken) = w.counts(l + 1);
+            r[5] = failed as f64;
+            r[6] = broken as f64;
+            r[8] = w.first_failure[l + 1];
+        }
+        let back = rows.last().map_or(0.0, |r| r[7]);
+        let t = self.state.t;
+        let proj = self
+            .op
+            .projectiles
+            .projectiles
+            .first()
+            .map(|p| (p.tip, p.v_full, p.force, p.radius));
+        let w = &mut self.watch;
+        w.back_face_peak = w.back_face_peak.max(back);
+        w.last_rows.clone_from(rows);
+        if let Some((tip, v, f, radius)) = proj {
+            w.judge(t, &tip, &v, &f, radius);
+        }
     }
 
     /// The failures of the force pass just done: logged, their nodes' attachments
@@ -743,6 +864,7 @@ impl Solver {
                 ) {
                     self.op.surfaces.erode(f.kind, f.element);
                     self.op.projectiles.erode(f.kind, f.element);
+                    self.watch.on_erosion(f.kind, f.element, self.state.t);
                 }
             }
         }
@@ -855,6 +977,7 @@ impl Solver {
         }
         let contact = contact_e
             + self.op.projectiles.friction_work
+            + self.op.projectiles.damping_work
             + (self.op.surfaces.stored + self.op.surfaces.dissipated);
         let w_ext = self.op.loads.work + self.op.projectiles.prescribed_work;
         let e = self.ledger.book(ke, el_e, contact, w_ext, self.state.step);

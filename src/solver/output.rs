@@ -10,6 +10,7 @@ use arrow_array::{Float64Array, Int64Array, RecordBatch};
 use arrow_schema::{DataType, Field, Schema, SchemaRef};
 
 use super::energy::Energies;
+use super::watch::LayerValues;
 use crate::error::Result;
 use crate::table::{batch, AtomicTableWriter, Col, Provenance};
 
@@ -20,6 +21,10 @@ pub trait Sink {
     fn energy(&mut self, t: f64, e: &Energies) -> Result<()>;
     /// A projectile at time t: tip position, velocity, contact force on it.
     fn projectile(&mut self, _t: f64, _id: i64, _state: &[f64; 9]) -> Result<()> {
+        Ok(())
+    }
+    /// The layers of a fabric at time t, layer 1 first (see [`super::watch`]).
+    fn layers(&mut self, _t: f64, _rows: &[LayerValues]) -> Result<()> {
         Ok(())
     }
 }
@@ -33,6 +38,8 @@ pub(super) struct Snapshot {
     pub(super) e: Energies,
     /// Per projectile: tip x, y, z, velocity, contact force.
     pub(super) proj: Vec<[f64; 9]>,
+    /// Per layer of a fabric (layer 1 first), its values (see [`super::watch`]).
+    pub(super) layers: Vec<LayerValues>,
 }
 
 /// Linear interpolation of the step snapshots onto the fixed output grid t_k = k·Δt_out.
@@ -42,6 +49,7 @@ pub(super) struct Sampler {
     have_prev: bool,
     interp_u: Vec<[f64; 3]>,
     interp_v: Vec<[f64; 3]>,
+    interp_layers: Vec<LayerValues>,
 }
 
 impl Sampler {
@@ -57,6 +65,7 @@ impl Sampler {
             have_prev: false,
             interp_u: vec![[0.0; 3]; nout],
             interp_v: vec![[0.0; 3]; nout],
+            interp_layers: vec![],
         }
     }
 
@@ -103,6 +112,24 @@ impl Sampler {
             };
             sink.history(tk, nodes, src_u, src_v)?;
             sink.energy(tk, &e)?;
+            if !cur.layers.is_empty() {
+                // Energies and deflections interpolated; counts as of the earlier step.
+                let rows = if w >= 1.0 || prev.layers.len() != cur.layers.len() {
+                    &cur.layers
+                } else {
+                    self.interp_layers.clear();
+                    for (a, b) in prev.layers.iter().zip(&cur.layers) {
+                        let mut r: LayerValues = std::array::from_fn(|c| a[c] + w * (b[c] - a[c]));
+                        // Counts and the first failure's time as of the earlier step.
+                        r[5] = a[5];
+                        r[6] = a[6];
+                        r[8] = a[8];
+                        self.interp_layers.push(r);
+                    }
+                    &self.interp_layers
+                };
+                sink.layers(tk, rows)?;
+            }
             progress(*k, tk);
             *k += 1;
         }
@@ -123,11 +150,17 @@ pub struct MemorySink {
     pub energy: Vec<Energies>,
     /// (t, projectile id, [tip x y z, v x y z, force x y z]).
     pub projectile: Vec<(f64, i64, [f64; 9])>,
+    /// (t, per layer its values, layer 1 first).
+    pub layers: Vec<(f64, Vec<LayerValues>)>,
 }
 
 impl Sink for MemorySink {
     fn projectile(&mut self, t: f64, id: i64, s: &[f64; 9]) -> Result<()> {
         self.projectile.push((t, id, *s));
+        Ok(())
+    }
+    fn layers(&mut self, t: f64, rows: &[LayerValues]) -> Result<()> {
+        self.layers.push((t, rows.to_vec()));
         Ok(())
     }
     fn history(&mut self, t: f64, nodes: &[usize], u: &[[f64; 3]], v: &[[f64; 3]]) -> Result<()> {
@@ -187,6 +220,7 @@ pub struct ParquetSink {
     energy_t: Vec<f64>,
     energy: Vec<Energies>,
     projectile: Vec<(f64, i64, [f64; 9])>,
+    layers: Vec<(f64, Vec<LayerValues>)>,
 }
 
 impl ParquetSink {
@@ -199,7 +233,40 @@ impl ParquetSink {
             energy_t: Vec::new(),
             energy: Vec::new(),
             projectile: Vec::new(),
+            layers: Vec::new(),
         })
+    }
+
+    /// `ballistic.parquet`: one row per output time and layer (see [`super::watch`]).
+    fn ballistic_table(&self) -> Option<arrow_array::RecordBatch> {
+        if self.layers.is_empty() {
+            return None;
+        }
+        let rows: Vec<(f64, usize, &LayerValues)> = self
+            .layers
+            .iter()
+            .flat_map(|(t, ls)| ls.iter().enumerate().map(move |(l, r)| (*t, l + 1, r)))
+            .collect();
+        let f = |c: usize| rows.iter().map(|r| r.2[c]).collect::<Vec<_>>();
+        let i = |c: usize| rows.iter().map(|r| r.2[c] as i64).collect::<Vec<_>>();
+        Some(batch(vec![
+            Col::F64("t", rows.iter().map(|r| r.0).collect()),
+            Col::I64("layer", rows.iter().map(|r| r.1 as i64).collect()),
+            Col::F64("kinetic", f(0)),
+            Col::F64("strain", f(1)),
+            Col::F64("eroded", f(2)),
+            Col::F64("friction", f(3)),
+            Col::F64("absorbed", f(4)),
+            Col::I64("failed_elements", i(5)),
+            Col::I64("broken_yarns", i(6)),
+            Col::F64("deflection", f(7)),
+            Col::OptF64(
+                "first_failure_time",
+                rows.iter()
+                    .map(|r| Some(r.2[8]).filter(|t| !t.is_nan()))
+                    .collect(),
+            ),
+        ]))
     }
 
     fn flush(&mut self) -> Result<()> {
@@ -289,8 +356,20 @@ impl ParquetSink {
             w.write(&pb)?;
             pw = Some(w);
         }
+        let bw = match self.ballistic_table() {
+            Some(b) => {
+                let mut w =
+                    AtomicTableWriter::create(&out.join("ballistic.parquet"), b.schema(), prov)?;
+                w.write(&b)?;
+                Some(w)
+            }
+            None => None,
+        };
         ew.finish()?;
         if let Some(w) = pw {
+            w.finish()?;
+        }
+        if let Some(w) = bw {
             w.finish()?;
         }
         self.hist.finish()?;
@@ -301,6 +380,10 @@ impl ParquetSink {
 impl Sink for ParquetSink {
     fn projectile(&mut self, t: f64, id: i64, s: &[f64; 9]) -> Result<()> {
         self.projectile.push((t, id, *s));
+        Ok(())
+    }
+    fn layers(&mut self, t: f64, rows: &[LayerValues]) -> Result<()> {
+        self.layers.push((t, rows.to_vec()));
         Ok(())
     }
     fn history(&mut self, t: f64, nodes: &[usize], u: &[[f64; 3]], v: &[[f64; 3]]) -> Result<()> {

@@ -113,6 +113,7 @@ fn failure_law(p: &crate::model::PartProps, factor: f64) -> FailureLaw {
             strain: eps * factor,
             rate_coefficient: p.failure_rate_coefficient.unwrap_or(0.0),
             reference_rate: p.failure_reference_rate.unwrap_or(1.0),
+            delay: p.failure_delay.unwrap_or(0.0),
         },
         None => FailureLaw::NONE,
     }
@@ -150,6 +151,7 @@ impl TrussGroup {
                 let lw = &law[e];
                 if lw.can_fail() {
                     let (eps, rate) = strain_and_rate(&x[a], &x[b], &v[a], &v[b], l0[e]);
+                    let eps = lw.filter(eps, ctx.dt_prev, &mut fate.filtered[0]);
                     let limit = lw.threshold(rate);
                     if eps >= limit {
                         // Its strain energy, and the half step of work its force would
@@ -309,5 +311,21 @@ impl Family for TrussGroup {
     }
     fn can_fail(&self) -> bool {
         self.erosion.active()
+    }
+    fn element_energy(&self, x: &[[f64; 3]], e: usize) -> f64 {
+        if !self.erosion.alive(e) {
+            return 0.0;
+        }
+        let [a, b] = self.nodes[e];
+        energy(
+            &x[a as usize],
+            &x[b as usize],
+            self.k[e],
+            self.l0[e],
+            self.tension_only[e],
+        )
+    }
+    fn element_eroded(&self, e: usize) -> f64 {
+        self.erosion.fate.get(e).map_or(0.0, |f| f.energy)
     }
 }

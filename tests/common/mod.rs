@@ -255,6 +255,7 @@ pub fn composite() -> weft::model::Model {
         prescribed_velocity: false,
         contact_stiffness: None,
         friction: 0.1,
+        contact_damping: 0.0,
         segment_contact: true,
     });
     let curve = std::sync::Arc::new(Curve {

@@ -39,14 +39,14 @@ mod params;
 mod section;
 mod yarns;
 
-pub use params::{Edge, Surround, WovenBandParams, YarnModel};
+pub use params::{Edge, StrengthPer, Surround, WovenBandParams, YarnFailure, YarnModel};
 pub use section::{chain_touching_amplitude, Lenticular};
 use section::{crimp_amplitude, crimp_of, Section};
 use yarns::{add_layer, insert_sets, Built, Weave};
 
 use crate::error::{Result, WeftError};
 use crate::model::contacts::{ContactDef, Slave};
-use crate::model::{Analysis, Model, ProjectileSpec, SymmetryPlane};
+use crate::model::{Analysis, ElementKind, Model, ProjectileSpec, SymmetryPlane};
 
 /// What the generator reports besides the model.
 #[derive(Debug, Clone)]
@@ -157,6 +157,66 @@ fn check(p: &WovenBandParams) -> Result<()> {
             "a speed ≥ 0 in m/s",
         );
     }
+    check_failure(&p.failure)
+}
+
+/// The yarn failure's parameters: a finite failure strain ≥ 0 (0: none), a Weibull
+/// modulus and gauge length > 0, a rate law with C ≥ 0 and ε̇₀ > 0.
+fn check_failure(f: &YarnFailure) -> Result<()> {
+    let bad = |name: &str, v: f64, exp: &str| {
+        Err(WeftError::input(format!("--{name} = `{v}`")).expected(exp.to_string()))
+    };
+    if !(f.strain.is_finite() && f.strain >= 0.0) {
+        return bad(
+            "failure-strain",
+            f.strain,
+            "a failure strain ≥ 0 along the yarn (0: no failure; aramid yarn: 0.036)",
+        );
+    }
+    if let Some(m) = f.weibull_modulus {
+        if !(m.is_finite() && m > 0.0) {
+            return bad(
+                "weibull-modulus",
+                m,
+                "a Weibull modulus m > 0 (aramid yarns: 8–22), or leave it out for equal strengths",
+            );
+        }
+        if f.strain == 0.0 {
+            return Err(WeftError::input(format!(
+                "--weibull-modulus {m} without a failure strain"
+            ))
+            .expected("--failure-strain > 0: the Weibull scale the strengths are drawn about"));
+        }
+    }
+    if let Some(l) = f.gauge_length {
+        if !(l.is_finite() && l > 0.0) {
+            return bad("weibull-gauge-length", l, "a gauge length > 0 in m");
+        }
+    }
+    if !(f.rate_coefficient.is_finite() && f.rate_coefficient >= 0.0) {
+        return bad(
+            "failure-rate-coefficient",
+            f.rate_coefficient,
+            "C ≥ 0 of ε_f(ε̇) = ε_f (1 + C ln(ε̇/ε̇₀))",
+        );
+    }
+    if !(f.reference_rate.is_finite() && f.reference_rate > 0.0) {
+        return bad("failure-reference-rate", f.reference_rate, "ε̇₀ > 0 in 1/s");
+    }
+    if let Some(d) = f.delay {
+        if !(d.is_finite() && d >= 0.0) {
+            return bad("failure-delay", d, "a delay ≥ 0 in s");
+        }
+    }
+    if let Some(z) = f.contact_damping {
+        if !(0.0..=1.0).contains(&z) {
+            return bad(
+                "projectile-contact-damping",
+                z,
+                "a fraction 0 ≤ ζ ≤ 1 of critical",
+            );
+        }
+    }
     Ok(())
 }
 
@@ -180,6 +240,7 @@ pub fn woven(p: &WovenBandParams) -> Result<(Model, WovenInfo)> {
     for layer in 0..p.layers {
         add_layer(&mut m, &weave, layer, -(layer as f64) * pitch, &mut built);
     }
+    tag_yarns(&mut m, p, &weave, &built);
     add_contacts(&mut m, p, &weave.section, &built.parts);
     if p.quarter {
         for normal in [0, 1] {
@@ -202,6 +263,7 @@ pub fn woven(p: &WovenBandParams) -> Result<(Model, WovenInfo)> {
             "diagonal".into(),
             "diagonal_weft".into(),
         ],
+        stop_on_outcome: p.stop_on_outcome,
         ..Analysis::default()
     };
     let area = weave.section.lens.area();
@@ -218,6 +280,69 @@ pub fn woven(p: &WovenBandParams) -> Result<(Model, WovenInfo)> {
     }
     m.validate()?;
     Ok((m, info))
+}
+
+/// Each yarn element's layer and yarn (`layer`, `yarn` columns: the yarn's index within
+/// its part, from 1), the yarn parts' failure law, and the elements' strengths.
+fn tag_yarns(m: &mut Model, p: &WovenBandParams, w: &yarns::Weave, b: &Built) {
+    let kind = if w.section.chain {
+        ElementKind::Truss
+    } else {
+        ElementKind::Quad
+    };
+    let f = &p.failure;
+    if f.strain > 0.0 {
+        for &(warp, weft) in &b.parts {
+            for part in [warp, weft] {
+                let props = &mut m.parts[part].props;
+                props.failure_strain = Some(f.strain);
+                props.failure_delay = Some(p.failure_delay());
+                if f.rate_coefficient > 0.0 {
+                    props.failure_rate_coefficient = Some(f.rate_coefficient);
+                    props.failure_reference_rate = Some(f.reference_rate);
+                }
+            }
+        }
+    }
+    let factors = f
+        .weibull_modulus
+        .map(|modulus| strength_factors(f, modulus, w, &b.tags));
+    let blk = m.elements.get_mut(&kind).expect("the yarns' elements");
+    blk.layer = b.tags.iter().map(|t| Some(t.layer as i64 + 1)).collect();
+    blk.yarn = b.tags.iter().map(|t| Some(t.yarn)).collect();
+    if let Some(fs) = factors {
+        blk.failure_factor = fs;
+    }
+}
+
+/// Weibull strength factors ε/ε₀ = (L₀/L)^{1/m}(−ln(1 − u))^{1/m}, one per element: u drawn
+/// per yarn (keyed by layer, family and yarn) or per element (keyed by its id), L the
+/// yarn's or the element's length along the patch, L₀ the gauge length (the yarn's by
+/// default) (docs/theory.md, "Failure, perforation and the ballistic limit").
+fn strength_factors(
+    f: &YarnFailure,
+    modulus: f64,
+    w: &yarns::Weave,
+    tags: &[yarns::Tag],
+) -> Vec<f64> {
+    let yarn_length = w.length();
+    let element_length = yarn_length / w.elements_along() as f64;
+    let gauge = f.gauge_length.unwrap_or(yarn_length);
+    tags.iter()
+        .map(|t| {
+            let (u, length) = match f.per {
+                StrengthPer::Yarn => {
+                    let key = ((t.layer as u64) << 40) | ((t.family as u64) << 32) | t.yarn as u64;
+                    (crate::random::uniform(f.seed, key), yarn_length)
+                }
+                StrengthPer::Element => (
+                    crate::random::uniform(f.seed, t.element as u64),
+                    element_length,
+                ),
+            };
+            crate::random::weibull(u, modulus, 1.0, gauge, length)
+        })
+        .collect()
 }
 
 /// Contact: warp against weft in each layer, and every yarn of a layer against every
@@ -270,6 +395,7 @@ fn add_projectile(m: &mut Model, p: &WovenBandParams, s: &Section, top: f64) {
         prescribed_velocity: false,
         contact_stiffness: None,
         friction: p.projectile_friction,
+        contact_damping: p.contact_damping(),
         segment_contact: !s.chain,
     });
 }

@@ -32,6 +32,92 @@ pub enum YarnModel {
     Chain,
 }
 
+/// What a statistical strength is drawn for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum StrengthPer {
+    /// One draw per yarn: every element of the yarn has its strength.
+    Yarn,
+    /// One draw per element (weakest-link: a yarn's weakest element sets where it breaks).
+    Element,
+}
+
+/// Yarn failure (docs/theory.md, "Failure, perforation and the ballistic limit").
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct YarnFailure {
+    /// Failure strain ε_f along the yarn (0: the yarns never fail; aramid yarn: 0.036):
+    /// with a Weibull modulus, the Weibull scale at the gauge length.
+    pub strain: f64,
+    /// Weibull modulus m of the strengths (None: every yarn fails at ε_f).
+    pub weibull_modulus: Option<f64>,
+    /// Gauge length L₀ of the Weibull scale [m] (None: each yarn's modelled length).
+    pub gauge_length: Option<f64>,
+    /// Drawn per yarn or per element.
+    pub per: StrengthPer,
+    /// Seed of the draws: the same seed, the same strengths, on any machine and thread count.
+    pub seed: u64,
+    /// The rate law's C and ε̇₀ [1/s] (C = 0: rate-independent).
+    pub rate_coefficient: f64,
+    pub reference_rate: f64,
+    /// Delay τ of the failure [s] (None: ten element transits, L_e/c each; see
+    /// `failure_delay` in docs/tables.md).
+    pub delay: Option<f64>,
+    /// The projectile's contact damping ζ (None: 0.5 when the yarns can fail, else 0).
+    pub contact_damping: Option<f64>,
+}
+
+impl Default for YarnFailure {
+    fn default() -> Self {
+        YarnFailure {
+            // No failure by default: the paper's studies (§3, §5) model none, and a
+            // ballistic study asks for it (`--failure-strain 0.036`, the aramid yarn's).
+            strain: 0.0,
+            weibull_modulus: None,
+            gauge_length: None,
+            per: StrengthPer::Yarn,
+            seed: 1,
+            rate_coefficient: 0.0,
+            reference_rate: 1.0,
+            delay: None,
+            contact_damping: None,
+        }
+    }
+}
+
+/// Element transits in the default failure delay: a struck yarn's first elements
+/// overshoot Smith's strain by about 40 % for about ten steps whatever the element size;
+/// with this delay (and the nose's contact damping) a struck chain and band break within
+/// 1 % and 2 % of Smith's critical velocity (`tests/failure.rs`).
+pub const DELAY_TRANSITS: f64 = 10.0;
+
+/// The nose's contact damping (fraction of critical) when the yarns can fail: the nodes
+/// under a nose otherwise ring on their penalty springs at ±30 % of Smith's strain
+/// (measured), which breaks a struck yarn below its critical velocity.
+pub const FAILURE_CONTACT_DAMPING: f64 = 0.5;
+
+impl WovenBandParams {
+    /// The failure delay: the one given, or [`DELAY_TRANSITS`] element transits
+    /// (spacing/per_spacing)/√(E/ρ).
+    pub fn failure_delay(&self) -> f64 {
+        self.failure.delay.unwrap_or_else(|| {
+            DELAY_TRANSITS * self.spacing
+                / self.per_spacing as f64
+                / (self.modulus / self.density).sqrt()
+        })
+    }
+    /// The projectile's contact damping: the one given, or [`FAILURE_CONTACT_DAMPING`]
+    /// when the yarns can fail (0 otherwise, as before failure existed).
+    pub fn contact_damping(&self) -> f64 {
+        self.failure
+            .contact_damping
+            .unwrap_or(if self.failure.strain > 0.0 {
+                FAILURE_CONTACT_DAMPING
+            } else {
+                0.0
+            })
+    }
+}
+
 /// Parameters of the yarn-level patch; every default is a documented aramid plain weave
 /// (docs/theory.md, "Material data and defaults" and "The yarn-level woven patch").
 #[derive(Debug, Clone, Serialize)]
@@ -87,6 +173,11 @@ pub struct WovenBandParams {
     /// The paper's §3 combined model: the patch's yarn ends tied to a graded orthotropic
     /// membrane around it (None: the patch alone, its ends held by `edge`).
     pub surround: Option<Surround>,
+    /// Yarn failure and statistical strengths.
+    pub failure: YarnFailure,
+    /// End the run once the projectile is arrested or has perforated (analysis
+    /// `stop_on_outcome`: a ballistic sweep's runs).
+    pub stop_on_outcome: bool,
 }
 
 /// A graded orthotropic membrane around a quarter patch (the paper's §3: a small woven
@@ -169,6 +260,8 @@ impl Default for WovenBandParams {
             output_interval: 1e-6,
             dt_safety: 0.9,
             surround: None,
+            failure: YarnFailure::default(),
+            stop_on_outcome: false,
         }
     }
 }

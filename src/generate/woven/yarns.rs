@@ -62,6 +62,17 @@ impl<'a> Weave<'a> {
         }
     }
 
+    /// The length of a yarn along the patch [m] (the modelled one: half the yarn on a
+    /// quarter model).
+    pub(super) fn length(&self) -> f64 {
+        self.hi - self.lo
+    }
+
+    /// Elements along a yarn.
+    pub(super) fn elements_along(&self) -> usize {
+        self.n_along
+    }
+
     /// The centre line of yarn j (see [`yarn_centre`]).
     fn centre(&self, j: i64) -> f64 {
         yarn_centre(self.p, j)
@@ -143,8 +154,20 @@ pub(super) struct Built {
     diagonal_weft: Vec<usize>,
     edge_nodes: Vec<usize>,
     pub(super) top: f64,
+    /// Per yarn element, in the order they were added: its layer, family and yarn.
+    pub(super) tags: Vec<Tag>,
     nid: i64,
     eid: i64,
+}
+
+/// A yarn element's place in the fabric: its layer (from 0), family (0 warp, 1 weft),
+/// yarn within its part (from 1) and element id.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Tag {
+    pub(super) layer: usize,
+    pub(super) family: usize,
+    pub(super) yarn: i64,
+    pub(super) element: i64,
 }
 
 impl Built {
@@ -157,6 +180,7 @@ impl Built {
             diagonal_weft: vec![],
             edge_nodes: vec![],
             top: f64::NEG_INFINITY,
+            tags: vec![],
             nid: 0,
             eid: 0,
         }
@@ -287,12 +311,23 @@ fn gather_crossing(b: &mut Built, y: Yarn, other: i64, n: usize) {
     }
 }
 
+/// The tag of element `eid` of yarn `y`.
+fn tag(w: &Weave, y: Yarn, eid: i64) -> Tag {
+    Tag {
+        layer: y.layer,
+        family: y.fam,
+        yarn: y.j - w.first + 1,
+        element: eid,
+    }
+}
+
 /// A chain's trusses along the centre-line nodes (half the section on a symmetry plane).
 fn add_chain_elements(m: &mut Model, w: &Weave, y: Yarn, idx: &[Vec<usize>], b: &mut Built) {
     let na = w.section.na;
     let half = w.p.quarter && y.j == 0;
     for i in 0..w.n_along {
         b.eid += 1;
+        b.tags.push(tag(w, y, b.eid));
         let ends = [idx[i][na / 2], idx[i + 1][na / 2]];
         if half {
             m.add_truss_with_area(b.eid, y.part, ends, 0.5 * w.section.lens.area());
@@ -309,6 +344,7 @@ fn add_band_elements(m: &mut Model, w: &Weave, y: Yarn, idx: &[Vec<usize>], b: &
     for i in 0..w.n_along {
         for k in k0..na {
             b.eid += 1;
+            b.tags.push(tag(w, y, b.eid));
             let q = if y.fam == 0 {
                 [idx[i][k], idx[i + 1][k], idx[i + 1][k + 1], idx[i][k + 1]]
             } else {

@@ -44,6 +44,10 @@ pub fn read(r: &mut Reading) -> Result<()> {
             .map(String::from)
             .collect(),
         max_energy_error: get("max_energy_error", Some(d.max_energy_error))?.unwrap(),
+        stop_on_outcome: t
+            .bool_opt("stop_on_outcome")?
+            .and_then(|v| v[0])
+            .unwrap_or(d.stop_on_outcome),
     };
     Ok(())
 }
@@ -62,6 +66,7 @@ pub fn write(m: &Model, w: &Writing) -> Result<()> {
             Col::OptF64("target_time_step", vec![a.target_time_step]),
             Col::Str("history_sets", vec![a.history_sets.join(",")]),
             Col::F64("max_energy_error", vec![a.max_energy_error]),
+            Col::Bool("stop_on_outcome", vec![a.stop_on_outcome]),
         ]),
     )
 }

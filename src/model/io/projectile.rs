@@ -31,6 +31,7 @@ pub fn read(r: &mut Reading) -> Result<()> {
     };
     let (ax, ay, az) = (o("axis_x")?, o("axis_y")?, o("axis_z")?);
     let (len, k, mu) = (o("length")?, o("contact_stiffness")?, o("friction")?);
+    let damping = o("contact_damping")?;
     let presc = t
         .bool_opt("prescribed_velocity")?
         .unwrap_or_else(|| vec![None; n]);
@@ -62,6 +63,7 @@ pub fn read(r: &mut Reading) -> Result<()> {
             prescribed_velocity: presc[row].unwrap_or(false),
             contact_stiffness: k[row],
             friction: mu[row].unwrap_or(0.0),
+            contact_damping: damping[row].unwrap_or(0.0),
             segment_contact: seg[row].unwrap_or(true),
         });
     }
@@ -104,6 +106,7 @@ pub fn write(m: &Model, w: &Writing) -> Result<()> {
                 p.iter().map(|x| x.contact_stiffness).collect(),
             ),
             Col::F64("friction", c(|x| x.friction)),
+            Col::F64("contact_damping", c(|x| x.contact_damping)),
             Col::Bool(
                 "segment_contact",
                 p.iter().map(|x| x.segment_contact).collect(),

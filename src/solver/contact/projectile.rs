@@ -61,6 +61,8 @@ pub struct Projectile {
     /// Fixed penalty stiffness [N/m], or `None` for κ_c m/Δt².
     pub stiffness: Option<f64>,
     pub friction: f64,
+    /// Normal viscous damping ζ of the contact springs (fraction of critical).
+    pub damping: f64,
     /// Contact the membrane faces' sample points too.
     pub segments: bool,
     /// Contact force on the projectile at the last step [N].
@@ -83,6 +85,7 @@ impl Projectile {
             prescribed: p.prescribed_velocity,
             stiffness: p.contact_stiffness,
             friction: p.friction,
+            damping: p.contact_damping,
             segments: p.segment_contact,
             force: [0.0; 3],
         }
@@ -272,6 +275,11 @@ pub struct ProjectileContact {
     k_node: Vec<f64>,
     /// Friction work dissipated in contact [J].
     pub friction_work: f64,
+    /// Work dissipated by the contact springs' dashpots [J].
+    pub damping_work: f64,
+    /// When asked, the friction work so far by node [J] (a face contact's shared by the
+    /// face's nodes with the contact point's weights), for the energy absorbed per layer.
+    pub node_friction: Option<Vec<f64>>,
     /// Work done by projectiles with prescribed velocity [J].
     pub prescribed_work: f64,
     /// Directions normal to the symmetry planes: projectiles cannot move along them.
@@ -368,6 +376,8 @@ impl ProjectileContact {
             face_tris,
             k_node: vec![],
             friction_work: 0.0,
+            damping_work: 0.0,
+            node_friction: None,
             prescribed_work: 0.0,
             fixed: std::array::from_fn(|d| m.symmetry.iter().any(|sp| sp.normal == d)),
             near: vec![],
@@ -450,13 +460,27 @@ impl ProjectileContact {
                 })
                 .collect();
             for (i, g, n) in inside {
-                let fnorm = p.stiffness.unwrap_or(kc[i]) * g;
+                let k = p.stiffness.unwrap_or(kc[i]);
+                let mut fnorm = k * g;
+                if p.damping > 0.0 {
+                    // A dashpot on the approach speed, never pulling the node back
+                    // (LS-DYNA's VDC); its work on the node (over the last half step) is
+                    // dissipated.
+                    let vr = [v[i][0] - p.v[0], v[i][1] - p.v[1], v[i][2] - p.v[2]];
+                    let vn = vr[0] * n[0] + vr[1] * n[1] + vr[2] * n[2];
+                    let fd = (-2.0 * p.damping * (k * mass[i]).sqrt() * vn).max(-fnorm);
+                    fnorm += fd;
+                    self.damping_work -= fd * vn * dt_prev;
+                }
                 let mut f = [n[0] * fnorm, n[1] * fnorm, n[2] * fnorm];
                 if p.friction > 0.0 {
                     let vr = [v[i][0] - p.v[0], v[i][1] - p.v[1], v[i][2] - p.v[2]];
                     let (ft, power) = friction(&n, fnorm, &vr, p.friction);
                     f = [f[0] + ft[0], f[1] + ft[1], f[2] + ft[2]];
                     self.friction_work += power * dt_prev;
+                    if let Some(nf) = self.node_friction.as_mut() {
+                        nf[i] += power * dt_prev;
+                    }
                 }
                 add(&mut fcon[i], &f);
                 ftot = [ftot[0] - f[0], ftot[1] - f[1], ftot[2] - f[2]];
@@ -494,6 +518,11 @@ impl ProjectileContact {
                         let (ft, power) = friction(&n, fnorm, &vr, p.friction);
                         f = [f[0] + ft[0], f[1] + ft[1], f[2] + ft[2]];
                         self.friction_work += power * dt_prev;
+                        if let Some(nf) = self.node_friction.as_mut() {
+                            for a in 0..3 {
+                                nf[t.nodes[a] as usize] += w[a] * power * dt_prev;
+                            }
+                        }
                     }
                     for a in 0..3 {
                         let i = t.nodes[a] as usize;
@@ -524,6 +553,11 @@ impl ProjectileContact {
                         let (ft, power) = friction(&n, fnorm, &vr, p.friction);
                         f = [f[0] + ft[0], f[1] + ft[1], f[2] + ft[2]];
                         self.friction_work += power * dt_prev;
+                        if let Some(nf) = self.node_friction.as_mut() {
+                            for a in 0..sp.n {
+                                nf[nodes[a] as usize] += sp.w[a] * power * dt_prev;
+                            }
+                        }
                     }
                     for a in 0..sp.n {
                         let i = nodes[a] as usize;

@@ -236,6 +236,9 @@ pub struct SurfaceContact {
     counts: ChunkSums,
     /// Friction work dissipated so far [J].
     pub dissipated: f64,
+    /// When asked ([`SurfaceContact::track_friction`]): the friction work so far by slave
+    /// node [J] (a pair's work goes to its slave), for the energy absorbed per layer.
+    pub node_friction: Option<Vec<f64>>,
     /// Stored energy at the last force evaluation [J].
     pub stored: f64,
     pub initial: Vec<InitialPen>,
@@ -293,6 +296,12 @@ impl SurfaceContact {
 
     pub fn is_empty(&self) -> bool {
         self.sides.is_empty()
+    }
+
+    /// Keep the friction work by slave node from now on (`node_friction`), for `nodes`
+    /// nodes.
+    pub fn track_friction(&mut self, nodes: usize) {
+        self.node_friction = Some(vec![0.0; nodes]);
     }
 
     /// Element `e` of kind `kind` has failed: its faces (or segments) leave every side
@@ -454,6 +463,14 @@ impl SurfaceContact {
                 self.counts.penetrated += c.penetrated;
             }
             self.slave_steps += s.slaves.len() as u64;
+            if let Some(nf) = self.node_friction.as_mut() {
+                // In side, chunk and slave order: the same sums for any thread count.
+                for active in &s.chunk_active {
+                    for &si in active {
+                        nf[s.slaves[si as usize] as usize] += s.out[si as usize].dissipated;
+                    }
+                }
+            }
         }
         let t_narrow = std::time::Instant::now();
         let ph = &mut self.phases;
