@@ -1,7 +1,13 @@
-//! Ballistic limits from impact runs: the Lambert–Jonas fit of residual against striking
-//! velocity ([`lambert_jonas`]) and the probability of perforation ([`probability`]).
+//! Ballistic limits from impact runs: the runs gathered and grouped ([`runs`]), the
+//! Lambert–Jonas fit of residual against striking velocity ([`lambert_jonas`]), the
+//! probability of perforation ([`probability`]), the limit of each group and its tables
+//! ([`limit`]), and a search that runs the impacts itself, bracketing the limit
+//! ([`search`]).
 //! The physics and the practice behind them: docs/theory.md, "Failure, perforation and
 //! the ballistic limit".
 
 pub mod lambert_jonas;
+pub mod limit;
 pub mod probability;
+pub mod runs;
+pub mod search;

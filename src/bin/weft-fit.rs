@@ -23,7 +23,7 @@ use weft::fit::Method;
                   --reference-model, --reference-history and --model in the same order; the objective is their mean T.\n\n\
                   A parameter is PART.PROPERTY[*FACTOR][,PART.PROPERTY[*FACTOR]...]:LOWER:UPPER[:log|lin][:INITIAL]: \
                   the property names are the columns of parts.parquet (docs/tables.md; aliases E, rho, A, E1, E2, nu12, \
-                  G12, G, s, b, h), comma-separated targets are tied to one value (each times its factor), and the \
+                  G12, G, s, b, h, eps_f), comma-separated targets are tied to one value (each times its factor), and the \
                   start is the model's own value unless given.\n\n\
                   --objective arrival matches wave arrival times along the ordered --set instead (for each --arrival \
                   COMPONENT:LEVEL, or --arrival-component at --relative-level of each node's peak, as weft-wavespeed measures \

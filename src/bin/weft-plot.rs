@@ -43,6 +43,10 @@ enum Figure {
     /// Test MSE of a network search against the hidden neurons, per activation
     /// (weft-surrogate's search.parquet; the paper's Fig. 6b).
     Surrogate(SurrogateArgs),
+    /// A ballistic limit (weft-ballistic's tables): residual against striking velocity
+    /// with the Lambert–Jonas fits, energy absorbed, probability of perforation, or the
+    /// limit against layers.
+    Ballistic(BallisticArgs),
     /// Section of a woven patch along y = y₀: the yarn along x (centre line and ± t/2
     /// envelope) and the sections of the yarns across it; reference dashed and formed
     /// solid for a model from weft-form.
@@ -243,6 +247,31 @@ struct FitArgs {
 }
 
 #[derive(Args)]
+struct BallisticArgs {
+    /// ballistic_runs.parquet from weft-ballistic.
+    #[arg(long)]
+    runs: PathBuf,
+    /// ballistic_limit.parquet from weft-ballistic.
+    #[arg(long)]
+    limit: PathBuf,
+    /// Which figure: residual, energy, probability or limit.
+    #[arg(long, value_enum)]
+    kind: plot::ballistic::BallisticKind,
+    /// The grouping column of the tables (weft-ballistic --by).
+    #[arg(long, default_value = "layers")]
+    by: String,
+    /// `limit`: the abscissa is the grouping value times this factor (e.g. 0.1946, the
+    /// areal density of one layer in kg/m²) ...
+    #[arg(long, default_value_t = 1.0)]
+    x_factor: f64,
+    /// ... under this label (e.g. 'areal density [kg/m²]').
+    #[arg(long)]
+    x_label: Option<String>,
+    #[command(flatten)]
+    common: Common,
+}
+
+#[derive(Args)]
 struct SurrogateArgs {
     /// search.parquet from weft-surrogate train.
     #[arg(long)]
@@ -349,6 +378,17 @@ fn run() -> anyhow::Result<()> {
                     Some(p) => Some(weft::surrogate::Surrogate::read(p)?.regression_test_mse),
                     None => None,
                 },
+            }),
+            a.common,
+        ),
+        Figure::Ballistic(a) => (
+            plot::Figure::Ballistic(plot::ballistic::BallisticFigure {
+                runs: a.runs,
+                limit: a.limit,
+                by: a.by,
+                kind: a.kind,
+                x_factor: a.x_factor,
+                x_label: a.x_label,
             }),
             a.common,
         ),

@@ -108,6 +108,41 @@ pub(crate) fn coarse_membrane(
     props: &MembraneProps,
     first_id: i64,
 ) -> Coarse {
+    coarse_membrane_at(m, pos, quarter, c, props, first_id, &Sheet::default())
+}
+
+/// Which membrane sheet of a stack: its height, part id and name, and its first element id.
+#[derive(Debug, Clone)]
+pub(crate) struct Sheet {
+    pub(crate) z: f64,
+    pub(crate) part_id: i64,
+    pub(crate) name: String,
+    pub(crate) first_element: i64,
+}
+
+impl Default for Sheet {
+    /// The single sheet: z = 0, part 90 `coarse_membrane`, elements from 10⁶.
+    fn default() -> Self {
+        Sheet {
+            z: 0.0,
+            part_id: 90,
+            name: "coarse_membrane".into(),
+            first_element: 1_000_000,
+        }
+    }
+}
+
+/// [`coarse_membrane`] as one sheet of a stack (a multi-layer fabric's surround: a sheet
+/// per layer, at its height).
+pub(crate) fn coarse_membrane_at(
+    m: &mut Model,
+    pos: &[f64],
+    quarter: bool,
+    c: f64,
+    props: &MembraneProps,
+    first_id: i64,
+    sheet: &Sheet,
+) -> Coarse {
     let lines: Vec<f64> = if quarter {
         pos.to_vec()
     } else {
@@ -141,13 +176,13 @@ pub(crate) fn coarse_membrane(
     for j in 0..k {
         for i in 0..k {
             if used[j * k + i] {
-                idx[j * k + i] = m.add_node(nid, [lines[i], lines[j], 0.0]);
+                idx[j * k + i] = m.add_node(nid, [lines[i], lines[j], sheet.z]);
                 nid += 1;
             }
         }
     }
-    let part = m.add_part(90, "coarse_membrane", ElementKind::Quad, props.part());
-    let mut eid = 1_000_000i64;
+    let part = m.add_part(sheet.part_id, &sheet.name, ElementKind::Quad, props.part());
+    let mut eid = sheet.first_element;
     for (i, j) in cells {
         m.add_element(
             eid,

@@ -7,6 +7,7 @@
 //! Errors are `anyhow` errors: problems with the input are [`WeftError`]s inside them;
 //! the file system and the drawing backend fail with their own errors under a context.
 
+pub mod ballistic;
 mod chart;
 pub mod field;
 mod history;
@@ -53,6 +54,8 @@ pub enum Figure {
     /// Test MSE of a network search against the hidden neurons n₁, per activation
     /// (search.parquet; the paper's Fig. 6b).
     Surrogate(SurrogateFigure),
+    /// A ballistic limit's figures (weft-ballistic's tables).
+    Ballistic(ballistic::BallisticFigure),
 }
 
 /// What drawing a figure reports back to the binary.
@@ -74,6 +77,7 @@ pub fn run(c: &Config) -> anyhow::Result<Report> {
         Figure::Error(a) => tables::error(a)?,
         Figure::Fit(a) => tables::fit(a)?,
         Figure::Surrogate(a) => tables::surrogate(a)?,
+        Figure::Ballistic(a) => ballistic::ballistic(a)?,
         Figure::Weave(a) => weave::weave(a)?,
         Figure::Field(a) => {
             let (f, report) = field::build(a)?;

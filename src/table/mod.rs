@@ -97,6 +97,8 @@ pub enum Col {
     F64Named(String, Vec<f64>),
     /// A nullable float column named at run time.
     OptF64Named(String, Vec<Option<f64>>),
+    /// A string column named at run time (a grouping column's).
+    StrNamed(String, Vec<String>),
 }
 
 impl Col {
@@ -141,6 +143,10 @@ impl Col {
             Col::OptF64Named(n, v) => (
                 Field::new(n, DataType::Float64, true),
                 Arc::new(Float64Array::from(v)),
+            ),
+            Col::StrNamed(n, v) => (
+                Field::new(n, DataType::Utf8, false),
+                Arc::new(StringArray::from(v)),
             ),
         }
     }

@@ -61,6 +61,8 @@ pub struct WovenInfo {
     pub areal_density: f64,
     /// The yarns' contact thickness: the bands' centre thickness t_c [m].
     pub contact_thickness: f64,
+    /// The distance between layers' mid-planes [m].
+    pub layer_pitch: f64,
 }
 
 fn check(p: &WovenBandParams) -> Result<()> {
@@ -274,6 +276,7 @@ pub fn woven(p: &WovenBandParams) -> Result<(Model, WovenInfo)> {
         area,
         areal_density: 2.0 * p.density * area * (1.0 + crimp) / p.spacing,
         contact_thickness: weave.section.t_centre,
+        layer_pitch: pitch,
     };
     if let Some(s) = &p.surround {
         surround(&mut m, p, s, &info)?;
@@ -402,7 +405,9 @@ fn add_projectile(m: &mut Model, p: &WovenBandParams, s: &Section, top: f64) {
 
 /// Ties the quarter patch's yarn ends into a graded membrane (see [`Surround`]).
 fn surround(m: &mut Model, p: &WovenBandParams, s: &Surround, info: &WovenInfo) -> Result<()> {
-    use crate::generate::surround::{coarse_membrane, graded_lines, tie_to_hole, MembraneProps};
+    use crate::generate::surround::{
+        coarse_membrane_at, graded_lines, tie_to_hole, MembraneProps, Sheet,
+    };
     if !p.quarter {
         return Err(WeftError::input("--membrane-length with --full".to_string())
             .expected("a quarter patch: a full patch's yarn ends lie at the crimp's crests, off the membrane's plane")
@@ -431,8 +436,11 @@ fn surround(m: &mut Model, p: &WovenBandParams, s: &Surround, info: &WovenInfo) 
             return bad(name, v, "a ratio > 0");
         }
     }
-    let layers = p.layers as f64;
-    let thickness = s.thickness.unwrap_or(2.0 * info.area * layers / p.spacing);
+    // One membrane sheet per layer, at the layer's height, carrying one layer's share:
+    // each layer's yarn ends (at its mid-plane: the quarter's edge lies where the crimp
+    // crosses it) are tied to its own sheet.
+    let layers = p.layers;
+    let thickness = s.thickness.unwrap_or(2.0 * info.area / p.spacing);
     if !(thickness > 0.0 && thickness.is_finite()) {
         return bad("membrane-thickness", thickness, "a thickness > 0 in m");
     }
@@ -442,19 +450,46 @@ fn surround(m: &mut Model, p: &WovenBandParams, s: &Surround, info: &WovenInfo) 
         poisson_ratio: 0.0,
         shear_modulus: s.shear_ratio * e_m,
         thickness,
-        density: s.density_ratio * info.areal_density * layers / thickness,
+        density: s.density_ratio * info.areal_density / thickness,
     };
     // The yarn ends are tied, not held.
     let ends = m.node_sets["edge"].clone();
     let is_end: std::collections::HashSet<usize> = ends.iter().copied().collect();
     m.constraints.retain(|(n, _)| !is_end.contains(n));
     let lines = graded_lines(c, 0.5 * p.spacing, s.length, s.growth)?;
-    let first_id = m.node_id.iter().copied().max().unwrap_or(0) + 1;
     let patch_nodes = m.num_nodes();
-    let coarse = coarse_membrane(m, &lines, true, c, &props, first_id);
-    let tied = tie_to_hole(m, &coarse, &ends)?;
-    for &o in &coarse.outer {
-        m.constraints.push((o, [true, true, true]));
+    let mut tied = Vec::new();
+    for l in 0..layers {
+        let zl = -(l as f64) * info.layer_pitch;
+        let sheet = if l == 0 {
+            Sheet::default()
+        } else {
+            Sheet {
+                z: zl,
+                part_id: 90 + l as i64,
+                name: format!("coarse_membrane_{}", l + 1),
+                first_element: 1_000_000 + 200_000 * l as i64,
+            }
+        };
+        let first_id = m.node_id.iter().copied().max().unwrap_or(0) + 1;
+        let before = m.elements.get(&ElementKind::Quad).map_or(0, |b| b.len());
+        let coarse = coarse_membrane_at(m, &lines, true, c, &props, first_id, &sheet);
+        let layer_ends: Vec<usize> = ends
+            .iter()
+            .copied()
+            .filter(|&n| (m.coords[n][2] - zl).abs() <= 1e-9)
+            .collect();
+        tied.extend(tie_to_hole(m, &coarse, &layer_ends)?);
+        for &o in &coarse.outer {
+            m.constraints.push((o, [true, true, true]));
+        }
+        // The sheet belongs to its layer (its energies and deflection with it).
+        let b = m
+            .elements
+            .get_mut(&ElementKind::Quad)
+            .expect("the sheet's quads");
+        b.layer.resize(before, None);
+        b.layer.resize(b.len(), Some(l as i64 + 1));
     }
     // The x axis line on both sides of the interface: the patch's crossings, then the
     // membrane's nodes on y = 0 beyond it.

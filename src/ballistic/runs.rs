@@ -1,0 +1,177 @@
+//! Impact runs gathered for a ballistic limit: one [`Run`] per impact, read from the
+//! `summary.parquet` of each run folder (or from one table that gathers them, as
+//! `weft gather` writes), grouped by a column (`layers`, by default), each group checked
+//! to be one model.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use crate::error::{Result, WeftError};
+use crate::table::Table;
+
+/// One impact.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Run {
+    /// Where it comes from: the run folder, or `TABLE row N`.
+    pub source: String,
+    /// The value of the grouping column.
+    pub group: String,
+    pub striking_velocity: f64,
+    /// 0 when stopped.
+    pub residual_velocity: f64,
+    pub perforated: bool,
+    /// `perforated`, `arrested` (or `undecided`: refused before a fit).
+    pub outcome: String,
+    /// The energy the fabric absorbed by the end of the run [J] (NaN when unknown).
+    pub energy_absorbed: f64,
+    /// What must agree within a group: layers, the projectile's mass and radius, and the
+    /// model's nodes and elements.
+    pub signature: Vec<(&'static str, f64)>,
+}
+
+/// The summary columns a run must have.
+const REQUIRED: &str = "striking_velocity, outcome, perforated, residual_velocity, layers";
+
+/// The columns that say two runs are of one model (a velocity and a seed may differ).
+const SIGNATURE: [&str; 5] = [
+    "layers",
+    "projectile_mass",
+    "projectile_radius",
+    "nodes",
+    "elements",
+];
+
+/// The runs of a table of summaries: `summary.parquet` of one run (one row), or a table
+/// that gathers several (`weft gather --table summary.parquet`), grouped by `by`.
+pub fn read_table(path: &Path, by: &str, label: &dyn Fn(usize) -> String) -> Result<Vec<Run>> {
+    let t = Table::read(path)?;
+    let n = t.num_rows();
+    let sv = t.f64("striking_velocity", REQUIRED)?;
+    let outcome = t.str("outcome", REQUIRED)?;
+    let perforated = t.bool("perforated", REQUIRED)?;
+    let residual = t.f64_opt("residual_velocity")?.unwrap_or(vec![None; n]);
+    let absorbed = t.f64_opt("energy_absorbed")?.unwrap_or(vec![None; n]);
+    let group = group_column(&t, by)?;
+    let sig: Vec<(&'static str, Vec<f64>)> = SIGNATURE
+        .iter()
+        .filter(|c| t.has(c))
+        .map(|&c| Ok((c, numeric(&t, c)?)))
+        .collect::<Result<_>>()?;
+    let mut runs = Vec::with_capacity(n);
+    for row in 0..n {
+        runs.push(Run {
+            source: label(row),
+            group: group[row].clone(),
+            striking_velocity: sv[row],
+            residual_velocity: if perforated[row] {
+                residual[row].unwrap_or(f64::NAN)
+            } else {
+                0.0
+            },
+            perforated: perforated[row],
+            outcome: outcome[row].clone(),
+            energy_absorbed: absorbed[row].unwrap_or(f64::NAN),
+            signature: sig.iter().map(|(c, v)| (*c, v[row])).collect(),
+        });
+    }
+    Ok(runs)
+}
+
+/// A numeric column as f64 (integers included).
+fn numeric(t: &Table, c: &str) -> Result<Vec<f64>> {
+    t.f64(c, REQUIRED)
+}
+
+/// The grouping column as text (integers and floats as written).
+fn group_column(t: &Table, by: &str) -> Result<Vec<String>> {
+    if !t.has(by) {
+        return Err(
+            WeftError::input(format!("no column `{by}` to group the runs by"))
+                .in_file(&t.path)
+                .expected(format!("a column `{by}` (--by), e.g. `layers`"))
+                .hint("give --by a column of the runs' summaries, or of the gathered table"),
+        );
+    }
+    if let Ok(v) = t.str(by, by) {
+        return Ok(v);
+    }
+    Ok(t.f64(by, by)?
+        .iter()
+        .map(|x| {
+            if x.fract() == 0.0 && x.abs() < 1e15 {
+                format!("{}", *x as i64)
+            } else {
+                format!("{x}")
+            }
+        })
+        .collect())
+}
+
+/// The runs of run folders (each with its `summary.parquet`).
+pub fn read_folders(dirs: &[PathBuf], by: &str) -> Result<Vec<Run>> {
+    let mut runs = Vec::new();
+    for d in dirs {
+        let path = d.join("summary.parquet");
+        if !path.exists() {
+            return Err(
+                WeftError::input(format!("`{}` has no summary.parquet", d.display()))
+                    .in_file(&path)
+                    .expected("the output folder of a weft-simulate run")
+                    .hint("a run that was killed writes nothing; rerun it"),
+            );
+        }
+        let label = |_| d.display().to_string();
+        runs.extend(read_table(&path, by, &label)?);
+    }
+    Ok(runs)
+}
+
+/// The runs by group (in the groups' order: numeric when they all are), each group
+/// checked: decided outcomes only, and one model (the same signature).
+pub fn group(runs: Vec<Run>) -> Result<Vec<(String, Vec<Run>)>> {
+    let mut by: BTreeMap<String, Vec<Run>> = BTreeMap::new();
+    for r in runs {
+        if r.outcome != "perforated" && r.outcome != "arrested" {
+            return Err(WeftError::input(format!(
+                "run `{}` at {} m/s ended `{}`",
+                r.source, r.striking_velocity, r.outcome
+            ))
+            .expected("perforated or arrested: a run whose outcome is decided")
+            .hint("raise the run's end time (weft-simulate --end-time) so that the projectile is stopped or free of the fabric"));
+        }
+        by.entry(r.group.clone()).or_default().push(r);
+    }
+    for (g, rs) in &by {
+        check_one_model(g, rs)?;
+    }
+    let mut groups: Vec<(String, Vec<Run>)> = by.into_iter().collect();
+    if groups.iter().all(|(g, _)| g.parse::<f64>().is_ok()) {
+        groups.sort_by(|a, b| {
+            a.0.parse::<f64>()
+                .unwrap()
+                .total_cmp(&b.0.parse::<f64>().unwrap())
+        });
+    }
+    for (_, rs) in groups.iter_mut() {
+        rs.sort_by(|a, b| a.striking_velocity.total_cmp(&b.striking_velocity));
+    }
+    Ok(groups)
+}
+
+/// The runs of one group must be of one model: the same signature.
+fn check_one_model(group: &str, runs: &[Run]) -> Result<()> {
+    let first = &runs[0];
+    for r in &runs[1..] {
+        for ((c, a), (_, b)) in first.signature.iter().zip(&r.signature) {
+            if a != b && !(a.is_nan() && b.is_nan()) {
+                return Err(WeftError::input(format!(
+                    "runs `{}` and `{}` of group `{group}` are of different models: {c} = {a} and {b}",
+                    first.source, r.source
+                ))
+                .expected("one model per group: only the striking velocity (and a seed) may differ")
+                .hint("group the runs by the column that tells the models apart (--by), or fit them separately"));
+            }
+        }
+    }
+    Ok(())
+}

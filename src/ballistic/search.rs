@@ -1,0 +1,194 @@
+//! A ballistic limit searched by running the impacts: rounds of `per_round` impacts run
+//! in parallel at velocities spread over the bracket of the limit, each round narrowing
+//! the bracket (the fastest stop below the slowest perforation) by a factor
+//! `per_round + 1`, until it is narrower than the tolerance.
+
+use super::runs::Run;
+use crate::error::{Result, WeftError};
+use crate::model::Model;
+use crate::solver::output::Sink;
+use crate::solver::watch::{LayerValues, Outcome};
+use crate::solver::{Energies, Solver};
+
+/// How to search.
+#[derive(Debug, Clone)]
+pub struct Options {
+    /// The first bracket [m/s]: `lo` should stop, `hi` perforate.
+    pub lo: f64,
+    pub hi: f64,
+    /// Stop once the bracket is at most this wide [m/s].
+    pub tolerance: f64,
+    /// Impacts per round (run in parallel).
+    pub per_round: usize,
+    /// At most this many rounds.
+    pub max_rounds: usize,
+}
+
+/// One impact of the search.
+#[derive(Debug, Clone)]
+pub struct Impact {
+    pub round: usize,
+    pub run: Run,
+    /// Solver steps and the simulated time at the outcome.
+    pub steps: u64,
+    pub end_time: f64,
+}
+
+/// A sink that keeps nothing: the search reads the outcome from the solver.
+struct Discard;
+
+impl Sink for Discard {
+    fn history(&mut self, _: f64, _: &[usize], _: &[[f64; 3]], _: &[[f64; 3]]) -> Result<()> {
+        Ok(())
+    }
+    fn energy(&mut self, _: f64, _: &Energies) -> Result<()> {
+        Ok(())
+    }
+    fn layers(&mut self, _: f64, _: &[LayerValues]) -> Result<()> {
+        Ok(())
+    }
+}
+
+/// One impact of `m` at `v` [m/s], run to its outcome.
+pub fn impact(m: &Model, v: f64, label: &str) -> Result<(Run, u64, f64)> {
+    let mut m = m.clone();
+    for p in &mut m.projectiles {
+        let d = p.velocity;
+        let n = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+        let dir = if n > 0.0 {
+            [d[0] / n, d[1] / n, d[2] / n]
+        } else {
+            p.axis
+        };
+        p.velocity = [v * dir[0], v * dir[1], v * dir[2]];
+    }
+    m.analysis.stop_on_outcome = true;
+    let mut s = Solver::new(&m)?;
+    let stats = s
+        .run(&mut Discard, &mut |_| {})
+        .map_err(|e| e.context(format!("the impact at {v} m/s stopped")))?;
+    let (perforated, residual, outcome) = match s.watch.outcome {
+        Outcome::Perforated {
+            residual_velocity, ..
+        } => (true, residual_velocity, "perforated"),
+        Outcome::Arrested { .. } => (false, 0.0, "arrested"),
+        Outcome::Undecided => (false, 0.0, "undecided"),
+    };
+    let absorbed: f64 = s.watch.last_rows.iter().map(|r| r[4]).sum();
+    Ok((
+        Run {
+            source: label.to_string(),
+            group: "search".into(),
+            striking_velocity: v,
+            residual_velocity: residual,
+            perforated,
+            outcome: outcome.into(),
+            energy_absorbed: if s.watch.n_layers > 0 {
+                absorbed
+            } else {
+                f64::NAN
+            },
+            signature: vec![],
+        },
+        stats.steps,
+        stats.end_time,
+    ))
+}
+
+/// The bracket of the runs so far: the fastest stop below the slowest perforation, and
+/// that perforation.
+pub fn bracket(runs: &[Impact]) -> (f64, f64) {
+    let hi = runs
+        .iter()
+        .filter(|r| r.run.perforated)
+        .map(|r| r.run.striking_velocity)
+        .fold(f64::INFINITY, f64::min);
+    let lo = runs
+        .iter()
+        .filter(|r| !r.run.perforated && r.run.striking_velocity < hi)
+        .map(|r| r.run.striking_velocity)
+        .fold(f64::NEG_INFINITY, f64::max);
+    (lo, hi)
+}
+
+/// The search: rounds of impacts until the bracket is within the tolerance. `progress`
+/// hears of each round's bracket.
+pub fn search(
+    m: &Model,
+    o: &Options,
+    mut progress: impl FnMut(usize, f64, f64),
+) -> Result<Vec<Impact>> {
+    use rayon::prelude::*;
+    if !(o.lo >= 0.0 && o.hi > o.lo && o.hi.is_finite()) {
+        return Err(WeftError::input(format!("--lo {} --hi {}", o.lo, o.hi))
+            .expected("0 ≤ lo < hi: striking velocities in m/s"));
+    }
+    if !(o.tolerance > 0.0) || o.per_round == 0 {
+        return Err(WeftError::input(format!(
+            "--tolerance {} with --per-round {}",
+            o.tolerance, o.per_round
+        ))
+        .expected("a tolerance > 0 in m/s and at least one impact per round"));
+    }
+    if m.projectiles.is_empty() {
+        return Err(WeftError::input("the model has no projectile")
+            .in_file("projectile.parquet")
+            .expected("a model with a projectile (weft-weave woven)"));
+    }
+    let mut runs: Vec<Impact> = Vec::new();
+    // The first round takes the bracket's ends and points between them.
+    let k = o.per_round.max(2);
+    let mut speeds: Vec<f64> = (0..k)
+        .map(|i| o.lo + (o.hi - o.lo) * i as f64 / (k - 1) as f64)
+        .collect();
+    for round in 0..o.max_rounds {
+        let done: Vec<Result<(Run, u64, f64)>> = speeds
+            .par_iter()
+            .map(|&v| impact(m, v, &format!("round {round}, {v:.3} m/s")))
+            .collect();
+        for r in done {
+            let (run, steps, end_time) = r?;
+            runs.push(Impact {
+                round,
+                run,
+                steps,
+                end_time,
+            });
+        }
+        if let Some(u) = runs.iter().find(|r| r.run.outcome == "undecided") {
+            return Err(WeftError::input(format!(
+                "the impact at {} m/s was neither arrested nor free of the fabric by its end time {:.3e} s",
+                u.run.striking_velocity, u.end_time
+            ))
+            .in_file("analysis.parquet")
+            .in_column("end_time")
+            .expected("an end time long enough for every impact's outcome")
+            .hint("raise the model's end time (weft-weave woven --end-time)"));
+        }
+        let (lo, hi) = bracket(&runs);
+        progress(round, lo, hi);
+        if !hi.is_finite() {
+            return Err(WeftError::input(format!(
+                "every impact up to --hi {} m/s was stopped",
+                o.hi
+            ))
+            .expected("a bracket whose top perforates")
+            .hint("raise --hi"));
+        }
+        if !lo.is_finite() {
+            return Err(WeftError::input(format!(
+                "every impact down to --lo {} m/s perforated",
+                o.lo
+            ))
+            .expected("a bracket whose bottom is stopped")
+            .hint("lower --lo"));
+        }
+        if hi - lo <= o.tolerance {
+            break;
+        }
+        speeds = (1..=o.per_round)
+            .map(|i| lo + (hi - lo) * i as f64 / (o.per_round + 1) as f64)
+            .collect();
+    }
+    Ok(runs)
+}

@@ -1,0 +1,259 @@
+//! `weft-ballistic`: ballistic limits from impact runs (`fit`), or by running the impacts
+//! (`search`).
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+use weft::ballistic::lambert_jonas::Bounds;
+use weft::ballistic::limit::{self, Options};
+use weft::ballistic::probability::Link;
+use weft::ballistic::{runs, search};
+use weft::table::Provenance;
+
+#[derive(Parser)]
+#[command(
+    name = "weft-ballistic",
+    version,
+    about = "Ballistic limits (V50, the Lambert–Jonas fit) from impact runs, or by running them",
+    long_about = "The ballistic limit of a fabric from impacts at several striking velocities \
+                  (docs/theory.md, \"Failure, perforation and the ballistic limit\").\n\n\
+                  `fit` gathers impact runs (the weft-simulate output folders, or one table that \
+                  `weft gather --table summary.parquet` made of them), groups them (by `layers`), \
+                  and fits per group the Lambert–Jonas law V_r = a(V_s^p − V_bl^p)^(1/p) with \
+                  bootstrap intervals and the probability of perforation (V50, V10, V90; a \
+                  bracket when the outcomes are separated).\n\n`search` runs the impacts of one \
+                  model itself, in parallel, narrowing the bracket of the limit to a tolerance.\n\n\
+                  Both write ballistic_runs.parquet (one row per impact) and \
+                  ballistic_limit.parquet (one row per group) into --out (docs/tables.md).\n\n\
+                  Example:\n  weft-ballistic fit --runs runs/v300 runs/v350 runs/v400 --out runs/limit\n  \
+                  weft-ballistic search --model runs/patch --lo 50 --hi 400 --tolerance 5 --out runs/search"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Fit the ballistic limit of impact runs (one limit per group).
+    Fit(FitArgs),
+    /// Run impacts of one model, bracketing its limit to a tolerance, then fit it.
+    Search(SearchArgs),
+}
+
+#[derive(clap::Args)]
+struct FitArgs {
+    /// Impact run folders (weft-simulate --out), each with its summary.parquet.
+    #[arg(long, num_args = 1.., required_unless_present = "table")]
+    runs: Vec<PathBuf>,
+    /// A table of run summaries instead (weft gather --table summary.parquet), one row
+    /// per impact.
+    #[arg(long, conflicts_with = "runs")]
+    table: Option<PathBuf>,
+    /// The column that tells the groups apart (one limit per group).
+    #[arg(long, default_value = "layers")]
+    by: String,
+    #[command(flatten)]
+    fit: FitOptions,
+    /// Output folder for ballistic_runs.parquet and ballistic_limit.parquet.
+    #[arg(long)]
+    out: PathBuf,
+}
+
+#[derive(clap::Args)]
+struct FitOptions {
+    /// The probability of perforation's link: logit or probit.
+    #[arg(long, value_enum, default_value = "logit")]
+    link: LinkArg,
+    /// Bootstrap replicates of the Lambert–Jonas intervals.
+    #[arg(long, default_value_t = Options::default().replicates)]
+    bootstrap: usize,
+    /// Seed of the bootstrap.
+    #[arg(long, default_value_t = Options::default().seed)]
+    seed: u64,
+    /// Bounds of the Lambert–Jonas a [default: 0.1–2].
+    #[arg(long, num_args = 2, value_names = ["LO", "HI"])]
+    a_bounds: Option<Vec<f64>>,
+    /// Bounds of the Lambert–Jonas p [default: 1.1–5].
+    #[arg(long, num_args = 2, value_names = ["LO", "HI"])]
+    p_bounds: Option<Vec<f64>>,
+}
+
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum LinkArg {
+    Logit,
+    Probit,
+}
+
+#[derive(clap::Args)]
+struct SearchArgs {
+    /// The model folder (weft-weave woven with a failure strain): its projectile's speed is
+    /// set for each impact, and each runs to its outcome.
+    #[arg(long)]
+    model: PathBuf,
+    /// The first bracket [m/s]: the slower end should stop, the faster perforate.
+    #[arg(long)]
+    lo: f64,
+    #[arg(long)]
+    hi: f64,
+    /// Stop once the bracket is at most this wide [m/s].
+    #[arg(long, default_value_t = 5.0)]
+    tolerance: f64,
+    /// Impacts per round, run in parallel [default: the threads].
+    #[arg(long)]
+    per_round: Option<usize>,
+    /// At most this many rounds.
+    #[arg(long, default_value_t = 12)]
+    max_rounds: usize,
+    /// Worker threads [default: all cores]. Results do not depend on it.
+    #[arg(long)]
+    threads: Option<usize>,
+    #[command(flatten)]
+    fit: FitOptions,
+    /// Output folder for ballistic_runs.parquet and ballistic_limit.parquet.
+    #[arg(long)]
+    out: PathBuf,
+}
+
+impl FitOptions {
+    fn options(&self) -> anyhow::Result<Options> {
+        let d = Options::default();
+        let pair =
+            |v: &Option<Vec<f64>>, dflt: (f64, f64), name: &str| -> anyhow::Result<(f64, f64)> {
+                match v {
+                    None => Ok(dflt),
+                    Some(v) if v[0] > 0.0 && v[1] > v[0] && v[1].is_finite() => Ok((v[0], v[1])),
+                    Some(v) => Err(weft::WeftError::input(format!(
+                        "--{name}-bounds {} {}",
+                        v[0], v[1]
+                    ))
+                    .expected("0 < LO < HI")
+                    .into()),
+                }
+            };
+        Ok(Options {
+            bounds: Bounds {
+                a: pair(&self.a_bounds, d.bounds.a, "a")?,
+                p: pair(&self.p_bounds, d.bounds.p, "p")?,
+            },
+            link: match self.link {
+                LinkArg::Logit => Link::Logit,
+                LinkArg::Probit => Link::Probit,
+            },
+            replicates: self.bootstrap,
+            seed: self.seed,
+        })
+    }
+}
+
+fn main() -> ExitCode {
+    weft::cli::main(run_cli)
+}
+
+fn run_cli() -> anyhow::Result<ExitCode> {
+    let cli: Cli = weft::cli::parse();
+    match cli.command {
+        Command::Fit(a) => fit(a),
+        Command::Search(a) => search_cmd(a),
+    }
+}
+
+fn fit(a: FitArgs) -> anyhow::Result<ExitCode> {
+    let o = a.fit.options()?;
+    let all = match &a.table {
+        Some(t) => runs::read_table(t, &a.by, &|row| format!("{} row {row}", t.display()))?,
+        None => runs::read_folders(&a.runs, &a.by)?,
+    };
+    let groups = runs::group(all)?;
+    let limits = limit::fit_groups(&groups, &a.by, &o)?;
+    let params = serde_json::json!({
+        "runs": a.runs, "table": a.table, "by": a.by, "bootstrap": o.replicates, "seed": o.seed,
+        "a_bounds": o.bounds.a, "p_bounds": o.bounds.p, "link": o.link.name(),
+    });
+    write(&a.out, &groups, &limits, &a.by, params)?;
+    Ok(ExitCode::SUCCESS)
+}
+
+fn search_cmd(a: SearchArgs) -> anyhow::Result<ExitCode> {
+    let o = a.fit.options()?;
+    let m = weft::model::io::read_model(&a.model)?;
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(a.threads.unwrap_or(0))
+        .build()?;
+    let per_round = a.per_round.unwrap_or(pool.current_num_threads()).max(1);
+    let so = search::Options {
+        lo: a.lo,
+        hi: a.hi,
+        tolerance: a.tolerance,
+        per_round,
+        max_rounds: a.max_rounds,
+    };
+    let impacts = pool.install(|| {
+        search::search(&m, &so, |round, lo, hi| {
+            eprintln!("round {round}: the limit lies in ({lo:.2}, {hi:.2}) m/s")
+        })
+    })?;
+    let group = a
+        .model
+        .file_name()
+        .map_or("model".to_string(), |n| n.to_string_lossy().to_string());
+    let mut runs: Vec<runs::Run> = impacts
+        .iter()
+        .map(|i| runs::Run {
+            group: group.clone(),
+            ..i.run.clone()
+        })
+        .collect();
+    runs.sort_by(|a, b| a.striking_velocity.total_cmp(&b.striking_velocity));
+    let groups = vec![(group, runs)];
+    let limits = limit::fit_groups(&groups, "model", &o)?;
+    let params = serde_json::json!({
+        "model": a.model, "lo": a.lo, "hi": a.hi, "tolerance": a.tolerance,
+        "per_round": per_round, "max_rounds": a.max_rounds, "bootstrap": o.replicates, "seed": o.seed,
+        "a_bounds": o.bounds.a, "p_bounds": o.bounds.p, "link": o.link.name(),
+    });
+    write(&a.out, &groups, &limits, "model", params)?;
+    Ok(ExitCode::SUCCESS)
+}
+
+/// The two tables into `out`, and a line per limit on stderr.
+fn write(
+    out: &std::path::Path,
+    groups: &[(String, Vec<runs::Run>)],
+    limits: &[limit::Limit],
+    by: &str,
+    params: serde_json::Value,
+) -> anyhow::Result<()> {
+    std::fs::create_dir_all(out).map_err(|e| weft::WeftError::io(out, e))?;
+    let prov = Provenance::new("ballistic", params);
+    limit::write_runs(
+        &out.join("ballistic_runs.parquet"),
+        groups,
+        limits,
+        by,
+        &prov,
+    )?;
+    limit::write_limits(&out.join("ballistic_limit.parquet"), limits, by, &prov)?;
+    for l in limits {
+        let p = &l.probability;
+        let lj = l.lambert_jonas.map_or(
+            "Lambert–Jonas: fewer than 3 perforations".to_string(),
+            |f| {
+                format!(
+                    "V_bl {:.1} m/s ({:.1}–{:.1}), a {:.3}, p {:.2}, rms {:.2} m/s",
+                    f.law.v_bl, f.v_bl_interval.0, f.v_bl_interval.1, f.law.a, f.law.p, f.rms
+                )
+            },
+        );
+        eprintln!(
+            "{by} {}: {} runs, {} perforated; V50 {:.1} m/s ({:.1}–{:.1}, {}); {lj}",
+            l.group, l.runs, l.perforations, p.v50, p.v50_interval.0, p.v50_interval.1, p.method
+        );
+    }
+    eprintln!(
+        "  wrote {}/{{ballistic_runs,ballistic_limit}}.parquet",
+        out.display()
+    );
+    Ok(())
+}
