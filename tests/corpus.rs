@@ -271,7 +271,17 @@ fn check(model: &Path, file: &str, column: Option<&str>, what: &str) -> bool {
             });
         }
     }
-    if out.exists() {
+    if err.contains("the run stopped") {
+        // Refused during the run (a NaN, say): the tables up to the last good sample stay,
+        // marked as such in the summary.
+        let status = out.join("summary.parquet");
+        let t = Table::read(&status).unwrap();
+        assert_eq!(
+            t.str("status", "").unwrap(),
+            vec!["stopped"],
+            "{case}:\n{err}"
+        );
+    } else if out.exists() {
         let left: Vec<_> = std::fs::read_dir(&out).unwrap().collect();
         assert!(left.is_empty(), "{case}: output left after a refusal");
     }

@@ -258,7 +258,7 @@ fn rigidly_rotated_truss_frame_stays_unstressed_in_a_run() {
     }
     m.analysis.end_time = std::f64::consts::FRAC_PI_2 / w;
     m.analysis.output_interval = m.analysis.end_time / 50.0;
-    let (s, out, _) = weft::solver::run_in_memory(&m).unwrap();
+    let (s, out, stats) = weft::solver::run_in_memory(&m).unwrap();
     // Positions at t = π/(2ω) (the last output sample): node i at angle a_i + π/2; the
     // radius grows only by the centripetal stretch (strain ~ ρω²r²/E ~ 1e-10).
     for i in 0..3 {
@@ -287,8 +287,18 @@ fn rigidly_rotated_truss_frame_stays_unstressed_in_a_run() {
         w_max <= 4.0 * w_static * 1.01 && w_max > 0.5 * w_static,
         "strain energy {w_max} J"
     );
+    // The ledger's kinetic energy is the central difference's ½m v^{n−½}·v^{n+½}, which
+    // in a rotation differs from ½m|v|² by O((ωΔt)²)·KE (v^{n±½} = v ∓ aΔt/2 with a ⊥ v,
+    // |a| = ω|v|: the dot product is (ωΔt)²/4 below). The balance closes to that order:
+    // measured −7.6e-8 J = 0.64 (ωΔt)²·KE₀ (Δt 3.07e-5 s).
+    let dt = stats.end_time / stats.steps as f64;
+    let order = (w * dt).powi(2) * ke0;
     let e = out.energy.last().unwrap();
-    assert!(e.balance_error.abs() < 1e-6 * ke0, "{e:?}");
+    eprintln!(
+        "balance error {:.4e} J against (ωΔt)²·KE₀ = {order:.4e} J",
+        e.balance_error
+    );
+    assert!(e.balance_error.abs() < order, "{e:?}");
 }
 
 #[test]

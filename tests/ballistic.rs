@@ -1,0 +1,361 @@
+//! Perforation and the ballistic limit: the woven patch with failing yarns against the
+//! bullet, statistical strengths, the stopped run's tables, and the fits of
+//! `weft-ballistic`.
+//!
+//! References: the impulse–momentum theorem (a perforating projectile loses the momentum
+//! its contact force's impulse takes); the Weibull law of the strengths
+//! (docs/theory.md, "Failure, perforation and the ballistic limit") checked by the
+//! Kolmogorov–Smirnov test and the moments of ln ε (Weibull 1951); the Lambert–Jonas law
+//! (BRL-R-1852, 1976) on synthetic data.
+
+mod common;
+use common::woven::run_on;
+use common::*;
+use weft::ballistic::lambert_jonas::{self, Bounds, Law, Shot};
+use weft::ballistic::probability::{self, Link};
+use weft::generate::woven::{woven, StrengthPer, WovenBandParams, YarnFailure, YarnModel};
+use weft::model::ElementKind;
+use weft::random::Stream;
+use weft::solver::run_in_memory;
+use weft::solver::watch::Outcome;
+
+/// A small chain patch of 8 × 8 yarns a quarter, failing at 3.6 %, its runs ending at the
+/// outcome.
+fn patch(layers: usize, failure: YarnFailure) -> WovenBandParams {
+    WovenBandParams {
+        yarns: 8,
+        yarn_model: YarnModel::Chain,
+        layers,
+        failure,
+        stop_on_outcome: true,
+        end_time: 2e-4,
+        output_interval: 2e-7,
+        ..WovenBandParams::default()
+    }
+}
+
+fn failing() -> YarnFailure {
+    YarnFailure {
+        strain: 0.036,
+        ..YarnFailure::default()
+    }
+}
+
+/// A perforating projectile loses the momentum that the impulse of the contact force on
+/// it takes: m (v_end − v₀) = ∫ F dt (Newton's second law). The force is sampled every
+/// 20 ns (a step is 26 ns) and integrated by the trapezoid rule.
+#[test]
+fn a_perforating_projectile_loses_the_impulse_of_its_contact_force() {
+    let mut p = patch(1, failing());
+    p.projectile_velocity = 400.0;
+    p.output_interval = 2e-8;
+    let (m, _) = woven(&p).unwrap();
+    let (s, out, stats) = run_in_memory(&m).unwrap();
+    let Outcome::Perforated {
+        residual_velocity, ..
+    } = s.watch.outcome
+    else {
+        panic!("not perforated: {:?}", s.watch.outcome);
+    };
+    let mass = m.projectiles[0].mass;
+    let pr = &out.projectile;
+    let dp = mass * (pr.last().unwrap().2[5] - pr[0].2[5]);
+    let impulse: f64 = pr
+        .windows(2)
+        .map(|w| 0.5 * (w[1].0 - w[0].0) * (w[0].2[8] + w[1].2[8]))
+        .sum();
+    println!(
+        "perforated at 400 m/s, residual {residual_velocity:.2} m/s: Δp {dp:.6e} N·s, impulse {impulse:.6e} N·s ({:.2e}); balance {:.2e}",
+        rel(dp, impulse),
+        stats.max_balance_error_relative
+    );
+    assert!(dp > 0.0, "the projectile (moving in −z) slows: Δp_z > 0");
+    // Measured: 1.3·10⁻³ (the trapezoid over the sampled force; the issue asks 1 %).
+    assert!(rel(dp, impulse) < 5e-3, "{dp} vs {impulse}");
+}
+
+/// Strengths drawn per element with modulus m = 8 at the gauge length of the elements:
+/// the factors ε/ε₀ follow the Weibull law of scale 1 and modulus 8. Kolmogorov–Smirnov:
+/// D below its 1 % critical value 1.63/√n; the mean of ln(ε/ε₀) within four standard
+/// errors of −γ/m (γ Euler's constant), its variance within four of π²/(6m²).
+#[test]
+fn strengths_follow_the_weibull_law_asked_for() {
+    let modulus = 8.0;
+    let mut p = patch(2, failing());
+    p.yarns = 20;
+    p.failure.weibull_modulus = Some(modulus);
+    p.failure.per = StrengthPer::Element;
+    // The gauge length of one element: the factors are then the Weibull law's own.
+    p.failure.gauge_length = Some(p.spacing / p.per_spacing as f64);
+    p.failure.seed = 12345;
+    let (m, _) = woven(&p).unwrap();
+    let mut f = m.elements[&ElementKind::Truss].failure_factor.clone();
+    let n = f.len() as f64;
+    assert!(n > 5000.0);
+    f.sort_by(f64::total_cmp);
+    let cdf = |x: f64| 1.0 - (-x.powf(modulus)).exp();
+    let d = f
+        .iter()
+        .enumerate()
+        .map(|(i, &x)| {
+            let c = cdf(x);
+            (c - i as f64 / n).abs().max(((i + 1) as f64 / n - c).abs())
+        })
+        .fold(0.0, f64::max);
+    let logs: Vec<f64> = f.iter().map(|x| x.ln()).collect();
+    let mean = logs.iter().sum::<f64>() / n;
+    let var = logs.iter().map(|l| (l - mean).powi(2)).sum::<f64>() / (n - 1.0);
+    let euler = 0.577_215_664_901_532_9;
+    let (mu, sig2) = (
+        -euler / modulus,
+        std::f64::consts::PI.powi(2) / (6.0 * modulus * modulus),
+    );
+    // ln X is Gumbel (of the minimum): kurtosis 5.4, so Var(s²) ≈ (5.4 − 1)σ⁴/n.
+    println!(
+        "{n} factors: KS D = {d:.4} (1 % critical {:.4}); mean ln {mean:.5} vs {mu:.5}, variance {var:.6} vs {sig2:.6}",
+        1.63 / n.sqrt()
+    );
+    assert!(d < 1.63 / n.sqrt());
+    assert!((mean - mu).abs() < 4.0 * (sig2 / n).sqrt());
+    assert!((var - sig2).abs() < 4.0 * (4.4 * sig2 * sig2 / n).sqrt());
+    // The same seed, the same strengths; another seed, others.
+    let (m2, _) = woven(&p).unwrap();
+    assert_eq!(
+        m2.elements[&ElementKind::Truss].failure_factor,
+        m.elements[&ElementKind::Truss].failure_factor
+    );
+    p.failure.seed = 12346;
+    let (m3, _) = woven(&p).unwrap();
+    assert_ne!(
+        m3.elements[&ElementKind::Truss].failure_factor,
+        m.elements[&ElementKind::Truss].failure_factor
+    );
+}
+
+/// With statistical strengths and erosion active, 1 and 2 threads give the same bits
+/// (the solver's chunks are fixed and failures are collected in element order).
+#[test]
+fn erosion_with_statistical_strengths_is_thread_independent() {
+    let mut p = patch(2, failing());
+    p.failure.weibull_modulus = Some(10.0);
+    p.failure.seed = 7;
+    p.projectile_velocity = 300.0;
+    p.end_time = 3e-5;
+    let (m, _) = woven(&p).unwrap();
+    let (o1, _, s1) = run_on(&m, 1);
+    let (o2, _, _) = run_on(&m, 2);
+    let e1: Vec<[f64; 3]> = o1
+        .energy
+        .iter()
+        .map(|e| [e.kinetic, e.internal, e.eroded])
+        .collect();
+    let e2: Vec<[f64; 3]> = o2
+        .energy
+        .iter()
+        .map(|e| [e.kinetic, e.internal, e.eroded])
+        .collect();
+    let eroded = o1.energy.last().unwrap().eroded;
+    println!(
+        "two layers at 300 m/s to 30 µs: eroded {eroded:.4e} J, balance {:.2e}",
+        s1.max_balance_error_relative
+    );
+    assert!(eroded > 0.0, "something failed");
+    assert_eq!(e1, e2);
+    assert_eq!(o1.u, o2.u);
+    // Bit for bit, NaN (a layer with no failure yet) included.
+    let bits = |o: &weft::solver::output::MemorySink| -> Vec<u64> {
+        o.layers
+            .iter()
+            .flat_map(|(t, l)| {
+                std::iter::once(t.to_bits()).chain(l.iter().flatten().map(|x| x.to_bits()))
+            })
+            .collect()
+    };
+    assert_eq!(bits(&o1), bits(&o2));
+}
+
+/// Lambert–Jonas on synthetic data: without noise the constants come back to round-off;
+/// with noise (Gaussian, 3 m/s, seeded) the true constants lie in the bootstrap intervals.
+#[test]
+fn lambert_jonas_recovers_synthetic_laws() {
+    let truth = Law {
+        a: 0.9,
+        p: 2.2,
+        v_bl: 250.0,
+    };
+    let speeds: Vec<f64> = (0..20).map(|k| 200.0 + 15.0 * k as f64).collect();
+    let exact: Vec<Shot> = speeds
+        .iter()
+        .map(|&v| Shot {
+            striking: v,
+            residual: truth.residual(v),
+            perforated: v > truth.v_bl,
+        })
+        .collect();
+    let f = lambert_jonas::fit(&exact, &Bounds::default(), 200, 1).unwrap();
+    println!("exact: {:?}", f.law);
+    // Measured: relative errors below 10⁻¹⁰.
+    assert!(
+        rel(f.law.v_bl, truth.v_bl) < 1e-8
+            && rel(f.law.a, truth.a) < 1e-8
+            && rel(f.law.p, truth.p) < 1e-8
+    );
+    let mut rng = Stream::new(99);
+    let noisy: Vec<Shot> = exact
+        .iter()
+        .map(|s| Shot {
+            residual: if s.perforated {
+                (s.residual + 3.0 * rng.next_normal()).max(0.0)
+            } else {
+                0.0
+            },
+            ..*s
+        })
+        .collect();
+    let f = lambert_jonas::fit(&noisy, &Bounds::default(), 1000, 2).unwrap();
+    println!("noisy: {:?}", f);
+    let inside = |v: f64, (lo, hi): (f64, f64)| lo <= v && v <= hi;
+    assert!(inside(truth.v_bl, f.v_bl_interval), "{f:?}");
+    assert!(inside(truth.a, f.a_interval), "{f:?}");
+    assert!(inside(truth.p, f.p_interval), "{f:?}");
+}
+
+/// The probability of perforation on outcomes drawn from a known logistic law
+/// (V50 = 300 m/s, scale 10 m/s): the fit's V50 interval holds the true V50, and V10, V90
+/// are V50 ∓ 10 ln 9 within the interval's width.
+#[test]
+fn the_probability_fit_recovers_a_logistic_law() {
+    let (v50, s) = (300.0, 10.0);
+    let mut rng = Stream::new(5);
+    let outcomes: Vec<(f64, bool)> = (0..400)
+        .map(|i| {
+            let v = 250.0 + 100.0 * (i as f64 + 0.5) / 400.0;
+            (v, rng.next_uniform() < 1.0 / (1.0 + (-(v - v50) / s).exp()))
+        })
+        .collect();
+    let f = probability::fit(&outcomes, Link::Logit).unwrap();
+    println!("{f:?}");
+    assert_eq!(f.method, "logit");
+    assert!(f.v50_interval.0 <= v50 && v50 <= f.v50_interval.1, "{f:?}");
+    let w = f.v50_interval.1 - f.v50_interval.0;
+    let spread = s * 9f64.ln();
+    assert!((f.v90 - f.v10 - 2.0 * spread).abs() < 2.0 * w, "{f:?}");
+}
+
+// ---------------------------------------------------------------------------------------
+// Runs that stop, and bad input.
+
+/// A run that stops keeps what it computed: the tables up to the last good output
+/// sample, `status = stopped` with the reason in the summary, and an error (a non-zero
+/// exit). The stop: an energy-balance limit far below this rod's O(Δt²) drift.
+#[test]
+fn a_stopped_run_keeps_its_tables_and_says_why() {
+    let dir = tempfile::tempdir().unwrap();
+    let (model, out) = (dir.path().join("rod"), dir.path().join("out"));
+    let rod = weft::generate::rod::build(&weft::generate::rod::RodParams::default()).unwrap();
+    weft::model::io::write_model(
+        &rod,
+        &model,
+        &weft::table::Provenance::new("t", serde_json::json!({})),
+    )
+    .unwrap();
+    let c = weft::simulate::Config {
+        model: model.clone(),
+        out: out.clone(),
+        max_energy_error: Some(1e-13),
+        end_time: Some(4e-4),
+        ..Default::default()
+    };
+    let err = weft::simulate::run(&c, &mut |_| {})
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("the run stopped") && err.contains("energy balance error"),
+        "{err}"
+    );
+    let s = weft::table::Table::read(&out.join("summary.parquet")).unwrap();
+    assert_eq!(s.str("status", "").unwrap(), vec!["stopped"]);
+    let why = s.str_opt("stop_reason").unwrap().unwrap()[0]
+        .clone()
+        .unwrap();
+    assert!(why.contains("energy balance error"), "{why}");
+    let end = s.f64("end_time", "").unwrap()[0];
+    let e = weft::table::Table::read(&out.join("energy.parquet")).unwrap();
+    let t = e.f64("t", "").unwrap();
+    let h = weft::table::Table::read(&out.join("history.parquet")).unwrap();
+    println!(
+        "stopped at {end:e} s: {} energy rows, {} history rows; {why}",
+        t.len(),
+        h.num_rows()
+    );
+    assert!(end > 0.0 && end < 4e-4);
+    assert_eq!(
+        *t.last().unwrap(),
+        end,
+        "the tables end at the last good sample"
+    );
+}
+
+/// Bad input, each named: a negative or non-finite failure strain (parts.parquet), a
+/// Weibull modulus ≤ 0 (the generator), velocities that cannot bracket a limit, runs of
+/// two models in one group.
+#[test]
+fn bad_failure_input_is_named() {
+    let (mut m, _) = woven(&patch(1, failing())).unwrap();
+    let warp = m.parts.iter().position(|p| p.name == "warp_1").unwrap();
+    m.parts[warp].props.failure_strain = Some(-0.01);
+    let e = m.validate().unwrap_err().to_string();
+    assert!(
+        e.contains("failure_strain") && e.contains("-0.01") && e.contains("warp_1"),
+        "{e}"
+    );
+    m.parts[warp].props.failure_strain = Some(f64::INFINITY);
+    let e = m.validate().unwrap_err().to_string();
+    assert!(e.contains("failure_strain") && e.contains("inf"), "{e}");
+    for bad in [0.0, -3.0, f64::NAN] {
+        let mut p = patch(1, failing());
+        p.failure.weibull_modulus = Some(bad);
+        let e = woven(&p).unwrap_err().to_string();
+        assert!(
+            e.contains("--weibull-modulus") && e.contains("m > 0"),
+            "{e}"
+        );
+    }
+    let run = |v: f64, perforated: bool, nodes: f64| weft::ballistic::runs::Run {
+        source: format!("runs/{v}"),
+        group: "2".into(),
+        striking_velocity: v,
+        residual_velocity: if perforated { 0.5 * v } else { 0.0 },
+        perforated,
+        outcome: if perforated { "perforated" } else { "arrested" }.into(),
+        energy_absorbed: f64::NAN,
+        signature: vec![("layers", 2.0), ("nodes", nodes)],
+    };
+    let fit = |runs: Vec<weft::ballistic::runs::Run>| -> String {
+        match weft::ballistic::runs::group(runs) {
+            Err(e) => e.to_string(),
+            Ok(groups) => {
+                match weft::ballistic::limit::fit_groups(&groups, "layers", &Default::default()) {
+                    Err(e) => e.to_string(),
+                    Ok(_) => String::new(),
+                }
+            }
+        }
+    };
+    let all = fit(vec![run(300.0, true, 1.0), run(350.0, true, 1.0)]);
+    assert!(
+        all.contains("every run perforated")
+            && all.contains("300, 350")
+            && all.contains("layers = 2"),
+        "{all}"
+    );
+    let none = fit(vec![run(30.0, false, 1.0), run(35.0, false, 1.0)]);
+    assert!(none.contains("no run perforated"), "{none}");
+    let mixed = fit(vec![run(30.0, false, 1.0), run(300.0, true, 2.0)]);
+    assert!(
+        mixed.contains("different models")
+            && mixed.contains("nodes = 1 and 2")
+            && mixed.contains("runs/30"),
+        "{mixed}"
+    );
+}
