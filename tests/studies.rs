@@ -469,3 +469,103 @@ fn woven_membrane_study_runs_small_and_the_fit_lowers_t() {
         "{again}"
     );
 }
+
+/// The ballistic-limit study (`pipelines/ballistic_limit.toml`) made small: one layer,
+/// five striking velocities around its limit. Each impact's projectile loses the kinetic
+/// energy ½M(V_s² − V_r²) (its mass and two speeds: independent of the fabric's ledger)
+/// that the layer's watch says the fabric absorbed, within the run's own energy-balance
+/// error (measured: the fabric 0.4–1.1 % above, balance errors 0.8–2.1 %); the slower impacts stop
+/// and the faster perforate, with V_r < V_s; V50 lies between the fastest stop and the
+/// slowest perforation; the figures are written, and a second run is all fresh.
+#[test]
+fn ballistic_limit_study_runs_small_and_the_energies_agree() {
+    let dir = project_with("ballistic_limit.toml");
+    let root = dir.path();
+    let p = root.join("pipelines/ballistic_limit.toml");
+    // Of the foreach rows (one per line), one layer's five; TOML allows the trailing comma.
+    let keep = [35, 48, 57, 70, 90].map(|v| format!("{{ layers = 1, velocity = {v} }}"));
+    let s: String = std::fs::read_to_string(&p)
+        .unwrap()
+        .replace(
+            "matrix = { layers = [1, 2, 4, 8] }",
+            "matrix = { layers = [1] }",
+        )
+        .lines()
+        .filter_map(|l| {
+            let row = l.trim().trim_end_matches(',');
+            if !row.starts_with("{ layers = ") {
+                Some(format!("{l}\n"))
+            } else {
+                keep.contains(&row.to_string())
+                    .then(|| format!("  {row},\n"))
+            }
+        })
+        .collect();
+    std::fs::write(&p, &s).unwrap();
+    weft_run(root, "ballistic_limit.toml");
+    let out = root.join("runs/ballistic_limit");
+    let t = Table::read(&out.join("impacts.parquet")).unwrap();
+    let col = |c: &str| -> Vec<f64> {
+        t.f64_opt(c)
+            .unwrap()
+            .unwrap_or_else(|| panic!("no {c}"))
+            .into_iter()
+            .map(|x| x.unwrap_or(0.0))
+            .collect()
+    };
+    let (vs, vr, m) = (
+        col("striking_velocity"),
+        col("residual_velocity"),
+        col("projectile_mass"),
+    );
+    let (absorbed, bal) = (col("energy_absorbed"), col("max_balance_error_relative"));
+    let perf: Vec<bool> = t
+        .bool_opt("perforated")
+        .unwrap()
+        .unwrap()
+        .into_iter()
+        .map(|x| x.unwrap())
+        .collect();
+    assert_eq!(vs.len(), 5);
+    for i in 0..vs.len() {
+        let ke0 = 0.5 * m[i] * vs[i] * vs[i];
+        let lost = ke0 - 0.5 * m[i] * vr[i] * vr[i];
+        eprintln!(
+            "V_s {:.0} m/s: V_r {:.2}, lost {lost:.4} J, absorbed {:.4} J ({:+.2} %), balance {:.2} %",
+            vs[i], vr[i], absorbed[i], 100.0 * (absorbed[i] - lost) / ke0, 100.0 * bal[i]
+        );
+        assert!(
+            (absorbed[i] - lost).abs() <= bal[i] * ke0 + 1e-9,
+            "impact at {} m/s",
+            vs[i]
+        );
+        assert!(
+            vr[i] < vs[i] && (vr[i] > 0.0) == perf[i],
+            "impact at {} m/s",
+            vs[i]
+        );
+    }
+    let fastest_stop = (0..5)
+        .filter(|&i| !perf[i])
+        .map(|i| vs[i])
+        .fold(f64::NAN, f64::max);
+    let slowest_perf = (0..5)
+        .filter(|&i| perf[i])
+        .map(|i| vs[i])
+        .fold(f64::NAN, f64::min);
+    assert!(
+        fastest_stop < slowest_perf,
+        "stops up to {fastest_stop}, perforations from {slowest_perf}"
+    );
+    let l = Table::read(&out.join("limit/ballistic_limit.parquet")).unwrap();
+    let v50 = l.f64_opt("v50").unwrap().unwrap()[0].unwrap();
+    assert!(v50 > fastest_stop && v50 < slowest_perf, "V50 {v50}");
+    for fig in ["residual.png", "energy.png", "probability.png", "limit.png"] {
+        assert!(out.join("figures").join(fig).exists(), "{fig}");
+    }
+    let again = weft_run(root, "ballistic_limit.toml");
+    assert!(
+        again.contains("fresh") && !again.contains("run "),
+        "{again}"
+    );
+}
