@@ -676,3 +676,25 @@ outputs = { o = "out/use/${n}-${k}.txt" }
         "{out}"
     );
 }
+
+/// A stage judged by the weft tool its command names, not by a `mkdir` before it: the
+/// figure stages of the shipped pipelines start `mkdir -p … && weft-plot …`, and a new
+/// weft-plot must make them stale.
+#[test]
+fn a_stage_is_judged_by_the_weft_tool_it_runs() {
+    let p = Project::new(
+        r#"
+[stages.figs]
+cmd = "mkdir -p out/figs && weft --version > ${outputs.o}"
+outputs = { o = "out/figs/v.txt" }
+"#,
+    );
+    assert_eq!(p.run(&[]), ["figs"]);
+    let t = p.root().join("records.parquet");
+    let o = p.weft(&["records", "pipelines/p.toml", "--out", t.to_str().unwrap()]);
+    assert!(o.status.success());
+    let r = weft::table::Table::read(&t).unwrap();
+    let bin = r.str("binary", "").unwrap();
+    let weft = std::path::PathBuf::from(env!("CARGO_BIN_EXE_weft"));
+    assert_eq!(std::path::PathBuf::from(&bin[0]), weft, "{bin:?}");
+}

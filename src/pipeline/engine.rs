@@ -534,7 +534,7 @@ impl<'a> Schedule<'a> {
 fn check_command(p: &Pipeline, ws: &Workspace, i: usize) -> Result<()> {
     let inst = &p.instances[i];
     if ws.binary_of(&inst.command).is_none() {
-        let name = inst.command.split_whitespace().next().unwrap_or("");
+        let name = ws.program_of(&inst.command).unwrap_or_default();
         return Err(
             WeftError::input(format!("stage `{}`: command `{name}` not found", inst.name))
                 .in_file(&p.file)

@@ -85,13 +85,27 @@ impl Workspace {
         }
     }
 
-    /// The executable a command starts with, resolved like the shell would (the
+    /// The program a stage is judged by, as the command names it: the first weft tool
+    /// the command names (a word that is an executable beside `weft`: `mkdir -p D &&
+    /// weft-plot …` is weft-plot's), else the word it starts with.
+    pub fn program_of(&self, command: &str) -> Option<String> {
+        let word = |w: &str| w.trim_matches(|c| c == '\'' || c == '"').to_string();
+        let tool = self.exe_dir.as_ref().and_then(|d| {
+            command.split_whitespace().map(word).find(|w| {
+                !w.is_empty()
+                    && !w.contains(['/', '$', '='])
+                    && !w.starts_with('-')
+                    && d.join(w).is_file()
+            })
+        });
+        tool.or_else(|| command.split_whitespace().next().map(word))
+    }
+
+    /// The executable of [`Self::program_of`], resolved like the shell would (the
     /// directory of `weft` first, then PATH).
     pub fn binary_of(&self, command: &str) -> Option<PathBuf> {
-        let first = command
-            .split_whitespace()
-            .next()?
-            .trim_matches(|c| c == '\'' || c == '"');
+        let first = self.program_of(command)?;
+        let first = first.as_str();
         if let Some(hit) = self.bin_memo.borrow().get(first) {
             return hit.clone();
         }
@@ -156,12 +170,7 @@ impl Workspace {
             None => None,
         };
         if bin_hash != rec.binary_hash {
-            let name = inst
-                .command
-                .split_whitespace()
-                .next()
-                .unwrap_or("")
-                .to_string();
+            let name = self.program_of(&inst.command).unwrap_or_default();
             return Ok(Verdict::Stale(match bin {
                 None => format!("binary `{name}` not found"),
                 Some(_) => format!("binary `{name}` changed"),

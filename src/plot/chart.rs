@@ -146,11 +146,14 @@ where
                 .map_err(err)?,
         };
         let st = s.style;
-        anno.label(&s.label).legend(move |(x, y)| match st {
-            Style::Points => Circle::new((x + 10, y), 3, color.filled()).into_dyn(),
-            Style::Dashed => PathElement::new(vec![(x, y), (x + 8, y)], style).into_dyn(),
-            _ => PathElement::new(vec![(x, y), (x + 20, y)], style).into_dyn(),
-        });
+        // A series without a label (the second bound of an interval) has no legend row.
+        if !s.label.is_empty() {
+            anno.label(&s.label).legend(move |(x, y)| match st {
+                Style::Points => Circle::new((x + 10, y), 3, color.filled()).into_dyn(),
+                Style::Dashed => PathElement::new(vec![(x, y), (x + 8, y)], style).into_dyn(),
+                _ => PathElement::new(vec![(x, y), (x + 20, y)], style).into_dyn(),
+            });
+        }
         if s.style == Style::LinePoints {
             ch.draw_series(data.iter().map(|&p| Circle::new(p, 3, color.filled())))
                 .map_err(err)?;
