@@ -42,7 +42,7 @@ def main():
 # each striking velocity an impact of its own, run to its outcome; then the Lambert–Jonas
 # fit and the probability of perforation per layer count (weft-ballistic), and figures.
 #
-#   weft run pipelines/ballistic_limit.toml        (from the project root; minutes on 2 cores)
+#   weft run pipelines/ballistic_limit.toml        (from the project root; about 6 min on 2 cores)
 #   weft run pipelines/ballistic_limit.toml --executor slurm    (each impact a task of a job array)
 #   python3 -c "import polars as pl; print(pl.read_parquet('runs/ballistic_limit/limit/ballistic_limit.parquet'))"
 #

@@ -138,7 +138,7 @@ pub fn write_runs(
         path,
         &batch(vec![
             Col::Str("run", cols.0),
-            Col::StrNamed(by.to_string(), cols.1),
+            super::runs::group_col(by, cols.1),
             Col::F64("striking_velocity", cols.2),
             Col::F64("residual_velocity", cols.3),
             Col::Bool("perforated", cols.4),
@@ -167,10 +167,7 @@ pub fn write_limits(path: &Path, limits: &[Limit], by: &str, prov: &Provenance) 
     write_table(
         path,
         &batch(vec![
-            Col::StrNamed(
-                by.to_string(),
-                limits.iter().map(|l| l.group.clone()).collect(),
-            ),
+            super::runs::group_col(by, limits.iter().map(|l| l.group.clone()).collect()),
             Col::I64("runs", limits.iter().map(|l| l.runs as i64).collect()),
             Col::I64(
                 "perforated_runs",

@@ -83,7 +83,7 @@ fn numeric(t: &Table, c: &str) -> Result<Vec<f64>> {
 }
 
 /// The grouping column as text (integers and floats as written).
-fn group_column(t: &Table, by: &str) -> Result<Vec<String>> {
+pub fn group_column(t: &Table, by: &str) -> Result<Vec<String>> {
     if !t.has(by) {
         return Err(
             WeftError::input(format!("no column `{by}` to group the runs by"))
@@ -174,4 +174,23 @@ fn check_one_model(group: &str, runs: &[Run]) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// The grouping column to write: integers when every value is one as written (`layers`),
+/// numbers when every value is one, text otherwise, so that a table read back in pandas
+/// or polars sorts and plots its groups as the source table did.
+pub fn group_col(by: &str, groups: Vec<String>) -> crate::table::Col {
+    use crate::table::Col;
+    let ints: Option<Vec<i64>> = groups
+        .iter()
+        .map(|g| g.parse::<i64>().ok().filter(|i| i.to_string() == *g))
+        .collect();
+    if let Some(v) = ints {
+        return Col::I64Named(by.to_string(), v);
+    }
+    let floats: Option<Vec<f64>> = groups.iter().map(|g| g.parse::<f64>().ok()).collect();
+    match floats {
+        Some(v) if v.iter().all(|x| x.is_finite()) => Col::F64Named(by.to_string(), v),
+        _ => Col::StrNamed(by.to_string(), groups),
+    }
 }

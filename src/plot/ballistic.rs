@@ -45,7 +45,7 @@ type Runs = Vec<(String, Vec<(f64, f64, bool, f64)>)>;
 
 fn read_runs(a: &BallisticFigure) -> Result<Runs> {
     let t = Table::read(&a.runs)?;
-    let g = t.str(&a.by, &a.by)?;
+    let g = crate::ballistic::runs::group_column(&t, &a.by)?;
     let vs = t.f64("striking_velocity", RUN_COLS)?;
     let vr = t.f64("residual_velocity", RUN_COLS)?;
     let pf = t.bool("perforated", RUN_COLS)?;
@@ -81,7 +81,7 @@ struct LimitRow {
 
 fn read_limits(a: &BallisticFigure) -> Result<Vec<LimitRow>> {
     let t = Table::read(&a.limit)?;
-    let g = t.str(&a.by, &a.by)?;
+    let g = crate::ballistic::runs::group_column(&t, &a.by)?;
     let v50 = t.f64("v50", LIMIT_COLS)?;
     let lo = t.f64("v50_low", LIMIT_COLS)?;
     let hi = t.f64("v50_high", LIMIT_COLS)?;

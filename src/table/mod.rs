@@ -99,6 +99,8 @@ pub enum Col {
     OptF64Named(String, Vec<Option<f64>>),
     /// A string column named at run time (a grouping column's).
     StrNamed(String, Vec<String>),
+    /// An integer column named at run time (a grouping column's).
+    I64Named(String, Vec<i64>),
 }
 
 impl Col {
@@ -147,6 +149,10 @@ impl Col {
             Col::StrNamed(n, v) => (
                 Field::new(n, DataType::Utf8, false),
                 Arc::new(StringArray::from(v)),
+            ),
+            Col::I64Named(n, v) => (
+                Field::new(n, DataType::Int64, false),
+                Arc::new(Int64Array::from(v)),
             ),
         }
     }
