@@ -264,3 +264,43 @@ fn fit_and_error_tables_open_in_pandas_and_polars() {
     );
     read_tables(&d.join("fit/models/cand"), &d.join("fit"), &d, true);
 }
+
+/// An impact in which yarns fail: its failures.parquet and ballistic.parquet (and the
+/// summary's outcome columns) open in pandas and polars with the documented types.
+#[test]
+fn a_failing_impact_opens_in_pandas_and_polars() {
+    if !python_ok() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let s = |p: &str| d.join(p).to_string_lossy().to_string();
+    run_ok(
+        env!("CARGO_BIN_EXE_weft-weave"),
+        &[
+            "woven",
+            "--yarns",
+            "6",
+            "--yarn-model",
+            "chain",
+            "--layers",
+            "2",
+            "--failure-strain",
+            "0.036",
+            "--projectile-velocity",
+            "400",
+            "--end-time",
+            "3e-5",
+            "--out",
+            &s("model"),
+        ],
+    );
+    run_ok(
+        env!("CARGO_BIN_EXE_weft-simulate"),
+        &["--quiet", "--model", &s("model"), "--out", &s("out")],
+    );
+    for t in ["failures.parquet", "ballistic.parquet"] {
+        assert!(d.join("out").join(t).exists(), "{t}");
+    }
+    read_tables(&d.join("model"), &d.join("out"), d, true);
+}
