@@ -18,6 +18,7 @@ pub mod kinds;
 pub mod props;
 pub mod types;
 pub mod validate;
+mod validate_contacts;
 pub mod yarn;
 
 pub use kinds::ElementKind;

@@ -1,0 +1,119 @@
+//! What a run's failures leave, and what an armour engineer reads while it goes: the
+//! failures logged ([`super::FailureLog`]), the failed elements taken out of the contact
+//! surfaces after each force pass, and the per-layer values and the projectile's
+//! outcome at each output sample ([`super::watch`]).
+
+use super::family::Family;
+use super::vec3::dot;
+use super::{failure, watch, Solver};
+use crate::model::ElementKind;
+
+impl Solver {
+    /// The watch at a sample step (t_n, x^n, v^n): each layer's values into `rows` (layer
+    /// 1 first), the last layer's deflection peak, and the projectile's outcome.
+    pub(super) fn watch_sample(&mut self, rows: &mut Vec<watch::LayerValues>) {
+        let w = &self.watch;
+        let axis = w.axis().unwrap_or([0.0, 0.0, -1.0]);
+        let n = w.n_layers;
+        rows.clear();
+        rows.resize(n, [0.0; 9]);
+        let (xn, vn, x0) = (&self.state.xn, &self.state.vn, &self.x0);
+        let fr_s = self.op.surfaces.node_friction.as_deref();
+        let fr_p = self.op.projectiles.node_friction.as_deref();
+        for i in 0..xn.len() {
+            let attached = self.failures.is_attached(i);
+            let l = w.node_layer(i) as usize;
+            if l == 0 {
+                continue;
+            }
+            let r = &mut rows[l - 1];
+            r[0] += 0.5 * self.mass[i] * dot(&vn[i], &vn[i]);
+            r[3] += fr_s.map_or(0.0, |f| f[i]) + fr_p.map_or(0.0, |f| f[i]);
+            if attached {
+                let u = [
+                    xn[i][0] - x0[i][0],
+                    xn[i][1] - x0[i][1],
+                    xn[i][2] - x0[i][2],
+                ];
+                r[7] = r[7].max(dot(&u, &axis));
+            }
+        }
+        let el = &self.op.el;
+        for (kind, len) in [
+            (ElementKind::Truss, el.truss.len()),
+            (ElementKind::Tri, el.tri.len()),
+            (ElementKind::Quad, el.quad.len()),
+        ] {
+            for e in 0..len {
+                let l = w.element_layer(kind, e) as usize;
+                if l == 0 {
+                    continue;
+                }
+                let (stored, eroded) = match kind {
+                    ElementKind::Truss => {
+                        (el.truss.element_energy(xn, e), el.truss.element_eroded(e))
+                    }
+                    ElementKind::Tri => (el.tri.element_energy(xn, e), el.tri.element_eroded(e)),
+                    _ => (el.quad.element_energy(xn, e), el.quad.element_eroded(e)),
+                };
+                rows[l - 1][1] += stored;
+                rows[l - 1][2] += eroded;
+            }
+        }
+        for (l, r) in rows.iter_mut().enumerate() {
+            r[4] = r[0] + r[1] + r[2] + r[3];
+            let (failed, broken) = w.counts(l + 1);
+            r[5] = failed as f64;
+            r[6] = broken as f64;
+            r[8] = w.first_failure[l + 1];
+        }
+        let back = rows.last().map_or(0.0, |r| r[7]);
+        let t = self.state.t;
+        let proj = self
+            .op
+            .projectiles
+            .projectiles
+            .first()
+            .map(|p| (p.tip, p.v_full, p.force, p.radius));
+        let w = &mut self.watch;
+        w.back_face_peak = w.back_face_peak.max(back);
+        w.last_rows.clone_from(rows);
+        if let Some((tip, v, f, radius)) = proj {
+            w.judge(t, &tip, &v, &f, radius);
+        }
+    }
+
+    /// The failures of the force pass just done: logged, their nodes' attachments
+    /// counted down, and the failed elements' faces and segments out of the contact
+    /// surfaces (projectiles' and between parts) before contact is computed.
+    pub(super) fn apply_failures(&mut self) {
+        let log = &mut self.failures;
+        log.collected.clear();
+        self.op
+            .el
+            .collect_failures(&mut log.scratch, &mut log.collected);
+        for c in log.collected.drain(..) {
+            let f = c.failure;
+            log.events.push(failure::FailureEvent {
+                time: self.state.t,
+                step: self.state.step,
+                id: c.id,
+                failure: f,
+            });
+            if f.eroded {
+                for &n in &c.nodes {
+                    let a = &mut log.attached[n as usize];
+                    *a = a.saturating_sub(1);
+                }
+                if matches!(
+                    f.kind,
+                    ElementKind::Truss | ElementKind::Tri | ElementKind::Quad
+                ) {
+                    self.op.surfaces.erode(f.kind, f.element);
+                    self.op.projectiles.erode(f.kind, f.element);
+                    self.watch.on_erosion(f.kind, f.element, self.state.t);
+                }
+            }
+        }
+    }
+}
