@@ -70,8 +70,9 @@ fn a_perforating_projectile_loses_the_impulse_of_its_contact_force() {
         stats.max_balance_error_relative
     );
     assert!(dp > 0.0, "the projectile (moving in −z) slows: Δp_z > 0");
-    // Measured: 1.3·10⁻³ (the trapezoid over the sampled force; the issue asks 1 %).
-    assert!(rel(dp, impulse) < 5e-3, "{dp} vs {impulse}");
+    // Measured: 2.7·10⁻⁴ (the trapezoid over the force sampled every 20 ns; the issue
+    // asks 1 %).
+    assert!(rel(dp, impulse) < 1e-3, "{dp} vs {impulse}");
 }
 
 /// Strengths drawn per element with modulus m = 8 at the gauge length of the elements:
