@@ -217,7 +217,13 @@ pub fn write_limits(path: &Path, limits: &[Limit], by: &str, prov: &Provenance) 
             Col::OptF64("p_low", lj(|f| f.p_interval.0)),
             Col::OptF64("p_high", lj(|f| f.p_interval.1)),
             Col::OptF64("rms_residual", lj(|f| f.rms)),
-            Col::OptF64("bootstrap_replicates", lj(|f| f.replicates as f64)),
+            Col::OptI64(
+                "bootstrap_replicates",
+                limits
+                    .iter()
+                    .map(|l| l.lambert_jonas.as_ref().map(|f| f.replicates as i64))
+                    .collect(),
+            ),
         ]),
         prov,
     )
