@@ -677,24 +677,30 @@ outputs = { o = "out/use/${n}-${k}.txt" }
     );
 }
 
-/// A stage judged by the weft tool its command names, not by a `mkdir` before it: the
+/// A stage judged by the weft tool its command runs, not by a `mkdir` before it: the
 /// figure stages of the shipped pipelines start `mkdir -p … && weft-plot …`, and a new
-/// weft-plot must make them stale.
+/// weft-plot must make them stale; `weft` as an argument is not a command.
 #[test]
 fn a_stage_is_judged_by_the_weft_tool_it_runs() {
     let p = Project::new(
         r#"
 [stages.figs]
-cmd = "mkdir -p out/figs && weft --version > ${outputs.o}"
+cmd = "mkdir -p out/figs && \\\n  weft --version > ${outputs.o}"
 outputs = { o = "out/figs/v.txt" }
+[stages.words]
+cmd = "echo weft > ${outputs.o}"
+outputs = { o = "out/words.txt" }
 "#,
     );
-    assert_eq!(p.run(&[]), ["figs"]);
+    assert_eq!(p.run(&[]), ["figs", "words"]);
     let t = p.root().join("records.parquet");
     let o = p.weft(&["records", "pipelines/p.toml", "--out", t.to_str().unwrap()]);
     assert!(o.status.success());
     let r = weft::table::Table::read(&t).unwrap();
-    let bin = r.str("binary", "").unwrap();
+    let (inst, bin) = (r.str("instance", "").unwrap(), r.str("binary", "").unwrap());
     let weft = std::path::PathBuf::from(env!("CARGO_BIN_EXE_weft"));
-    assert_eq!(std::path::PathBuf::from(&bin[0]), weft, "{bin:?}");
+    let of = |i: &str| std::path::PathBuf::from(&bin[inst.iter().position(|x| x == i).unwrap()]);
+    assert_eq!(of("figs"), weft, "{inst:?} {bin:?}");
+    // A weft word that is an argument, not a command, does not count.
+    assert!(of("words").ends_with("echo"), "{inst:?} {bin:?}");
 }

@@ -85,20 +85,34 @@ impl Workspace {
         }
     }
 
-    /// The program a stage is judged by, as the command names it: the first weft tool
-    /// the command names (a word that is an executable beside `weft`: `mkdir -p D &&
-    /// weft-plot …` is weft-plot's), else the word it starts with.
+    /// The program a stage is judged by, as the command names it: the first weft tool at
+    /// a command's position (the start, or after `&&`, `||`, `;` or `|`; an executable
+    /// beside `weft`: `mkdir -p D && weft-plot …` is weft-plot's), else the word the
+    /// command starts with.
     pub fn program_of(&self, command: &str) -> Option<String> {
         let word = |w: &str| w.trim_matches(|c| c == '\'' || c == '"').to_string();
+        let mut programs = vec![];
+        let mut at_command = true;
+        for w in command.split_whitespace() {
+            match w {
+                "&&" | "||" | ";" | "|" => at_command = true,
+                "\\" => {}
+                _ if at_command && w.contains('=') && !w.starts_with('-') => {} // VAR=value
+                _ => {
+                    if at_command {
+                        programs.push(word(w.trim_end_matches(';')));
+                    }
+                    at_command = w.ends_with(';');
+                }
+            }
+        }
         let tool = self.exe_dir.as_ref().and_then(|d| {
-            command.split_whitespace().map(word).find(|w| {
-                !w.is_empty()
-                    && !w.contains(['/', '$', '='])
-                    && !w.starts_with('-')
-                    && d.join(w).is_file()
-            })
+            programs
+                .iter()
+                .find(|w| !w.is_empty() && !w.contains(['/', '$']) && d.join(w).is_file())
+                .cloned()
         });
-        tool.or_else(|| command.split_whitespace().next().map(word))
+        tool.or_else(|| programs.into_iter().next())
     }
 
     /// The executable of [`Self::program_of`], resolved like the shell would (the
