@@ -160,21 +160,21 @@ struct WovenBandArgs {
     /// `interface` (the tied yarn ends) and `axis_x_all` (the x axis through both).
     #[arg(long)]
     membrane_length: Option<f64>,
-    /// Growth ratio of the membrane's cells (p/2 at the patch) outwards.
-    #[arg(long, default_value_t = Surround::default().growth)]
+    /// With --membrane-length: growth ratio of the membrane's cells (p/2 at the patch) outwards.
+    #[arg(long, requires = "membrane_length", default_value_t = Surround::default().growth)]
     membrane_growth: f64,
     /// Membrane areal density / the patch's (the paper's §3: 0.8).
-    #[arg(long, default_value_t = Surround::default().density_ratio)]
+    #[arg(long, requires = "membrane_length", default_value_t = Surround::default().density_ratio)]
     membrane_density_ratio: f64,
     /// Membrane E₁ = E₂ / the yarns' E (the paper's §3: 0.3).
-    #[arg(long, default_value_t = Surround::default().modulus_ratio)]
+    #[arg(long, requires = "membrane_length", default_value_t = Surround::default().modulus_ratio)]
     membrane_modulus_ratio: f64,
     /// Membrane G₁₂ / its E (the paper's §3: 0.0042).
-    #[arg(long, default_value_t = Surround::default().shear_ratio)]
+    #[arg(long, requires = "membrane_length", default_value_t = Surround::default().shear_ratio)]
     membrane_shear_ratio: f64,
     /// Membrane thickness [m] (an assumption; default 2A/p per layer, the yarns' section
     /// per unit width of both families).
-    #[arg(long)]
+    #[arg(long, requires = "membrane_length")]
     membrane_thickness: Option<f64>,
     /// Projectile nose shape.
     #[arg(long, value_enum, default_value_t = WovenBandParams::default().projectile_shape)]

@@ -106,13 +106,6 @@ fn arrival_terms(c: &Config) -> Result<Vec<ArrivalTerm>> {
                 c.arrival_component
             ),
         )?;
-        check(
-            c.relative_level > 0.0 && c.relative_level <= 1.0,
-            format!(
-                "--relative-level {}: expected a fraction of the peak in (0, 1]",
-                c.relative_level
-            ),
-        )?;
         return Ok(vec![ArrivalTerm {
             component: k[0],
             level: Level::Relative(c.relative_level),
@@ -153,6 +146,7 @@ pub fn budget(c: &Config) -> u64 {
 /// Run the stage. `on_eval` sees every evaluation as it completes (progress).
 pub fn run(c: &Config, on_eval: &(dyn Fn(&Evaluation) + Sync)) -> Result<Report> {
     check_counts(c)?;
+    check_settings(c)?;
     let comps = compared_components(c)?;
     let objective = objective(c)?;
     let read = read_cases(c, &comps, &objective)?;
@@ -213,6 +207,53 @@ fn check_counts(c: &Config) -> Result<()> {
     )
 }
 
+/// The numeric settings, whether or not this objective or method uses them (a value that
+/// could never be valid is refused, not silently ignored).
+fn check_settings(c: &Config) -> Result<()> {
+    check(
+        c.relative_level > 0.0 && c.relative_level <= 1.0,
+        format!(
+            "--relative-level {}: expected a fraction of the peak in (0, 1]",
+            c.relative_level
+        ),
+    )?;
+    check(
+        c.arrival_slack >= 0.0 && c.arrival_slack.is_finite(),
+        format!(
+            "--arrival-slack {}: expected a time ≥ 0 in s",
+            c.arrival_slack
+        ),
+    )?;
+    check(
+        c.arrival_weight > 0.0 && c.arrival_weight.is_finite(),
+        format!(
+            "--arrival-weight {}: expected a finite weight > 0",
+            c.arrival_weight
+        ),
+    )?;
+    check(
+        c.xtol > 0.0 && c.xtol < 1.0,
+        format!(
+            "--xtol {}: expected a step on the unit parameter box, 0 < xtol < 1",
+            c.xtol
+        ),
+    )?;
+    check(
+        c.ftol >= 0.0 && c.ftol < 1.0,
+        format!(
+            "--ftol {}: expected a relative change of T, 0 ≤ ftol < 1 (0: never stop on it)",
+            c.ftol
+        ),
+    )?;
+    check(
+        c.initial_step > 0.0 && c.initial_step <= 1.0,
+        format!(
+            "--initial-step {}: expected a first step on the unit parameter box, 0 < ρ ≤ 1",
+            c.initial_step
+        ),
+    )
+}
+
 /// The displacement components T compares (`--components`).
 fn compared_components(c: &Config) -> Result<Vec<usize>> {
     let comps = components(&c.components)?;
@@ -241,26 +282,12 @@ fn objective(c: &Config) -> Result<Objective> {
         }
         ObjectiveKind::Arrival | ObjectiveKind::Both => {
             let terms = arrival_terms(c)?;
-            check(
-                c.arrival_slack >= 0.0 && c.arrival_slack.is_finite(),
-                format!(
-                    "--arrival-slack {}: expected a time ≥ 0 in s",
-                    c.arrival_slack
-                ),
-            )?;
             if c.objective == ObjectiveKind::Arrival {
                 Objective::Arrival {
                     terms,
                     slack: c.arrival_slack,
                 }
             } else {
-                check(
-                    c.arrival_weight > 0.0 && c.arrival_weight.is_finite(),
-                    format!(
-                        "--arrival-weight {}: expected a finite weight > 0",
-                        c.arrival_weight
-                    ),
-                )?;
                 Objective::Both {
                     terms,
                     slack: c.arrival_slack,

@@ -78,6 +78,9 @@ pub fn build(p: &RodParams) -> Result<Model> {
     positive("density", p.density, "kg/m³")?;
     positive("width", p.width, "m")?;
     positive("thickness", p.thickness, "m")?;
+    if let Some(d) = p.pulse_duration {
+        positive("pulse-duration", d, "s")?;
+    }
     if p.elements == 0 {
         return Err(
             WeftError::input("rod parameter --elements = `0`").expected("at least 1 element")

@@ -66,6 +66,15 @@ impl Default for Square {
     }
 }
 
+/// The square's side and cell count: --length > 0, --cells ≥ 1.
+fn check_square(sq: &Square) -> Result<()> {
+    positive("length", sq.length, "in m")?;
+    if sq.cells == 0 {
+        return Err(WeftError::input("--cells = `0`").expected("at least 1 cell per side"));
+    }
+    Ok(())
+}
+
 fn positive(name: &str, v: f64, unit: &str) -> Result<()> {
     if v > 0.0 && v.is_finite() {
         Ok(())
@@ -112,10 +121,7 @@ fn clamp_load_analysis(
     id: &dyn Fn(usize, usize) -> usize,
     centre: usize,
 ) -> Result<()> {
-    positive("length", sq.length, "in m")?;
-    if sq.cells == 0 {
-        return Err(WeftError::input("--cells = `0`").expected("at least 1 cell per side"));
-    }
+    check_square(sq)?;
     if !sq.force.is_finite() {
         return Err(
             WeftError::input(format!("--force = `{}`", sq.force)).expected("a finite force in N")
@@ -227,13 +233,13 @@ impl GirderParams {
 pub fn girder(p: &GirderParams) -> Result<(Model, Vec<String>)> {
     positive("youngs-modulus", p.youngs_modulus, "in Pa")?;
     positive("density", p.density, "in kg/m³")?;
+    // The square's own flags first: the rod's default width and thickness derive from
+    // L/N, and a refusal should name the flag given, not what it made invalid.
+    check_square(&p.square)?;
     let (b, h) = (p.b(), p.h());
     positive("rod-width", b, "in m")?;
     positive("rod-thickness", h, "in m")?;
     let (n, l) = (p.square.cells, p.square.length);
-    if n == 0 {
-        return Err(WeftError::input("--cells = `0`").expected("at least 1 cell per side"));
-    }
     let a = l / n as f64;
     if b >= a {
         return Err(WeftError::input(format!(
@@ -524,12 +530,10 @@ fn membrane_part(p: &MembraneParams) -> PartProps {
 pub fn membrane(p: &MembraneParams) -> Result<Model> {
     positive("youngs-modulus", p.youngs_modulus, "in Pa")?;
     positive("shear-modulus", p.shear_modulus, "in Pa")?;
+    check_square(&p.square)?;
     positive("thickness", p.thickness, "in m")?;
     positive("density", p.density, "in kg/m³")?;
     let (n, l) = (p.square.cells, p.square.length);
-    if n == 0 {
-        return Err(WeftError::input("--cells = `0`").expected("at least 1 cell per side"));
-    }
     if let Some(z) = &p.girder_zone {
         return membrane_with_girder_zone(p, z);
     }

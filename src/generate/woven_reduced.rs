@@ -262,6 +262,8 @@ impl WovenParams {
             ("yarn-area", "m²", self.yarn_area),
             ("k-z", "N/m", self.k_z),
             ("k-xy", "N/m", self.k_xy),
+            ("projectile-mass", "kg", self.projectile_mass),
+            ("projectile-radius", "m", self.projectile_radius),
             ("membrane-density-ratio", "", r.density_ratio),
             ("membrane-modulus-ratio", "", r.modulus_ratio),
             ("membrane-shear-ratio", "", r.shear_ratio),
@@ -291,6 +293,19 @@ impl WovenParams {
                 WeftError::input(format!("--dt-safety = `{}`", self.dt_safety))
                     .expected("a safety factor 0 < f ≤ 1 on the stable step"),
             );
+        }
+        if !(self.projectile_velocity >= 0.0 && self.projectile_velocity.is_finite()) {
+            return Err(WeftError::input(format!(
+                "--projectile-velocity = `{}`",
+                self.projectile_velocity
+            ))
+            .expected("a speed ≥ 0 in m/s (the projectile moves along −z, towards the patch)"));
+        }
+        if !(self.crimp >= 0.0 && self.crimp < self.spacing) {
+            return Err(WeftError::input(format!("--crimp = `{}`", self.crimp)).expected(format!(
+                "an offset 0 ≤ a < the spacing {} m (warp and weft at ±a, alternating)",
+                self.spacing
+            )));
         }
         let pf = self.projectile_friction;
         if !(pf >= 0.0 && pf.is_finite()) {
