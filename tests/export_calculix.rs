@@ -27,8 +27,9 @@
 //!        |    |    |    |    |
 //! ```
 //!
-//! Where ccx is missing the CalculiX runs say so and pass, unless `WEFT_REQUIRE_CCX=1`
-//! (set by `.ci/run`, which installs `calculix-ccx`). The refusals need no ccx.
+//! Where ccx is missing the CalculiX runs are reported as ignored (tests/common/optional.rs:
+//! the summary line counts them), unless `WEFT_REQUIRE_CCX=1` (set by `.ci/run`, which
+//! installs `calculix-ccx`): then they fail. The refusals need no ccx.
 
 mod common;
 use common::run_ok;
@@ -40,19 +41,11 @@ use weft::model::{ElementKind, Load, Model, PartProps, TimeLaw};
 use weft::table::Table;
 
 fn ccx_ok() -> bool {
-    let ok = Command::new("ccx")
+    Command::new("ccx")
         .arg("-v")
         .output()
         .map(|o| String::from_utf8_lossy(&o.stdout).contains("2.2"))
-        .unwrap_or(false);
-    if !ok {
-        assert!(
-            std::env::var("WEFT_REQUIRE_CCX").as_deref() != Ok("1"),
-            "WEFT_REQUIRE_CCX=1 but CalculiX 2.2x (`ccx`) is not installed"
-        );
-        eprintln!("SKIP: CalculiX (`ccx`) not found (apt-get install calculix-ccx)");
-    }
-    ok
+        .unwrap_or(false)
 }
 
 fn s(p: &Path) -> &str {
@@ -167,11 +160,7 @@ fn compare(dir: &Path, model: &Path) -> (f64, f64, usize) {
     (num / den, dmax / umax, n)
 }
 
-#[test]
 fn calculix_runs_the_exported_rod_like_weft() {
-    if !ccx_ok() {
-        return;
-    }
     let dir = tempfile::tempdir().unwrap();
     let model = dir.path().join("rod");
     run_ok(
@@ -302,11 +291,7 @@ fn net(n: usize) -> Model {
     m
 }
 
-#[test]
 fn calculix_runs_the_exported_pretensioned_net_like_weft() {
-    if !ccx_ok() {
-        return;
-    }
     let dir = tempfile::tempdir().unwrap();
     let model = dir.path().join("net");
     let prov = weft::table::Provenance::new("test net", serde_json::json!({}));
@@ -318,7 +303,6 @@ fn calculix_runs_the_exported_pretensioned_net_like_weft() {
     assert!(t < 1e-6 && t < 2e-7, "T = {t}");
 }
 
-#[test]
 fn what_calculix_cannot_run_faithfully_is_refused_with_the_reason() {
     let dir = tempfile::tempdir().unwrap();
     let prov = weft::table::Provenance::new("test", serde_json::json!({}));
@@ -356,4 +340,23 @@ fn what_calculix_cannot_run_faithfully_is_refused_with_the_reason() {
         );
         assert!(!deck.exists(), "{name}: no deck written");
     }
+}
+
+/// CalculiX 2.2x (`ccx`): its tests are ignored where it is missing, unless `WEFT_REQUIRE_CCX=1`.
+const CCX: common::optional::Tool = common::optional::Tool {
+    what: "CalculiX 2.2x (`ccx`)",
+    install: "apt-get install calculix-ccx",
+    require: "WEFT_REQUIRE_CCX",
+    here: ccx_ok,
+};
+
+fn main() -> std::process::ExitCode {
+    common::optional::run(
+        &CCX,
+        vec![
+            ("calculix_runs_the_exported_rod_like_weft", true, calculix_runs_the_exported_rod_like_weft),
+            ("calculix_runs_the_exported_pretensioned_net_like_weft", true, calculix_runs_the_exported_pretensioned_net_like_weft),
+            ("what_calculix_cannot_run_faithfully_is_refused_with_the_reason", false, what_calculix_cannot_run_faithfully_is_refused_with_the_reason),
+        ],
+    )
 }

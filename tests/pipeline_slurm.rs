@@ -8,8 +8,8 @@
 //! Ctrl-C cancels the jobs.
 //!
 //! The reference is the local executor, which tests/pipeline.rs and tests/interruption.rs
-//! check on their own. Without a responding Slurm the tests say so and pass, unless
-//! `WEFT_REQUIRE_SLURM=1` (set by `.ci/run`).
+//! check on their own. Without a responding Slurm the tests are reported as ignored
+//! (tests/common/optional.rs), unless `WEFT_REQUIRE_SLURM=1` (set by `.ci/run`): then they fail.
 
 mod common;
 use common::same_outputs;
@@ -25,7 +25,7 @@ static SLURM: Mutex<()> = Mutex::new(());
 fn slurm_ok() -> bool {
     // Asked once: a configured but stopped Slurm takes `sinfo` ~10 s to give up.
     static UP: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
-    let ok = *UP.get_or_init(|| {
+    *UP.get_or_init(|| {
         Command::new("sinfo")
             .args(["--noheader", "--format=%t"])
             .output()
@@ -36,15 +36,7 @@ fn slurm_ok() -> bool {
                     })
             })
             .unwrap_or(false)
-    });
-    if !ok {
-        assert!(
-            std::env::var("WEFT_REQUIRE_SLURM").as_deref() != Ok("1"),
-            "WEFT_REQUIRE_SLURM=1 but no Slurm answers (`sinfo`); start one with scripts/slurm-single-node.sh start"
-        );
-        eprintln!("SKIP: no Slurm answers (`sinfo`); scripts/slurm-single-node.sh install && scripts/slurm-single-node.sh start");
-    }
-    ok
+    })
 }
 
 /// The shipped rod wave pipeline in a fresh project: 4 weave, 8 simulate, 8 speed and
@@ -105,12 +97,8 @@ fn done(stderr: &str) -> Vec<String> {
     v
 }
 
-#[test]
 fn rod_waves_through_slurm_equals_the_local_run_and_sweeps_become_arrays() {
     let _g = SLURM.lock().unwrap_or_else(|e| e.into_inner());
-    if !slurm_ok() {
-        return;
-    }
     let local = rod_project();
     let o = weft(local.path(), &["run", "-q", "pipelines/rod_waves.toml"]);
     assert!(o.status.success(), "{}", text(&o.stderr));
@@ -192,12 +180,8 @@ fn rod_waves_through_slurm_equals_the_local_run_and_sweeps_become_arrays() {
     assert_eq!(recs, 22);
 }
 
-#[test]
 fn a_controller_killed_mid_run_leaves_its_jobs_running_and_a_rerun_adopts_them() {
     let _g = SLURM.lock().unwrap_or_else(|e| e.into_inner());
-    if !slurm_ok() {
-        return;
-    }
     let local = rod_project();
     let o = weft(local.path(), &["run", "-q", "pipelines/rod_waves.toml"]);
     assert!(o.status.success(), "{}", text(&o.stderr));
@@ -295,12 +279,8 @@ outputs = { o = "other/x.txt" }
 poll_seconds = 0.3
 "#;
 
-#[test]
 fn a_failing_instance_cancels_its_dependants_and_keep_going_runs_the_rest() {
     let _g = SLURM.lock().unwrap_or_else(|e| e.into_inner());
-    if !slurm_ok() {
-        return;
-    }
     let dir = tempfile::tempdir().unwrap();
     std::fs::create_dir_all(dir.path().join("pipelines")).unwrap();
     std::fs::write(dir.path().join("pipelines/f.toml"), FAILING).unwrap();
@@ -351,12 +331,8 @@ fn a_failing_instance_cancels_its_dependants_and_keep_going_runs_the_rest() {
     );
 }
 
-#[test]
 fn ctrl_c_cancels_the_jobs_of_the_run() {
     let _g = SLURM.lock().unwrap_or_else(|e| e.into_inner());
-    if !slurm_ok() {
-        return;
-    }
     let dir = tempfile::tempdir().unwrap();
     std::fs::create_dir_all(dir.path().join("pipelines")).unwrap();
     std::fs::write(
@@ -422,12 +398,8 @@ fn ctrl_c_cancels_the_jobs_of_the_run() {
     assert!(!dir.path().join("out/x.txt").exists());
 }
 
-#[test]
 fn an_upstream_rerun_with_the_same_bytes_leaves_its_dependant_fresh_inside_its_job() {
     let _g = SLURM.lock().unwrap_or_else(|e| e.into_inner());
-    if !slurm_ok() {
-        return;
-    }
     let dir = tempfile::tempdir().unwrap();
     std::fs::create_dir_all(dir.path().join("pipelines")).unwrap();
     std::fs::write(
@@ -462,12 +434,8 @@ fn an_upstream_rerun_with_the_same_bytes_leaves_its_dependant_fresh_inside_its_j
     );
 }
 
-#[test]
 fn jobs_a_dying_controller_submitted_but_did_not_note_are_cancelled_by_the_next_run() {
     let _g = SLURM.lock().unwrap_or_else(|e| e.into_inner());
-    if !slurm_ok() {
-        return;
-    }
     let dir = tempfile::tempdir().unwrap();
     std::fs::create_dir_all(dir.path().join("pipelines")).unwrap();
     let file = dir.path().join("pipelines/o.toml");
@@ -514,12 +482,8 @@ fn jobs_a_dying_controller_submitted_but_did_not_note_are_cancelled_by_the_next_
     );
 }
 
-#[test]
 fn a_job_held_back_for_a_reason_that_does_not_pass_is_reported_while_waiting() {
     let _g = SLURM.lock().unwrap_or_else(|e| e.into_inner());
-    if !slurm_ok() {
-        return;
-    }
     let dir = tempfile::tempdir().unwrap();
     std::fs::create_dir_all(dir.path().join("pipelines")).unwrap();
     // `--hold` keeps the job pending (JobHeldUser) until released.
@@ -558,4 +522,27 @@ fn a_job_held_back_for_a_reason_that_does_not_pass_is_reported_while_waiting() {
     let rest: Vec<String> = lines.map(|l| l.unwrap()).collect();
     assert!(child.wait().unwrap().success(), "{seen:?} {rest:?}");
     assert!(rest.iter().any(|l| l.starts_with("done  a")), "{rest:?}");
+}
+
+/// a responding Slurm (`sinfo`): its tests are ignored where it is missing, unless `WEFT_REQUIRE_SLURM=1`.
+const SLURM_TOOL: common::optional::Tool = common::optional::Tool {
+    what: "a responding Slurm (`sinfo`)",
+    install: "scripts/slurm-single-node.sh install && scripts/slurm-single-node.sh start",
+    require: "WEFT_REQUIRE_SLURM",
+    here: slurm_ok,
+};
+
+fn main() -> std::process::ExitCode {
+    common::optional::run(
+        &SLURM_TOOL,
+        vec![
+            ("rod_waves_through_slurm_equals_the_local_run_and_sweeps_become_arrays", true, rod_waves_through_slurm_equals_the_local_run_and_sweeps_become_arrays),
+            ("a_controller_killed_mid_run_leaves_its_jobs_running_and_a_rerun_adopts_them", true, a_controller_killed_mid_run_leaves_its_jobs_running_and_a_rerun_adopts_them),
+            ("a_failing_instance_cancels_its_dependants_and_keep_going_runs_the_rest", true, a_failing_instance_cancels_its_dependants_and_keep_going_runs_the_rest),
+            ("ctrl_c_cancels_the_jobs_of_the_run", true, ctrl_c_cancels_the_jobs_of_the_run),
+            ("an_upstream_rerun_with_the_same_bytes_leaves_its_dependant_fresh_inside_its_job", true, an_upstream_rerun_with_the_same_bytes_leaves_its_dependant_fresh_inside_its_job),
+            ("jobs_a_dying_controller_submitted_but_did_not_note_are_cancelled_by_the_next_run", true, jobs_a_dying_controller_submitted_but_did_not_note_are_cancelled_by_the_next_run),
+            ("a_job_held_back_for_a_reason_that_does_not_pass_is_reported_while_waiting", true, a_job_held_back_for_a_reason_that_does_not_pass_is_reported_while_waiting),
+        ],
+    )
 }

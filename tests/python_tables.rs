@@ -1,8 +1,9 @@
 //! The tables open in pandas and polars with the documented columns and dtypes, carry
 //! provenance in `df.attrs`, and tables written back by pandas and polars are read.
 //!
-//! Runs `tests/read_tables.py`. Where pandas or polars are not installed the test says
-//! so and passes, unless `WEFT_REQUIRE_PYTHON=1` (set by `.ci/run`, which installs them).
+//! Runs `tests/read_tables.py`. Where pandas or polars are not installed the tests are
+//! reported as ignored (tests/common/optional.rs), unless `WEFT_REQUIRE_PYTHON=1` (set by
+//! `.ci/run`, which installs them): then they fail.
 
 mod common;
 use common::run_ok;
@@ -14,15 +15,7 @@ fn python_ok() -> bool {
     let probe = Command::new("python3")
         .args(["-c", "import pandas, polars, pyarrow"])
         .output();
-    let ok = probe.map(|o| o.status.success()).unwrap_or(false);
-    if !ok {
-        assert!(
-            std::env::var("WEFT_REQUIRE_PYTHON").as_deref() != Ok("1"),
-            "WEFT_REQUIRE_PYTHON=1 but python3 with pandas, polars and pyarrow is not available"
-        );
-        eprintln!("SKIP: python3 with pandas, polars and pyarrow not found (pip install pandas polars pyarrow)");
-    }
-    ok
+    probe.map(|o| o.status.success()).unwrap_or(false)
 }
 
 /// Runs `tests/read_tables.py` on a model folder and its results (`open_only`: check
@@ -51,11 +44,7 @@ fn read_tables(
 }
 
 /// Runs a weft binary, which must succeed.
-#[test]
 fn tables_open_in_pandas_and_polars() {
-    if !python_ok() {
-        return;
-    }
     let dir = tempfile::tempdir().unwrap();
     let model = dir.path().join("rod");
     let out = dir.path().join("out");
@@ -77,11 +66,7 @@ fn tables_open_in_pandas_and_polars() {
     read_tables(&model, &out, &dir.path(), false);
 }
 
-#[test]
 fn a_model_with_every_feature_opens_in_pandas_and_polars() {
-    if !python_ok() {
-        return;
-    }
     let dir = tempfile::tempdir().unwrap();
     let model = dir.path().join("composite");
     let out = dir.path().join("out");
@@ -111,11 +96,7 @@ fn a_model_with_every_feature_opens_in_pandas_and_polars() {
     read_tables(&model, &out, &dir.path(), true);
 }
 
-#[test]
 fn a_generated_woven_model_opens_in_pandas_and_polars() {
-    if !python_ok() {
-        return;
-    }
     let dir = tempfile::tempdir().unwrap();
     let (model, out) = (dir.path().join("woven"), dir.path().join("out"));
     let st = Command::new(env!("CARGO_BIN_EXE_weft-weave"))
@@ -138,11 +119,7 @@ fn a_generated_woven_model_opens_in_pandas_and_polars() {
 
 /// A formed woven model (initial displacements ux0, uy0, uz0 in nodes.parquet, and
 /// form.parquet) and its impact's tables open in pandas and polars.
-#[test]
 fn a_formed_woven_model_opens_in_pandas_and_polars() {
-    if !python_ok() {
-        return;
-    }
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let s = |p: &str| d.join(p).to_string_lossy().to_string();
@@ -180,11 +157,7 @@ fn a_formed_woven_model_opens_in_pandas_and_polars() {
 
 /// The fit and error stages' tables open in pandas and polars, with a parameter's name
 /// (`membrane.G12`) as a column and nulls where documented.
-#[test]
 fn fit_and_error_tables_open_in_pandas_and_polars() {
-    if !python_ok() {
-        return;
-    }
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let s = |p: &str| d.join(p).to_string_lossy().to_string();
@@ -267,11 +240,7 @@ fn fit_and_error_tables_open_in_pandas_and_polars() {
 
 /// An impact in which yarns fail: its failures.parquet and ballistic.parquet (and the
 /// summary's outcome columns) open in pandas and polars with the documented types.
-#[test]
 fn a_failing_impact_opens_in_pandas_and_polars() {
-    if !python_ok() {
-        return;
-    }
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let s = |p: &str| d.join(p).to_string_lossy().to_string();
@@ -303,4 +272,26 @@ fn a_failing_impact_opens_in_pandas_and_polars() {
         assert!(d.join("out").join(t).exists(), "{t}");
     }
     read_tables(&d.join("model"), &d.join("out"), d, true);
+}
+
+/// python3 with pandas, polars and pyarrow: its tests are ignored where it is missing, unless `WEFT_REQUIRE_PYTHON=1`.
+const PYTHON: common::optional::Tool = common::optional::Tool {
+    what: "python3 with pandas, polars and pyarrow",
+    install: "pip install pandas polars pyarrow",
+    require: "WEFT_REQUIRE_PYTHON",
+    here: python_ok,
+};
+
+fn main() -> std::process::ExitCode {
+    common::optional::run(
+        &PYTHON,
+        vec![
+            ("tables_open_in_pandas_and_polars", true, tables_open_in_pandas_and_polars),
+            ("a_model_with_every_feature_opens_in_pandas_and_polars", true, a_model_with_every_feature_opens_in_pandas_and_polars),
+            ("a_generated_woven_model_opens_in_pandas_and_polars", true, a_generated_woven_model_opens_in_pandas_and_polars),
+            ("a_formed_woven_model_opens_in_pandas_and_polars", true, a_formed_woven_model_opens_in_pandas_and_polars),
+            ("fit_and_error_tables_open_in_pandas_and_polars", true, fit_and_error_tables_open_in_pandas_and_polars),
+            ("a_failing_impact_opens_in_pandas_and_polars", true, a_failing_impact_opens_in_pandas_and_polars),
+        ],
+    )
 }

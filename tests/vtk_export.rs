@@ -7,8 +7,9 @@
 //! and run tables read by pandas: cell counts and VTK types per element kind, each
 //! cell's nodes, the output times, displacements and velocities (exactly: binary
 //! Float64), points = X + u₀ + u, the membranes' nodal thickness, the element results
-//! of `elements.parquet` as cell data, the projectile's tip and radius. Where Python's `vtk` is missing the test says so and passes, unless
-//! `WEFT_REQUIRE_PYTHON=1` (set by `.ci/run`, which installs it).
+//! of `elements.parquet` as cell data, the projectile's tip and radius. Where Python's `vtk` is missing the test is reported
+//! as ignored (tests/common/optional.rs), unless `WEFT_REQUIRE_PYTHON=1` (set by `.ci/run`,
+//! which installs it): then it fails.
 //!
 //! Case: the composite model of `tests/common` (every element kind: quads with a row of
 //! nodal thicknesses tied to triangles, beams, a tension-only truss, a point mass, a link
@@ -23,15 +24,7 @@ fn python_vtk_ok() -> bool {
     let probe = Command::new("python3")
         .args(["-c", "import vtkmodules.vtkIOXML, pandas, numpy"])
         .output();
-    let ok = probe.map(|o| o.status.success()).unwrap_or(false);
-    if !ok {
-        assert!(
-            std::env::var("WEFT_REQUIRE_PYTHON").as_deref() != Ok("1"),
-            "WEFT_REQUIRE_PYTHON=1 but python3 with vtk, pandas and numpy is not available"
-        );
-        eprintln!("SKIP: python3 with vtk and pandas not found (pip install vtk pandas pyarrow)");
-    }
-    ok
+    probe.map(|o| o.status.success()).unwrap_or(false)
 }
 
 fn s(p: &Path) -> &str {
@@ -58,11 +51,7 @@ fn composite_run(dir: &Path, extra: &[&str]) -> (std::path::PathBuf, std::path::
     (model, out)
 }
 
-#[test]
 fn vtk_reads_every_element_kind_the_times_and_the_history_values() {
-    if !python_vtk_ok() {
-        return;
-    }
     let dir = tempfile::tempdir().unwrap();
     let (model, out) = composite_run(dir.path(), &["--all-nodes", "--element-results", "all"]);
     let vtk = dir.path().join("vtk");
@@ -92,7 +81,6 @@ fn vtk_reads_every_element_kind_the_times_and_the_history_values() {
     eprintln!("{so}");
 }
 
-#[test]
 fn a_history_without_every_node_is_refused_and_nothing_is_written() {
     let dir = tempfile::tempdir().unwrap();
     let (model, out) = composite_run(dir.path(), &["--history-set", "beam"]);
@@ -127,4 +115,22 @@ fn a_history_without_every_node_is_refused_and_nothing_is_written() {
         .unwrap();
     let e = String::from_utf8_lossy(&o.stderr);
     assert!(!o.status.success() && e.contains("--every 0"), "{e}");
+}
+
+/// python3 with vtk, pandas and numpy: its tests are ignored where it is missing, unless `WEFT_REQUIRE_PYTHON=1`.
+const PYTHON_VTK: common::optional::Tool = common::optional::Tool {
+    what: "python3 with vtk, pandas and numpy",
+    install: "pip install vtk pandas pyarrow",
+    require: "WEFT_REQUIRE_PYTHON",
+    here: python_vtk_ok,
+};
+
+fn main() -> std::process::ExitCode {
+    common::optional::run(
+        &PYTHON_VTK,
+        vec![
+            ("vtk_reads_every_element_kind_the_times_and_the_history_values", true, vtk_reads_every_element_kind_the_times_and_the_history_values),
+            ("a_history_without_every_node_is_refused_and_nothing_is_written", false, a_history_without_every_node_is_refused_and_nothing_is_written),
+        ],
+    )
 }

@@ -362,3 +362,4 @@ pub fn same_outputs(a: &Path, b: &Path) -> Result<usize, String> {
     }
     Ok(ta.len())
 }
+pub mod optional;
