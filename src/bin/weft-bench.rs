@@ -13,14 +13,24 @@ use weft::solver::Solver;
 #[command(
     name = "weft-bench",
     version,
-    about = "Measure solver throughput (element-updates/s) and stage wall times"
+    about = "Measure solver throughput (element-updates/s) and stage wall times",
+    long_about = "Measure solver throughput (element-updates/s) and stage wall times on this \
+machine. By default: a net of trusses and links of each of --sizes elements, stepped for \
+--updates element-updates on each of --threads thread counts. --pipeline times the pipeline \
+engine (a no-op `weft run`, `weft status` over sweeps); --contact, the contact search on two \
+pressed layers of bands; --woven, the yarn-level woven patch hit by the bullet (wall time, \
+contact share). Prints its tables and writes nothing. Not a test: numbers depend on the \
+machine; compare two builds alternately in the same sitting.\n\n\
+Example:\n  \
+weft-bench --sizes 100000 --threads 1 2 --updates 3e8\n  \
+weft-bench --woven --woven-yarns 30 --woven-end-time 4e-5 --threads 2"
 )]
 struct Cli {
-    /// Element counts to measure.
-    #[arg(long, value_delimiter = ',', default_values_t = vec![10_000usize, 100_000, 1_000_000])]
+    /// Element counts to measure (several: `--sizes 1000 10000` or `--sizes 1000,10000`).
+    #[arg(long, num_args = 1.., value_delimiter = ',', default_values_t = vec![10_000usize, 100_000, 1_000_000])]
     sizes: Vec<usize>,
-    /// Thread counts to measure.
-    #[arg(long, value_delimiter = ',', default_values_t = vec![1usize, 2])]
+    /// Thread counts to measure (several: `--threads 1 2` or `--threads 1,2`).
+    #[arg(long, num_args = 1.., value_delimiter = ',', default_values_t = vec![1usize, 2])]
     threads: Vec<usize>,
     /// Element updates per measurement (sets the number of steps).
     #[arg(long, default_value_t = 3e8)]
@@ -34,7 +44,7 @@ struct Cli {
     #[arg(long)]
     contact: bool,
     /// Node counts for the contact benchmark.
-    #[arg(long, value_delimiter = ',', default_values_t = vec![1000usize, 10_000, 100_000])]
+    #[arg(long, num_args = 1.., value_delimiter = ',', default_values_t = vec![1000usize, 10_000, 100_000])]
     contact_nodes: Vec<usize>,
     /// Node-steps per contact measurement (sets the repetitions of the 300-step run).
     #[arg(long, default_value_t = 9e7)]
@@ -44,8 +54,11 @@ struct Cli {
     /// default projectile, simulated to --woven-end-time on each thread count.
     #[arg(long)]
     woven: bool,
+    /// Yarns per side of the woven benchmark's quarter patch (60: the paper's 120 × 120
+    /// reference).
     #[arg(long, default_value_t = 60)]
     woven_yarns: usize,
+    /// End time of the woven benchmark's impact [s].
     #[arg(long, default_value_t = 6e-5)]
     woven_end_time: f64,
     /// The yarns of the woven benchmark: `band` (the reference) or `chain` (truss chains;
@@ -53,7 +66,7 @@ struct Cli {
     #[arg(long, value_enum, default_value_t = weft::generate::woven::YarnModel::Band)]
     woven_yarn_model: weft::generate::woven::YarnModel,
     /// Sweep sizes for the pipeline benchmark.
-    #[arg(long, value_delimiter = ',', default_values_t = vec![1000usize, 10_000])]
+    #[arg(long, num_args = 1.., value_delimiter = ',', default_values_t = vec![1000usize, 10_000])]
     instances: Vec<usize>,
 }
 

@@ -20,7 +20,8 @@ use weft::analysis::energy;
                   fraction of its energy still there after the pulse has passed the interface: the reflection \
                   fraction R (≈ 0 for a well-matched interface; ((Z₁ − Z₂)/(Z₁ + Z₂))² between two bars of \
                   impedances Z = A√(Eρ)).\n\nExample:\n  \
-                  weft-energy pulse --model runs/combined --part warp_1 --axis x --from 0 --to 2e-3 --velocity 5 --out runs/pulse\n  \
+                  weft-energy pulse --model runs/combined --part warp_1 --axis x --from 0 --to 2e-3 \\\n    \
+                  --velocity 5 --out runs/pulse\n  \
                   weft-simulate --all-nodes --model runs/pulse --out runs/pulse-out\n  \
                   weft-energy measure --model runs/pulse --history runs/pulse-out/history.parquet \\\n    \
                   --region patch=warp_1,weft_1 --region coarse_membrane --source patch \\\n    \
@@ -46,7 +47,8 @@ enum Command {
         (default: the single sample after the launch where it is smallest). Choose the window after the pulse \
         has passed the interface and before anything returns from the model's outer boundary (or the reflected \
         part comes back to the interface).\n\nExample:\n  \
-        weft-energy measure --model runs/bar --history runs/bar-out/history.parquet --region bar1 --region bar2 \\\n    \
+        weft-energy measure --model runs/bar --history runs/bar-out/history.parquet \\\n    \
+        --region bar1 --region bar2 \\\n    \
         --source bar1 --window-start 4e-5 --window-end 6e-5 --out-dir runs/bar-energy"
     )]
     Measure(MeasureArgs),
@@ -57,7 +59,8 @@ enum Command {
         along that axis: a smooth in-plane (longitudinal) pulse. Nodes held in that direction (constraints, a \
         symmetry plane) and tied nodes get none. A strip that starts on a symmetry plane sends the whole pulse \
         outwards (the half that runs towards the plane comes back from it).\n\nExample:\n  \
-        weft-energy pulse --model runs/combined --part warp_1 --axis x --from 0 --to 2e-3 --velocity 5 --out runs/pulse"
+        weft-energy pulse --model runs/combined --part warp_1 --axis x --from 0 --to 2e-3 \\\n    \
+        --velocity 5 --out runs/pulse"
     )]
     Pulse(PulseArgs),
 }

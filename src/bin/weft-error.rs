@@ -20,8 +20,8 @@ use weft::analysis::error;
                   functions of the candidate element containing it (--match interpolate: meshes that differ). Only \
                   the compared components need be in the histories. Writes error.parquet (per node: the peak relative \
                   error peak‖p − q‖/peak‖q‖) and error_summary.parquet (T, the maximum node error).\n\nExample:\n  \
-                  weft-error --reference-model g --reference-history go/history.parquet --model m --history mo/history.parquet \
-                  --set reference --components ux,uy --out-dir runs/err"
+                  weft-error --reference-model g --reference-history go/history.parquet \\\n    \
+                  --model m --history mo/history.parquet --set reference --components ux,uy --out-dir runs/err"
 )]
 struct Cli {
     #[arg(long)]

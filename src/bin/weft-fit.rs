@@ -37,7 +37,8 @@ use weft::fit::Method;
                   Example (the membrane of a girder, static, two load cases):\n  \
                   weft-fit --reference-model g-ten --reference-history g-ten-out/history.parquet --model m-ten \\\n    \
                   --reference-model g-shr --reference-history g-shr-out/history.parquet --model m-shr \\\n    \
-                  --components ux,uy --static --param membrane.G12:1e8:1e10:log --param membrane.thickness:1e-4:1e-2:log \\\n    \
+                  --components ux,uy --static --param membrane.G12:1e8:1e10:log \\\n    \
+                  --param membrane.thickness:1e-4:1e-2:log \\\n    \
                   --out runs/fit"
 )]
 struct Cli {

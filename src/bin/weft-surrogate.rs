@@ -23,7 +23,8 @@ use weft::surrogate::{self, Activation, Scale, Training};
                   --threads.\n\npredict: y for every row of a table of x (a warning for a row outside the training \
                   range).\n\nExamples:\n  \
                   weft-surrogate train --table sweep.parquet --inputs b_g,N_g --outputs G_m,s_m,rho_m --out runs/sur\n  \
-                  weft-surrogate predict --surrogate runs/sur/surrogate.json --table new_x.parquet --out pred.parquet"
+                  weft-surrogate predict --surrogate runs/sur/surrogate.json --table new_x.parquet \\\n    \
+                  --out pred.parquet"
 )]
 struct Cli {
     #[command(subcommand)]
@@ -33,8 +34,10 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Fit the regression and search the networks on a table of x and y.
+    #[command(after_help = "Example:\n  weft-surrogate train --table sweep.parquet --inputs b_g,N_g \\\n    --outputs membrane.G12,membrane.s,membrane.rho --out runs/net")]
     Train(Box<TrainArgs>),
     /// Predict y for a table of x with a trained surrogate.
+    #[command(after_help = "Example:\n  weft-surrogate predict --surrogate runs/net/surrogate.json --x b_g=1.2e-3,N_g=7 \\\n    --out prediction.parquet")]
     Predict(PredictArgs),
 }
 

@@ -59,22 +59,27 @@ struct Cli {
 enum Model {
     /// A straight chain of trusses along x, fixed at x = 0, with an axial force pulse
     /// F0·sin(πt/T_F) on [0, T_F] at the free end x = L (transverse directions fixed).
+    #[command(after_help = "Example:\n  weft-weave rod --elements 200 --out runs/rod")]
     Rod(RodArgs),
     /// A square L × L grid of rods (the paper's §4 girder), N cells per side, clamped at
     /// x = 0 and loaded at x = L; rods as beams (rigid joints) or trusses (pinned joints).
+    #[command(after_help = "Example:\n  weft-weave girder --cells 10 --load-case shear --out runs/girder")]
     Girder(GirderArgs),
     /// The same square meshed with N × N membrane quads (the equivalent membrane),
     /// clamped at x = 0 and loaded at x = L. Defaults: the closed-form equivalent of the
     /// default girder (s = b²/a, ρ = ρ_g(2 − b/a), G = E(b/a)²/2 with b/a = 0.1). With
     /// --girder-cells, the paper's combined model (Fig. 5b): a girder zone at the centre.
+    #[command(after_help = "Example:\n  weft-weave membrane --cells 10 --load-case shear --out runs/membrane")]
     Membrane(MembraneArgs),
     /// A dense centre zone (rigid girder or fine membrane) inside a coarse membrane whose
     /// elements grow with distance from the centre, joined by tied interfaces; pinned outer
     /// edge; a transverse force pulse at the centre.
+    #[command(after_help = "Example:\n  weft-weave combined --out runs/combined")]
     Combined(CombinedArgs),
     /// The reduced woven model (the paper's §5): warp and weft trusses joined at every
     /// crossing by a link (springs, dashpots, optional friction slider), inside a graded
     /// equivalent membrane tied to the yarn ends, hit by a rigid projectile.
+    #[command(after_help = "Example:\n  weft-weave woven-reduced --yarns 10 --out runs/reduced")]
     WovenReduced(WovenArgs),
     /// The yarn-level plain-weave patch (the paper's §2 reference): every yarn a band of
     /// orthotropic membrane quads with the lenticular nodal thickness, warp along x and
@@ -83,6 +88,7 @@ enum Model {
     /// Quarter model (symmetry planes x = 0, y = 0) unless --full. Node sets: axis_x,
     /// axis_x_weft, diagonal, diagonal_weft (centre-line nodes at the crossings), edge.
     /// --yarn-model chain: truss chains along the bands' centre lines instead (faster).
+    #[command(after_help = "Example:\n  weft-weave woven --yarns 10 --out runs/woven\n  weft-weave woven --yarns 10 --layers 2 --failure-strain 0.036 --projectile-velocity 100 \\\n    --out runs/two")]
     Woven(WovenBandArgs),
 }
 

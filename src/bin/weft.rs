@@ -22,8 +22,9 @@ use weft::table::{write_table, Provenance};
                   on content (blake3), not timestamps.\n\nExamples:\n  weft run pipelines/rod_waves.toml          run what is stale\n  \
                   weft status pipelines/rod_waves.toml       say what is stale and why\n  \
                   weft run pipelines/rod_waves.toml -j 2 simulate   a stage and what it needs\n  \
-                  weft run pipelines/rod_waves.toml --executor slurm   each stale stage a Slurm job (docs/pipelines.md)\n  \
-                  weft gather pipelines/rod_waves.toml --stage simulate --table summary.parquet --out runs/summary.parquet"
+                  weft run pipelines/rod_waves.toml --executor slurm   each stale stage a Slurm job\n  \
+                  weft gather pipelines/rod_waves.toml --stage simulate --table summary.parquet \\\n    \
+                  --out runs/summary.parquet"
 )]
 struct Cli {
     #[command(subcommand)]
@@ -33,17 +34,21 @@ struct Cli {
 #[derive(Subcommand)]
 enum Cmd {
     /// Run the stale stages (all, or the named stages and what they need).
+    #[command(after_help = "Example:\n  weft run pipelines/woven_patch.toml\n  weft run -n pipelines/woven_patch.toml   (a dry run: what would run, and why)")]
     Run(RunArgs),
     /// Say for each stage instance whether it is fresh, or why it would run (and its
     /// Slurm job, while one of an interrupted `weft run --executor slurm` is queued or running).
+    #[command(after_help = "Example:\n  weft status pipelines/woven_patch.toml")]
     Status { pipeline: Option<PathBuf> },
     /// Print the stage graph.
+    #[command(after_help = "Example:\n  weft dag pipelines/woven_patch.toml --format mermaid")]
     Dag {
         pipeline: Option<PathBuf>,
         #[arg(long, value_enum, default_value_t = DagFormat::Text)]
         format: DagFormat,
     },
     /// The record of every stage instance (command, parameters, hashes, times, exit status).
+    #[command(after_help = "Example:\n  weft records pipelines/woven_patch.toml --out records.parquet")]
     Records {
         pipeline: Option<PathBuf>,
         /// Write the records as a Parquet table instead of printing them.
@@ -52,6 +57,7 @@ enum Cmd {
     },
     /// Gather one table of every instance of a (sweep) stage into one Parquet table, with
     /// the instance name and its parameters as columns.
+    #[command(after_help = "Example:\n  weft gather pipelines/ballistic_limit.toml --stage impact --table summary.parquet \\\n    --out impacts.parquet")]
     Gather {
         pipeline: Option<PathBuf>,
         /// The stage whose instances to gather.
