@@ -405,8 +405,9 @@ fn two_crossing_layers_are_bit_identical_on_one_and_two_threads() {
     );
     assert!(active > 100, "only {active} slaves in contact");
     assert!(u1 == u2 && e1 == e2, "1 and 2 threads differ");
-    // Friction and penalty keep the balance: measured 3e-4.
-    assert!(bal < 1e-2, "energy balance {bal}");
+    // Friction and penalty keep the balance: measured 7.25e-5 (1 and 2 threads, bit
+    // identical); tolerance 2.5e-4, 3.4×.
+    assert!(bal < 2.5e-4, "energy balance {bal}");
 }
 
 /// The narrow phase skips a slave whose margin at the build (how far it was from all its

@@ -167,13 +167,24 @@ fn a_formed_weave_left_alone_stays_where_it_is() {
         100.0 * all / h,
         stats.max_balance_error_relative
     );
-    // The issue asks < 1 % of the yarn thickness over 50 µs. Measured, relaxed whole:
-    // 1.9 % when forming stopped on kinetic energy and residual force alone, 0.14 % with
-    // the rest test; from the periodic cell 0.01 % (anywhere 0.05 %), with the energy
-    // balanced to 5e-4.
-    assert!(at_crossings < 0.01 * h, "moved {at_crossings} m");
-    assert!(all < 0.01 * h, "moved {all} m");
-    assert!(stats.max_balance_error_relative < 0.01);
+    // The issue asks < 1 % of the yarn thickness over 50 µs, which is also forming's own
+    // stop (its rest test, on the pulled model): asserting that could not fail. Measured,
+    // relaxed whole: 1.9 % when forming stopped on kinetic energy and residual force
+    // alone, 0.14 % with the rest test; from the periodic cell (this model) 1.70e-8 m =
+    // 0.014 % of h at the crossings and anywhere: tolerance 5e-4 h = 6.2e-8 m, 3.6×. The
+    // tiled cell taken without its rest test, relaxed on until forming's stop, moves
+    // 2.4e-7 m = 0.195 % of h here (measured): it passes the 1 % and fails this. Energy
+    // balance measured 7.90e-4, tolerance 2.5e-3, 3.2×.
+    assert!(
+        at_crossings < 5e-4 * h,
+        "moved {at_crossings} m at the crossings"
+    );
+    assert!(all < 5e-4 * h, "moved {all} m");
+    assert!(
+        stats.max_balance_error_relative < 2.5e-3,
+        "energy balance {}",
+        stats.max_balance_error_relative
+    );
 }
 
 /// The chain representation (`weft-weave woven --yarn-model chain`: truss chains along
@@ -198,8 +209,9 @@ fn a_chain_weave_is_formed_to_the_same_checks() {
     check_formed("6×6 chain quarter from the periodic cell", &m, &f, &r, 0.05);
     let (g, r) = formed(&m, &Params::default());
     check_formed("6×6 chain quarter relaxed whole", &m, &g, &r, 0.05);
-    // Left alone for 50 µs: the issue's < 1 % of the yarn thickness (measured 0.003 %,
-    // balance 6.2e-4).
+    // Left alone for 50 µs: the issue asks < 1 % of the yarn thickness; measured 3.54e-9 m
+    // = 0.003 % of h, tolerance 1e-4 h = 1.24e-8 m, 3.5×; energy balance measured 6.26e-4,
+    // tolerance 2e-3, 3.2×.
     let mut f = f;
     f.projectiles.clear();
     f.analysis.end_time = 50e-6;
@@ -217,8 +229,12 @@ fn a_chain_weave_is_formed_to_the_same_checks() {
         100.0 * moved / h,
         stats.max_balance_error_relative
     );
-    assert!(moved < 0.01 * h, "moved {moved} m");
-    assert!(stats.max_balance_error_relative < 0.01);
+    assert!(moved < 1e-4 * h, "moved {moved} m");
+    assert!(
+        stats.max_balance_error_relative < 2e-3,
+        "energy balance {}",
+        stats.max_balance_error_relative
+    );
 }
 
 #[test]
@@ -708,19 +724,20 @@ fn relaxation_finds_the_statics_of_a_pulled_string() {
     );
     assert!(st.converged);
     // Measured 1.6e-9: what the stop allows (the residual 1.5e-10 N against P = 0.05 N,
-    // 3e-9).
-    assert!(err < 1e-8, "{err}");
+    // 3e-9); tolerance 5e-9, 3×.
+    assert!(err < 5e-9, "{err}");
 }
 
 /// The §3 combined model formed the same way as the reference patch: the 4 × 4 quarter
 /// tied into a membrane out to 8 mm. The patch is formed with its ends pulled (as a
 /// patch alone), then the ties and the membrane's pre-stress come back and the whole
-/// model settles. Oracles: the bands carry the requested tension (the issue's 1 %), which
-/// the membrane's pre-stress must supply at the tied edge: at least the closed form
-/// N₀/s = T/(p·s) (Irvine's string statics: the yarn's tension is the pull at its end;
-/// more, since the membrane's pull relaxes as its edge moves); the model is in
-/// equilibrium (K ≤ 10⁻⁶ W) and, left alone 50 µs, moves < 1 % of the yarn thickness
-/// with the energy balanced.
+/// model settles. Oracles: the yarns' tension, taken in the test from the forces their
+/// tied ends exert (Irvine's string statics: the yarn's tension is the pull at its end),
+/// is the requested T; the membrane's pre-stress S₀ is what a clamped 1-D bar (ν = 0)
+/// whose edge moved out by ū needs to pull with that tension, N/s + E ū/(L − c), hence
+/// above N/s; left alone 50 µs, the model stays (the issue's < 1 % of the yarn
+/// thickness) with the energy balanced. (The bands' 1 % and K ≤ 10⁻⁶ W are forming's own
+/// stop: it errors otherwise.)
 #[test]
 fn a_patch_tied_into_a_membrane_is_formed_with_the_requested_tension() {
     use weft::generate::woven::Surround;
@@ -755,8 +772,8 @@ fn a_patch_tied_into_a_membrane_is_formed_with_the_requested_tension() {
             "band tension {t}"
         );
     }
-    // The membrane's pre-stress, against N₀/s (measured 1.26e7 / 1.29e7 Pa against
-    // 3.76e6 Pa: its edge moved out ~2 µm as the band ends followed its ripple).
+    // The membrane's pre-stress, uniform (measured 1.2757e7 / 1.2759e7 Pa against N₀/s =
+    // 3.76e6 Pa: its edge moved out ~1.7 µm as the band ends followed its ripple).
     let q = &f.elements[&weft::model::ElementKind::Quad];
     let s = f
         .parts
@@ -775,7 +792,99 @@ fn a_patch_tied_into_a_membrane_is_formed_with_the_requested_tension() {
         mem[0][0], mem[0][1]
     );
     for s0 in &mem {
-        assert!(s0[0] >= closed && s0[1] >= closed && s0[2] == 0.0, "{s0:?}");
+        assert!(s0 == &mem[0] && s0[2] == 0.0, "{s0:?}");
+    }
+    // The tension from the reactions (not the bands' stress, on which forming corrects
+    // S₀): at the formed state, −Σ f_int·ê over a yarn's tied end nodes is the pull the
+    // tie takes from it, which a string carries all along (Irvine §1). Per yarn j (at
+    // y = j·p; the one on the symmetry plane y = 0 is half a yarn), and per unit length of
+    // the tied edge x = c (y = c for the weft), N = Σ_j T_j / c.
+    let pitch = WovenBandParams::default().spacing;
+    let c = 3.5 * pitch;
+    let mpart = f
+        .parts
+        .iter()
+        .position(|pt| pt.name == "coarse_membrane")
+        .unwrap();
+    let props = &f.parts[mpart].props;
+    let e_m = props.youngs_modulus_1.unwrap();
+    // The membrane is a set of independent strips (ν₁₂ = 0, G₁₂ = 0.0042 E): 1-D bars.
+    assert_eq!(props.poisson_ratio_12, Some(0.0));
+    assert!(props.shear_modulus_12.unwrap() < 0.01 * e_m);
+    let mut on_membrane = vec![false; f.num_nodes()];
+    for e in (0..q.len()).filter(|&e| q.part[e] == mpart) {
+        for &n in &q.nodes[4 * e..4 * e + 4] {
+            on_membrane[n] = true;
+        }
+    }
+    let outer = f.coords.iter().map(|x| x[0]).fold(0.0, f64::max);
+    let fi = weft::solver::Solver::new(&f).unwrap().internal_forces();
+    let u0 = &f.initial_displacement;
+    for d in 0..2 {
+        let mut t = [0.0f64; 4];
+        for tie in &f.ties {
+            let x = f.coords[tie.slave];
+            if (x[d] - c).abs() < 1e-9 * c {
+                t[(x[1 - d] / pitch).round() as usize] -= fi[tie.slave][d];
+            }
+        }
+        let share = [0.5, 1.0, 1.0, 1.0];
+        let mean = t.iter().sum::<f64>() / share.iter().sum::<f64>();
+        let spread = (0..4)
+            .map(|j| (t[j] / (share[j] * p.warp_tension) - 1.0).abs())
+            .fold(0.0, f64::max);
+        // The 1-D bar from the tied edge x = c to the clamped x = L (the membrane's
+        // outer edge), pre-stressed by S₀, its edge moved out by ū (the mean of u₀ along
+        // the edge): S = S₀ − E ū/(L − c), which must carry N: S₀ = N/s + E ū/(L − c).
+        let mut edge: Vec<usize> = (0..f.num_nodes())
+            .filter(|&n| {
+                on_membrane[n]
+                    && (f.coords[n][d] - c).abs() < 1e-9 * c
+                    && f.coords[n][1 - d] <= c * (1.0 + 1e-9)
+            })
+            .collect();
+        edge.sort_by(|&a, &b| f.coords[a][1 - d].total_cmp(&f.coords[b][1 - d]));
+        let (mut ws, mut us) = (0.0, 0.0);
+        for k in 1..edge.len() {
+            let (a, b) = (edge[k - 1], edge[k]);
+            let w = f.coords[b][1 - d] - f.coords[a][1 - d];
+            us += 0.5 * w * (u0[a][d] + u0[b][d]);
+            ws += w;
+        }
+        let ubar = us / ws;
+        let n_edge = t.iter().sum::<f64>() / c;
+        let bar = n_edge / s + e_m * ubar / (outer - c);
+        let s0 = mem[0][d];
+        println!(
+            "{}: from the ties' reactions T_j {:.4} (half) / {:.4} / {:.4} / {:.4} N, mean per yarn {mean:.5} N ({:+.2e}), largest departure {spread:.3e}; edge moved out ū = {ubar:.4e} m; S₀ {s0:.5e} Pa against N/s = {:.5e} Pa and the bar's N/s + E ū/(L − c) = {bar:.5e} Pa ({:+.2e})",
+            ["warp", "weft"][d],
+            t[0],
+            t[1],
+            t[2],
+            t[3],
+            mean / p.warp_tension - 1.0,
+            n_edge / s,
+            s0 / bar - 1.0
+        );
+        // Measured −7.1e-3 (both families): the reactions include the hourglass forces
+        // and the lenticular contact's component along the yarn, the bands' stress not;
+        // tolerance 2e-2, 2.8×.
+        assert!(
+            (mean / p.warp_tension - 1.0).abs() < 2e-2,
+            "mean tension {mean} from the reactions"
+        );
+        // Per yarn: the ends follow the membrane edge's ripple; measured 6.2e-2 (the
+        // first full yarn), tolerance 0.15, 2.4×.
+        assert!(spread < 0.15, "tensions {t:?}");
+        // S₀ on both sides: at least N/s (the edge moved out, ū > 0, relieves the
+        // membrane), and the bar's value: measured +1.18e-2 (the shear coupling of the
+        // strips and the ripple's stretch), tolerance 4e-2, 3.4×.
+        assert!(
+            ubar > 0.0 && s0 > n_edge / s,
+            "S₀ {s0} against N/s {}",
+            n_edge / s
+        );
+        assert!((s0 / bar - 1.0).abs() < 4e-2, "S₀ {s0} against {bar}");
     }
     // Left alone: the ties keep the formed ends' offsets, nothing jumps.
     let mut g = f.clone();
@@ -795,9 +904,14 @@ fn a_patch_tied_into_a_membrane_is_formed_with_the_requested_tension() {
         100.0 * moved / h,
         stats.max_balance_error_relative
     );
-    // Measured 0.17 % of h, energy balance 9.1e-4.
-    assert!(moved < 0.01 * h, "moved {moved} m");
-    assert!(stats.max_balance_error_relative < 0.01);
+    // The issue asks < 1 % of h; measured 2.47e-7 m = 0.199 % of h, tolerance 6e-3 h =
+    // 7.4e-7 m, 3×; energy balance measured 4.93e-4, tolerance 1.5e-3, 3×.
+    assert!(moved < 6e-3 * h, "moved {moved} m");
+    assert!(
+        stats.max_balance_error_relative < 1.5e-3,
+        "energy balance {}",
+        stats.max_balance_error_relative
+    );
 }
 
 /// The periodic cell of the default weave (four half yarns between neighbouring
@@ -835,18 +949,20 @@ fn the_periodic_cell_balances_its_planes_and_keeps_its_two_fold_symmetry() {
     for d in 0..2 {
         // The stop: the tension to 1e-3.
         assert!((f.tension[d] / 0.5 - 1.0).abs() <= 1e-3, "{:?}", f.tension);
-        // Balance, measured 2e-7 relative (the relaxation's residual, 4e-7 N).
-        assert!(
-            (f.fixed_tension[d] - f.tension[d]).abs() < 1e-5 * f.tension[d],
-            "{:?} {:?}",
-            f.fixed_tension,
-            f.tension
+        let balance = (f.fixed_tension[d] / f.tension[d] - 1.0).abs();
+        println!(
+            "Σ F across the planes {}: {balance:.2e} of the tension",
+            ["x", "y"][d]
         );
+        // Balance: the relaxation's residual; measured 3.4e-8 / 2.6e-7 (x / y) of the
+        // tension; tolerance 1e-6, 3.8×.
+        assert!(balance < 1e-6, "{:?} {:?}", f.fixed_tension, f.tension);
         // The planes moved by the de-crimping and the stretch: positive, a few µm.
         assert!(f.stretch[d] > 0.0 && f.stretch[d] < 1e-5, "{:?}", f.stretch);
     }
-    // Measured 3e-7 N against contact forces of 0.04 N at the quarter crossings.
-    assert!(f.axis_reaction < 1e-5, "{}", f.axis_reaction);
+    // Measured 7.62e-9 N against contact forces of 0.04 N at the quarter crossings (the
+    // relaxation's residual); tolerance 3e-8 N, 3.9×.
+    assert!(f.axis_reaction < 3e-8, "{}", f.axis_reaction);
     // The two-fold rotations: node at (x, y, z) ↔ partner at (p − x, y, −z) with
     // u' = (δ_x − u_x, u_y, −u_z), and (x, y, z) ↔ (x, p − y, −z) with
     // u' = (u_x, δ_y − u_y, −u_z).
@@ -875,8 +991,9 @@ fn the_periodic_cell_balances_its_planes_and_keeps_its_two_fold_symmetry() {
         }
     }
     println!("two-fold symmetry: largest departure {worst:.2e} m (crimp amplitude {amp:.3e} m)");
-    // Measured 2e-10 m, 2.5e-6 of the amplitude: the relaxation's tolerance.
-    assert!(worst < 1e-3 * amp, "{worst}");
+    // Measured 1.42e-10 m = 1.7e-6 of the amplitude (8.31e-5 m): the relaxation's
+    // residual; tolerance 5e-6 of the amplitude, 2.9×.
+    assert!(worst < 5e-6 * amp, "{worst}");
 }
 
 /// What the periodic cell cannot form, named: a weave without tension (the planes are
@@ -955,6 +1072,7 @@ fn a_full_patch_formed_from_its_cell_keeps_its_centre() {
             .max((u[k][2] - u[n][2]).abs());
     }
     println!("two-fold symmetry about the centre: largest departure {worst:.2e} m");
-    // The tiling is exact up to the cell's own symmetry (2e-10 m): measured as printed.
-    assert!(worst < 1e-8, "{worst}");
+    // The tiling is exact up to the cell's own symmetry (1.4e-10 m, above) and the
+    // patch's relaxation: measured 4.66e-10 m; tolerance 2e-9 m, 4.3×.
+    assert!(worst < 2e-9, "{worst}");
 }
