@@ -20,38 +20,117 @@ use weft::generate::woven::{woven, Lenticular, WovenBandParams};
 use weft::model::{ElementKind, Model, PartProps, ProjectileShape, ProjectileSpec};
 use weft::solver::{run_in_memory, Solver};
 
+/// The complete elliptic integral of the second kind E(m) = ∫₀^{π/2} √(1 − m sin²θ) dθ
+/// by the arithmetic–geometric mean (Abramowitz & Stegun, *Handbook of Mathematical
+/// Functions*, 17.6.1–17.6.4: K = π/(2 AGM(1, √(1 − m))), E = K(1 − Σ 2^(n−1) c_n²),
+/// c₀² = m).
+fn elliptic_e(m: f64) -> f64 {
+    let (mut a, mut b) = (1.0f64, (1.0 - m).sqrt());
+    let (mut sum, mut pow) = (0.5 * m, 0.5);
+    for _ in 0..40 {
+        let c = 0.5 * (a - b);
+        (a, b) = (0.5 * (a + b), (a * b).sqrt());
+        pow *= 2.0;
+        sum += pow * c * c;
+        if c.abs() < 1e-17 {
+            break;
+        }
+    }
+    std::f64::consts::FRAC_PI_2 / a * (1.0 - sum)
+}
+
 #[test]
 fn lenticular_section_and_areal_density_match_their_closed_forms() {
     let p = WovenBandParams::default();
-    let lens = Lenticular::new(p.width, p.thickness);
+    let (w, h) = (p.width, p.thickness);
+    let lens = Lenticular::new(w, h);
     // Thickness: h at the centre line, 0 at the edges; area ≈ (2/3)wh (docs/theory.md, "The yarn-level woven patch").
-    assert!(rel(lens.thickness(0.0), p.thickness) < 1e-12);
-    assert!(lens.thickness(0.5 * p.width).abs() < 1e-12);
+    assert!(rel(lens.thickness(0.0), h) < 1e-12);
+    assert!(lens.thickness(0.5 * w).abs() < 1e-12);
+    // The section's area, from its geometry and not from `Lenticular::area`: two circular
+    // segments of chord w and height h/2, so of radius R = ((w/2)² + (h/2)²)/h and central
+    // angle θ = 2 asin(w/(2R)), each of area ½R²(θ − sin θ) (Zwillinger, *CRC Standard
+    // Mathematical Tables*, §4.5, circular segment).
+    let r = (0.25 * w * w + 0.25 * h * h) / h;
+    let theta = 2.0 * (0.5 * w / r).asin();
+    let area = r * r * (theta - theta.sin());
+    // Measured 6.0e-16 against the generator's (its acos form): rounding; bound ~450 ulps.
     assert!(
-        rel(lens.area(), 2.0 / 3.0 * p.width * p.thickness) < 0.01,
-        "area {}",
+        rel(lens.area(), area) < 1e-13,
+        "area {} vs {area}",
         lens.area()
     );
+    assert!(rel(area, 2.0 / 3.0 * w * h) < 0.01, "area {area}");
     let (m, info) = woven(&p).unwrap();
-    // The band's area, summed from its quads (width × mean nodal thickness), is the exact
-    // lenticular area: the nodal thickness is scaled for it.
     let b = &m.elements[&ElementKind::Quad];
-    // Mass of the quarter against 2ρA(1 + c)/p over the quarter patch [0, (n − ½)p]².
+    // The crimp amplitude a, read from the mesh (the warp j = 0 at x = 0 lies at z = a),
+    // is the documented default t_c/2 + 1 nm, t_c the centre thickness scaled so that two
+    // quads across (nodal thicknesses 0, t_c, 0: a trapezoid area w t_c/2) carry A:
+    // t_c = 2A/w.
+    let a = m.coords[m.node_sets["axis_x"][0]][2];
+    assert!(rel(a, area / w + 1e-9) < 1e-12, "amplitude {a}");
+    // The crimp of z = a cos(πx/p): over a half wave ∫₀^p √(1 + k² sin²(πx/p)) dx with
+    // k = πa/p, which is p (2/π) √(1 + k²) E(k²/(1 + k²)) (substitute θ = π/2 − πx/p).
+    let k = std::f64::consts::PI * a / p.spacing;
+    let crimp =
+        2.0 / std::f64::consts::PI * (1.0 + k * k).sqrt() * elliptic_e(k * k / (1.0 + k * k)) - 1.0;
+    // The quarter patch [0, (n − ½)p]²: per family n − ½ yarns of section A (the one on
+    // the symmetry plane carries half), each (n − ½)p long and crimped, so the areal
+    // density 2ρA(1 + c)/p.
     let s = Solver::new(&m).unwrap();
     let side = (p.yarns as f64 - 0.5) * p.spacing;
     let areal = s.physical_mass / (side * side);
-    let closed = 2.0 * p.density * lens.area() * (1.0 + info.crimp) / p.spacing;
+    let closed = 2.0 * p.density * area * (1.0 + crimp) / p.spacing;
+    // The mesh follows the crimp by flat quads, `per_spacing` = 4 per spacing: chords
+    // from x_i = ip/4 to x_{i+1}, so its exact mass is 2ρA(n − ½) Σ √((p/4)² + (z_{i+1} − z_i)²).
+    let n_along = (2 * p.yarns - 1) * p.per_spacing / 2;
+    let dx = p.spacing / p.per_spacing as f64;
+    let zc = |i: usize| a * (std::f64::consts::PI * i as f64 * dx / p.spacing).cos();
+    let chords: f64 = (0..n_along)
+        .map(|i| (dx * dx + (zc(i + 1) - zc(i)).powi(2)).sqrt())
+        .sum();
+    let chord_mass = 2.0 * p.density * area * (p.yarns as f64 - 0.5) * chords;
+    // The nodal masses summed with Kahan's compensation: the plain sum of 85 562 of them
+    // (`physical_mass`) carries up to n·ε of rounding (Higham, *Accuracy and Stability of
+    // Numerical Algorithms*, §4.2; measured 5.7e-13), the compensated one a few ulps.
+    assert!(s.scaling.is_none());
+    let (mut lumped, mut carry) = (0.0f64, 0.0f64);
+    for &mass in &s.mass {
+        let y = mass - carry;
+        let t = lumped + y;
+        carry = (t - lumped) - y;
+        lumped = t;
+    }
     println!(
-        "areal density {:.3} g/m² vs closed form {:.3} g/m² ({:.2e}); thickness scale {:.4}, crimp {:.3} %, {} quads",
+        "areal density {:.3} g/m² vs closed form {:.3} g/m² ({:.2e}); nodal masses vs the chords' {:.2e}; crimp {:.4} % (generator {:.2e} off), thickness scale {:.4}, {} quads",
         1e3 * areal,
         1e3 * closed,
         rel(areal, closed),
+        rel(lumped, chord_mass),
+        100.0 * crimp,
+        rel(info.crimp, crimp),
         info.thickness_scale,
-        100.0 * info.crimp,
         b.len()
     );
-    // Measured 8.2e-4: flat quads follow the crimped path by chords (4 per spacing).
+    // Measured 8.2e-4: the chords are shorter than the arcs (tolerance 2.4×).
     assert!(rel(areal, closed) < 2e-3);
+    // Measured 9.5e-16: the lumped masses are the chords' mass but for rounding (a bound
+    // of 1e-13, about 450 ulps).
+    assert!(rel(lumped, chord_mass) < 1e-13);
+    assert!(rel(s.physical_mass, lumped) < s.mass.len() as f64 * f64::EPSILON);
+    // What the generator reports (`weft-weave` prints it): its crimp by Simpson's rule
+    // against the elliptic integral, measured 2.6e-14 (2 ulps of the path length 1 + c,
+    // which c is the small difference of); bound 1e-12.
+    assert!(
+        rel(info.crimp, crimp) < 1e-12,
+        "crimp {} vs {crimp}",
+        info.crimp
+    );
+    assert!(
+        rel(info.areal_density, closed) < 1e-12,
+        "{}",
+        info.areal_density
+    );
     // Crossing node sets: the warp's centre-line nodes at x = i p on y = 0, and at (i p, i p).
     let ax = &m.node_sets["axis_x"];
     assert_eq!(ax.len(), p.yarns);
@@ -391,8 +470,9 @@ fn smith_transverse_impact_of_a_band() {
         100.0 * e_lin,
         stats.max_balance_error_relative
     );
-    // Measured: strain 1.0e-3, kink speed 5.8e-3 (the issue asks 1 %).
-    assert!(rel(strain, eps) < 0.01, "strain {strain} vs Smith {eps}");
+    // Measured: strain 1.0e-3 (tolerance 3e-3, 3×), kink speed 5.8e-3 (tolerance 1 %,
+    // 1.7×: the kink is read by a line fit to the nodes at two times).
+    assert!(rel(strain, eps) < 3e-3, "strain {strain} vs Smith {eps}");
     assert!(rel(u, u_lab) < 0.01, "kink speed {u} vs Smith {u_lab}");
 }
 
@@ -425,8 +505,13 @@ fn a_woven_patch_impact_keeps_its_energy_and_is_thread_independent() {
         o1.u == o2.u && o1.energy == o2.energy && o1.projectile == o2.projectile,
         "1 and 2 threads differ"
     );
-    // Measured 6.5e-5; the issue asks ≤ 1 % with contact and friction.
-    assert!(stats.max_balance_error_relative < 0.01);
+    // Measured 3.6e-5 (the same bits on 1 and 2 threads); tolerance 1e-4, 2.8× (users
+    // are promised ≤ 1 % with contact and friction).
+    assert!(
+        stats.max_balance_error_relative < 1e-4,
+        "balance {:.2e}",
+        stats.max_balance_error_relative
+    );
     assert!(rep.friction_work > 0.0 && rep.active > 0);
     // The projectile has slowed down, by what the fabric took.
     let vz = p1.last().unwrap().2[5];
@@ -469,8 +554,13 @@ fn a_patch_tied_into_a_membrane_weighs_and_conserves_what_it_should() {
         1e3 * info.areal_density,
         rel(membrane, expected)
     );
-    // Measured 1.1e-15: lumped masses add up exactly.
-    assert!(rel(membrane, expected) < 1e-9);
+    // Measured 1.1e-15: lumped masses add up exactly but for the rounding of the plain
+    // sums of the nodal masses, at most (n − 1)ε of the total (Higham, *Accuracy and
+    // Stability of Numerical Algorithms*, §4.2).
+    assert!(
+        (membrane - expected).abs() < m.num_nodes() as f64 * f64::EPSILON * mass_all,
+        "{membrane} vs {expected}"
+    );
     // Every yarn end tied, on the edge it lies on, and no yarn end held.
     let ends = &patch.node_sets["edge"];
     assert_eq!(m.node_sets["interface"], *ends);
@@ -488,7 +578,7 @@ fn a_patch_tied_into_a_membrane_weighs_and_conserves_what_it_should() {
         assert!(a[1 - axis] - 1e-12 <= s && s <= b[1 - axis] + 1e-12);
         assert!(m.constraints.iter().all(|(n, _)| *n != t.slave));
     }
-    // An impact: energy conserved to 1 % with contact, friction and ties, and the
+    // An impact: energy conserved with contact, friction and ties, and the
     // in-plane wave has crossed the interface into the membrane along the x axis.
     let (_s, out, stats) = run_in_memory(&m).unwrap();
     let axis = &m.node_sets["axis_x_all"];
@@ -508,7 +598,12 @@ fn a_patch_tied_into_a_membrane_weighs_and_conserves_what_it_should() {
         stats.max_balance_error_relative,
         1e3 * m.coords[node][0]
     );
-    assert!(stats.max_balance_error_relative < 0.01);
+    // Measured 1.6e-5; tolerance 5e-5, 3.1× (users are promised 1 %).
+    assert!(
+        stats.max_balance_error_relative < 5e-5,
+        "balance {:.2e}",
+        stats.max_balance_error_relative
+    );
     assert!(ux < -1e-7, "the wave did not reach the membrane: ux = {ux}");
 }
 

@@ -132,8 +132,13 @@ fn a_chain_patch_impact_keeps_its_energy_and_is_thread_independent() {
         o1.u == o2.u && o1.energy == o2.energy && o1.projectile == o2.projectile,
         "1 and 2 threads differ"
     );
-    // The issue asks ≤ 1 % with contact and friction; measured 2.6e-5.
-    assert!(stats.max_balance_error_relative < 0.01);
+    // Measured 1.9e-5 (the same bits on 1 and 2 threads); tolerance 6e-5, 3.1× (users
+    // are promised ≤ 1 % with contact and friction).
+    assert!(
+        stats.max_balance_error_relative < 6e-5,
+        "balance {:.2e}",
+        stats.max_balance_error_relative
+    );
     assert!(rep.friction_work > 0.0 && rep.active > 0);
     let vz = p1.last().unwrap().2[5];
     assert!(

@@ -532,9 +532,10 @@ fn the_framed_link_force_is_minus_its_energy_gradient_on_all_six_nodes() {
             "case {case}: moment {moment:?}"
         );
     }
-    // Measured 1.1·10⁻¹⁰ of the largest force (the central difference's rounding).
+    // Measured 1.1·10⁻¹⁰ of the largest force (the central difference's rounding, ε W/h);
+    // tolerance 3·10⁻¹⁰, 2.7×.
     eprintln!("framed link: worst |f + ∂W/∂x| {worst:.2e} of the largest force");
-    assert!(worst < 1e-8, "{worst}");
+    assert!(worst < 3e-10, "{worst}");
 }
 
 #[test]
@@ -608,23 +609,35 @@ fn a_tilted_local_link_oscillates_in_plane_and_the_global_one_in_z() {
             .fold(0.0, f64::max);
         let e = out.energy.last().unwrap();
         eprintln!(
-            "local {local}: peak along e1 {peak_e1:.4e} m (v0/wt = {:.4e}), along n {peak_n:.3e} m, |z| {peak_z:.4e} m (global closed form v0 sin θ/wn = {:.4e}), energy error {:.1e} J of {:.1e}",
+            "local {local}: peak along e1 {peak_e1:.4e} m (v0/wt = {:.4e}, {:.2e}), along n {peak_n:.3e} m, |z| {peak_z:.4e} m (global closed form v0 sin θ/wn = {:.4e}, {:.2e}), energy error {:.1e} J of {:.1e}",
             v0 / wt,
+            rel(peak_e1, v0 / wt),
             v0 * theta.sin() / wn,
+            rel(peak_z, v0 * theta.sin() / wn),
             e.balance_error,
             0.5 * mass * v0 * v0
         );
         if local {
-            assert!(rel(peak_e1, v0 / wt) < 1e-3, "{peak_e1}");
-            assert!(peak_n < 1e-9 * v0 / wt, "{peak_n}");
+            // Measured 1.3·10⁻⁸ (the central difference at ω_t Δt = 0.01); tolerance
+            // 5·10⁻⁸, 3.9×.
+            assert!(rel(peak_e1, v0 / wt) < 5e-8, "{peak_e1}");
+            // Nothing along n but rounding: measured 5.2·10⁻¹⁶ of the amplitude (2 ulps);
+            // bound 10⁻¹³, about 450 ulps.
+            assert!(peak_n < 1e-13 * v0 / wt, "{peak_n}");
         } else {
-            assert!(rel(peak_z, v0 * theta.sin() / wn) < 0.01, "{peak_z}");
+            // Measured 1.2·10⁻³ (the central difference at ω_n Δt = 0.1, and the output
+            // grid's sampling of the fast z oscillation); tolerance 4·10⁻³, 3.4×.
+            assert!(rel(peak_z, v0 * theta.sin() / wn) < 4e-3, "{peak_z}");
             // Along e₁: the x oscillator's share plus the z one's, far below v₀/ω_t.
             assert!(peak_e1 < 0.95 * v0 / wt, "{peak_e1}");
         }
-        // Measured 1.8·10⁻⁶ (local) and 2.8·10⁻⁴ (global: the z oscillator) of the
-        // initial kinetic energy, the O((ωΔt)²) swing of the ledger.
-        assert!(e.balance_error.abs() < 1e-3 * 0.5 * mass * v0 * v0, "{e:?}");
+        // Measured 3.8·10⁻¹⁵ (local) and 2.6·10⁻¹⁵ (global) of the initial kinetic
+        // energy: rounding (17 and 12 ulps of it, over 157 steps); bound 10⁻¹³, about
+        // 450 ulps.
+        assert!(
+            e.balance_error.abs() < 1e-13 * 0.5 * mass * v0 * v0,
+            "{e:?}"
+        );
     }
 }
 
@@ -704,18 +717,27 @@ fn coulomb_friction_slips_at_mu_n() {
             mu * n_load,
             f[2]
         );
-        // Measured: tangential and normal force equal μN and N to 10⁻¹⁶ (rounding); the
-        // stick displacement 0.1 % above F/k_t (the early slip while N builds up).
-        assert!(rel(-f[0], mu * n_load) < 0.01, "{name}: {f:?}");
-        assert!(rel(f[2], n_load) < 0.01, "{name}: {f:?}");
-        assert!(rel(x4, stick) < 0.01, "{name}: stick x {x4} vs {stick}");
+        // Measured: tangential and normal force equal μN and N but for rounding (0 and
+        // 1 ulp); bound 10⁻¹³, about 450 ulps. The stick displacement 9.5·10⁻⁴ above F/k_t
+        // (the early slip while N builds up); tolerance 3·10⁻³, 3.2×.
+        assert!(rel(-f[0], mu * n_load) < 1e-13, "{name}: {f:?}");
+        assert!(rel(f[2], n_load) < 1e-13, "{name}: {f:?}");
+        assert!(rel(x4, stick) < 3e-3, "{name}: stick x {x4} vs {stick}");
         // Dissipation μN × slip distance: the slip is x − μN/k_t.
         let e = out.energy.last().unwrap();
         let x_end = *out.series(1, 0).last().unwrap();
         let slip = x_end - mu * n_load / K_T;
+        eprintln!(
+            "{name}: off by: tangential {:.1e}, normal {:.1e}, stick {:.2e}, friction {:.1e}",
+            rel(-f[0], mu * n_load),
+            rel(f[2], n_load),
+            rel(x4, stick),
+            rel(e.friction, mu * n_load * slip)
+        );
         assert!(slip > 0.0);
+        // Measured 7.5·10⁻¹⁶ and 2.6·10⁻¹⁵: rounding; bound 10⁻¹³, about 450 ulps.
         assert!(
-            rel(e.friction, mu * n_load * slip) < 0.02,
+            rel(e.friction, mu * n_load * slip) < 1e-13,
             "{name}: friction energy {} vs μN·slip {}",
             e.friction,
             mu * n_load * slip
@@ -774,9 +796,10 @@ fn coulomb_friction_in_the_tilted_local_frame_takes_n_from_the_local_normal() {
         rel(-ft, mu * n_load),
         rel(fnorm, n_load)
     );
-    // Measured: both 1.8·10⁻¹⁰ off (the damped normal still settling); the issue asks 1 %.
-    assert!(rel(-ft, mu * n_load) < 0.01, "{f:?}");
-    assert!(rel(fnorm, n_load) < 0.01, "{f:?}");
+    // Measured: both 4.6·10⁻¹⁰ off (the damped normal still settling); tolerance 2·10⁻⁹,
+    // 4.3× (users are promised 1 %).
+    assert!(rel(-ft, mu * n_load) < 2e-9, "{f:?}");
+    assert!(rel(fnorm, n_load) < 2e-9, "{f:?}");
 }
 
 #[test]
@@ -854,14 +877,114 @@ fn small(p: &mut WovenParams) {
     p.output_interval = 5e-7;
 }
 
+/// Coulomb's dissipation Σ μ·N·|Δd_t| over the links and the time steps (Wriggers,
+/// *Computational Contact Mechanics*, §5.2: a slider at the limit μN dissipates μN per
+/// unit of slide), from the solver's state step by step: `s`, just set up, is stepped
+/// one time step at a time (`Solver::run` goes on from where it stopped, and an end time
+/// and output interval at the current time give one step) for `steps` steps. Before each
+/// step every link's N (its normal spring's push at the step's positions, which the slip
+/// limit reads) and its slip are taken; after it, the slide the step's slip made, at the
+/// step's positions: for a link in a local frame its slip s (the elastic part is d − s,
+/// link.rs); for a sliding link the change of d_t = (e₁·r, e₂·r) as its ends moved from
+/// ξ to ξ' (r = P_B − P_A between the ends, e₁ along yarn A's tangent, n ∥ e₁ × u_B,
+/// e₂ = n × e₁, tangents u interpolated between the windows' chords; sliding_link.rs).
+fn coulomb_work_step_by_step(s: &mut Solver, steps: u64, sliding: bool) -> f64 {
+    use weft::solver::output::MemorySink;
+    use weft::solver::sliding_link::WIN;
+    type V = [f64; 3];
+    let sub = |a: V, b: V| -> V { [a[0] - b[0], a[1] - b[1], a[2] - b[2]] };
+    let dot = |a: V, b: V| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    let cross = |a: V, b: V| -> V {
+        [
+            a[1] * b[2] - a[2] * b[1],
+            a[2] * b[0] - a[0] * b[2],
+            a[0] * b[1] - a[1] * b[0],
+        ]
+    };
+    let unit = |a: V| -> V { a.map(|c| c / dot(a, a).sqrt()) };
+    let mut work = 0.0;
+    let mut sink = MemorySink::default();
+    while s.state.step < steps {
+        let x = s.state.x.clone();
+        let step = s.state.step;
+        let (normal, mu, before): (Vec<f64>, Vec<f64>, Vec<[f64; 2]>) = if sliding {
+            let g = &s.op.el.sliding_link;
+            (
+                (0..g.id.len())
+                    .map(|e| g.normal_spring_force(e, &x).max(0.0))
+                    .collect(),
+                g.law.iter().map(|l| l.friction.unwrap()).collect(),
+                g.state.iter().map(|st| st.xi).collect(),
+            )
+        } else {
+            let g = &s.op.el.framed_link;
+            (
+                (0..g.id.len())
+                    .map(|e| g.normal_spring_force(e, &x).max(0.0))
+                    .collect(),
+                g.law.iter().map(|l| l.friction.unwrap()).collect(),
+                g.state.iter().map(|st| st.slip).collect(),
+            )
+        };
+        s.analysis.end_time = s.state.t;
+        s.analysis.output_interval = s.state.t.max(f64::MIN_POSITIVE);
+        s.run(&mut sink, &mut |_| {}).unwrap();
+        assert_eq!(s.state.step, step + 1, "one step per call");
+        for e in 0..normal.len() {
+            let slide = if sliding {
+                let g = &s.op.el.sliding_link;
+                let (nodes, win) = (&g.nodes[e], &g.geom[e].win);
+                let at = |side: usize, k: usize| x[nodes[side * WIN + k] as usize];
+                let chord = |side: usize, k: usize| -> V {
+                    let (p, m, axis) = win[side].chord(k);
+                    let c = sub(at(side, p), at(side, m));
+                    match axis {
+                        Some(ax) => {
+                            std::array::from_fn(|i| if i == ax { 2.0 * c[ax] } else { 0.0 })
+                        }
+                        None => c,
+                    }
+                };
+                let lerp = |a: V, b: V, t: f64| -> V {
+                    std::array::from_fn(|i| (1.0 - t) * a[i] + t * b[i])
+                };
+                let end = |side: usize, xi: f64| -> (V, V) {
+                    let (k, t) = win[side].locate(xi);
+                    (
+                        lerp(at(side, k), at(side, k + 1), t),
+                        lerp(chord(side, k), chord(side, k + 1), t),
+                    )
+                };
+                let d_t = |xi: [f64; 2]| -> [f64; 2] {
+                    let ((pa, ua), (pb, ub)) = (end(0, xi[0]), end(1, xi[1]));
+                    let e1 = unit(ua);
+                    let e2 = cross(unit(cross(e1, ub)), e1);
+                    let r = sub(pb, pa);
+                    [dot(e1, r), dot(e2, r)]
+                };
+                let after = g.state[e].xi;
+                if after == before[e] {
+                    continue;
+                }
+                let (d0, d1) = (d_t(before[e]), d_t(after));
+                (d1[0] - d0[0]).hypot(d1[1] - d0[1])
+            } else {
+                let after = s.op.el.framed_link.state[e].slip;
+                (after[0] - before[e][0]).hypot(after[1] - before[e][1])
+            };
+            work += mu[e] * normal[e] * slide;
+        }
+    }
+    work
+}
+
 #[test]
 fn the_reduced_model_with_local_coulomb_unilateral_links_runs_and_balances_energy() {
     // The projectile (a quarter of 8 g at 400 m/s: 160 J) on the reduced model whose
-    // links act in the local frame, slip at μ = 0.2 and push only. Energy balance ≤ 1 %
-    // of the impact energy (the issue's requirement; measured 3.8·10⁻³ J, 0.002 %), and
-    // the links did slip.
-    // The same with sliding links (their ends move along the yarns when they slip):
-    // measured 1.4·10⁻² J.
+    // links act in the local frame, slip at μ = 0.2 and push only; then the same with
+    // sliding links (their ends move along the yarns when they slip). Oracles: energy
+    // conservation; the friction work is Coulomb's, μN times the slide summed over the
+    // links and the steps (see `coulomb_work_step_by_step`), and the links did slip.
     for sliding in [false, true] {
         let mut p = WovenParams::paper();
         small(&mut p);
@@ -871,7 +994,7 @@ fn the_reduced_model_with_local_coulomb_unilateral_links_runs_and_balances_energ
         p.friction = Some(0.2);
         p.crimp = 5e-5;
         let m = woven_reduced(&p).unwrap();
-        let (_s, out, st) = run_in_memory(&m).unwrap();
+        let (s, out, st) = run_in_memory(&m).unwrap();
         let ke0 = 0.5 * 0.25 * p.projectile_mass * p.projectile_velocity.powi(2);
         let worst = out
             .energy
@@ -880,12 +1003,41 @@ fn the_reduced_model_with_local_coulomb_unilateral_links_runs_and_balances_energ
             .fold(0.0, f64::max);
         let e = out.energy.last().unwrap();
         let v = out.projectile.last().unwrap().2[5];
+        // The same run stepped one step at a time (the same bits), summing μN·|Δd_t|.
+        let mut stepped = Solver::new(&m).unwrap();
+        let coulomb = coulomb_work_step_by_step(&mut stepped, st.steps, sliding);
+        assert!(stepped.state.x == s.state.x, "stepping changed the run");
         eprintln!(
-            "local/Coulomb/unilateral, sliding {sliding}: {} steps, projectile {v:.1} m/s, friction {:.3e} J, worst energy error {worst:.3e} J of {ke0} J",
-            st.steps, e.friction
+            "local/Coulomb/unilateral, sliding {sliding}: {} steps, projectile {v:.1} m/s, friction {:.6e} J vs Σ μN|Δd_t| {coulomb:.6e} J ({:.2e}), worst energy error {worst:.3e} J of {ke0} J",
+            st.steps,
+            e.friction,
+            rel(coulomb, e.friction)
         );
-        assert!(worst < 0.01 * ke0, "{worst}");
+        // Measured 2.7·10⁻³ J (local links) and 3.3·10⁻³ J (sliding links) of 160 J;
+        // tolerance 10⁻² J, 3.7× and 3.0× (users are promised 1 %, 1.6 J).
+        assert!(worst < 1e-2, "{worst} J");
         assert!(e.friction > 0.0, "no link slipped");
+        if sliding {
+            // A sliding link releases μN·|Δd_t| exactly on a straight yarn in a fixed
+            // frame; the frame turns while the ends slide (the yarns bend under the
+            // nose), and the release is then μN|Δd_t| cos θ, θ between Δd_t and the
+            // force: measured 2.5·10⁻³; tolerance 10⁻², 4×.
+            assert!(
+                rel(coulomb, e.friction) < 1e-2,
+                "{coulomb} vs {}",
+                e.friction
+            );
+        } else {
+            // A two-node link's slider returns radially (k_x = k_y): −f_t·Δs = μN|Δs| at
+            // every step; measured 1.2·10⁻¹⁶, the two sums of the same positive terms in
+            // different orders; bound (n − 1)ε for n steps (Higham, *Accuracy and
+            // Stability of Numerical Algorithms*, §4.2).
+            assert!(
+                rel(coulomb, e.friction) < st.steps as f64 * f64::EPSILON,
+                "{coulomb} vs {}",
+                e.friction
+            );
+        }
         assert!(v > -0.999 * p.projectile_velocity);
     }
 }
