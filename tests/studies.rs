@@ -178,8 +178,9 @@ fn weft_plot_refuses_bad_input_clearly() {
 
 /// The woven patch pipeline (generate, form, impact, figures) at 6 × 6 and 4 µs (the
 /// shipped 10 × 10 forms in minutes): the formed patch carries the asked tension at its
-/// ends (the pull, to the relaxation's residual), the bullet moves the centre crossing
-/// down at about its speed, the figures are written, and a second run is all fresh.
+/// ends (the pull, to the relaxation's residual), the bullet's z momentum lost is the
+/// fabric's gained (momentum balance, below), the figures are written, and a second run
+/// is all fresh.
 #[test]
 fn woven_patch_pipeline_forms_and_hits_the_patch() {
     let dir = project_with("woven_patch.toml");
@@ -195,13 +196,111 @@ fn woven_patch_pipeline_forms_and_hits_the_patch() {
     let f = Table::read(&out.join("formed/form.parquet")).unwrap();
     for c in ["warp_end_tension", "weft_end_tension"] {
         let t = f.f64(c, "").unwrap()[0];
-        assert!((t - 0.5).abs() < 0.005, "{c} = {t}");
+        eprintln!("{c} = {t} N (asked 0.5 N)");
+        // The formed ends' tension as forming reports it, against the pull asked: measured
+        // off by 1.7e-4 N; tolerance 6e-4 N, 3.5×. (The tension derived independently from
+        // the reactions is tests/forming.rs's.)
+        assert!((t - 0.5).abs() < 6e-4, "{c} = {t}");
     }
+    // Momentum balance along z (the impact direction; the symmetry planes x = 0 and y = 0
+    // take no z force). The bullet flies along −z; the z momentum it gives up,
+    // Δp = m_p(v(t) − v₀) > 0, is what the fabric takes, −Σ mᵢ v_zᵢ(t), plus the impulse
+    // of the clamped yarn ends' reactions. The central-difference scheme conserves
+    // momentum exactly (each element's and each contact's forces sum to zero; the bullet's
+    // and the nodes' velocities are both written at tₙ), so:
+    // - until a signal from the contact can reach a clamp, the balance is exact but for
+    //   the formed state's own unbalanced residual (the relaxation stops at a residual,
+    //   here a net 5e-7 N along z, 1e-13 N s per sample). The fastest signal is the
+    //   in-plane wave c = √(E₁/ρ) (ν = 0), leaving from the edge of the nose's footprint,
+    //   whose radius after the tip has moved v₀t is at most √(2Rv₀t) (a hemisphere of
+    //   radius R pressed v₀t into a sheet held still), so no clamp stirs while
+    //   √(2Rv₀t) + ct < d (d the clamps' least distance from the axis): here 0.45 µs;
+    // - afterwards the clamps' reactions enter (at 1.0 µs, when the wave arrives): the
+    //   balance then holds only to their impulse, measured beside its tolerance.
+    // The bullet's own loss is also checked against the impulse of its written contact
+    // force, ∫f_z dt (trapezoid over 0.2 µs samples of a force that rings at the
+    // contact's period, so only to about a per cent).
     let pr = Table::read(&out.join("impact/projectile.parquet")).unwrap();
-    let vz = pr.f64("vz", "").unwrap();
-    // The bullet has slowed, not stopped or reversed, in 4 µs (it started at 400 m/s).
-    let last = *vz.last().unwrap();
-    assert!(last < -300.0 && last > -400.0, "vz = {last}");
+    let (t, vz, fz) = (
+        pr.f64("t", "").unwrap(),
+        pr.f64("vz", "").unwrap(),
+        pr.f64("fz", "").unwrap(),
+    );
+    let model = weft::model::io::read_model(&out.join("formed")).unwrap();
+    let bullet = &model.projectiles[0];
+    let m_p = bullet.mass;
+    let mass = weft::solver::Solver::new(&model).unwrap().mass;
+    let index: std::collections::HashMap<i64, usize> = model
+        .node_id
+        .iter()
+        .enumerate()
+        .map(|(k, &id)| (id, k))
+        .collect();
+    let d = model
+        .constraints
+        .iter()
+        .filter(|c| c.1[2])
+        .map(|&(n, _)| {
+            let x: [f64; 3] = std::array::from_fn(|a| {
+                model.coords[n][a] + model.initial_displacement.get(n).map_or(0.0, |u| u[a])
+            });
+            x[0].hypot(x[1])
+        })
+        .fold(f64::INFINITY, f64::min);
+    let props = &model.parts[0].props;
+    let c = (props.youngs_modulus_1.unwrap() / props.density.unwrap()).sqrt();
+    let v0 = -vz[0];
+    let quiet = |t: f64| (2.0 * bullet.radius * v0 * t).sqrt() + c * t < d;
+    let h = Table::read(&out.join("impact/history.parquet")).unwrap();
+    let (ht, hid, hvz) = (
+        h.f64("t", "").unwrap(),
+        h.i64("node_id", "").unwrap(),
+        h.f64("vz", "").unwrap(),
+    );
+    assert_eq!(ht.len(), t.len() * model.node_id.len(), "--all-nodes");
+    let (mut early, mut early_dp, mut worst) = (0.0f64, 0.0f64, 0.0f64);
+    for (k, &tk) in t.iter().enumerate() {
+        let fabric: f64 = (0..ht.len())
+            .filter(|&r| ht[r] == tk)
+            .map(|r| mass[index[&hid[r]]] * hvz[r])
+            .sum();
+        let dp = m_p * (vz[k] - vz[0]);
+        let off = (dp + fabric).abs();
+        if quiet(tk) {
+            early = early.max(off);
+            early_dp = dp;
+        }
+        worst = worst.max(off);
+    }
+    let lost = m_p * (*vz.last().unwrap() - vz[0]);
+    let impulse: f64 = (1..t.len())
+        .map(|k| 0.5 * (fz[k] + fz[k - 1]) * (t[k] - t[k - 1]))
+        .sum();
+    eprintln!(
+        "momentum: clamps {:.2} mm away, quiet to {:.2} µs: balance off by {early:.2e} N s of {early_dp:.3e} ({:.2e}); \
+         to 4 µs the bullet gave up {lost:.4e} N s (Δv {:.4} m/s), balance off by {worst:.2e} ({:.2e}); ∫f_z dt {impulse:.4e} N s ({:+.2e})",
+        1e3 * d,
+        1e6 * t.iter().filter(|&&x| quiet(x)).last().unwrap(),
+        early / early_dp,
+        *vz.last().unwrap() - vz[0],
+        worst / lost,
+        (impulse - lost) / lost
+    );
+    // Measured: quiet to 0.40 µs, 2.3e-13 N s of 6.9e-6 (3.3e-8); tolerance 1e-7, 3×.
+    assert!(
+        early_dp > 0.0 && early < 1e-7 * early_dp,
+        "momentum before the clamps stir: {early} of {early_dp}"
+    );
+    // Measured: 4.3e-3 of 9.0e-4 N s (the clamps' impulse); tolerance 1e-2, 2.3×.
+    assert!(
+        lost > 0.0 && worst < 1e-2 * lost,
+        "momentum off by {worst} of {lost}"
+    );
+    // Measured: +1.02e-2; tolerance 3e-2, 3×.
+    assert!(
+        (impulse - lost).abs() < 3e-2 * lost,
+        "∫f dt {impulse} vs {lost}"
+    );
     for fig in ["weave.png", "impact.png", "uz_field.png"] {
         assert!(out.join("figures").join(fig).exists(), "{fig}");
     }
@@ -212,12 +311,11 @@ fn woven_patch_pipeline_forms_and_hits_the_patch() {
 /// The paper's §5 study (`pipelines/woven_reduced.toml`), made small: a 5-yarn quarter
 /// yarn-level patch in a 20 mm membrane, formed, against the 5 × 5 girder with the same
 /// crossings and the same membrane, 20 µs. Expectations that do not come from the code:
-/// - every run keeps its energy balance within 1 % (issue 13; the explicit scheme
-///   conserves energy to round-off plus contact work, which the balance counts);
-/// - the extended fit starts from the paper fit's result and searches a box that holds
-///   it, so it can only lower T (COBYLA returns its best point), and it lowers the
-///   largest nodal error of the trial values; so does the fit of the sliding links,
-///   from their own start;
+/// - every run keeps its energy balance (issue 13; the explicit scheme conserves energy
+///   to round-off plus contact work, which the balance counts), held near today's;
+/// - the extended fit and the sliding links' fit lower T and the largest nodal error of
+///   the trial values, and end below the paper's own fitted model's largest nodal error,
+///   14 % (its §5, Fig. 11b);
 /// - the reduced model is smaller than the reference (the point of the reduction):
 ///   counted in elements, not timed.
 #[test]
@@ -245,15 +343,25 @@ fn woven_reduced_study_fits_the_girder_to_the_yarn_level_patch() {
     std::fs::write(&p, s).unwrap();
     weft_run(root, "woven_reduced.toml");
     let out = root.join("runs/woven_reduced");
-    for run in ["formed", "trial", "paper", "extended", "sliding"] {
+    // Energy conservation (the explicit scheme's, contact and friction work counted):
+    // each run's worst relative balance error held near what it measures today (the
+    // users' promise is 1 %, issue 13). Measured: formed 1.35e-4, trial 1.30e-5, paper
+    // 4.1e-6, extended 1.50e-4, sliding 1.75e-5; tolerances 3–3.7× above.
+    for (run, tol) in [
+        ("formed", 4e-4),
+        ("trial", 4e-5),
+        ("paper", 1.5e-5),
+        ("extended", 5e-4),
+        ("sliding", 6e-5),
+    ] {
         let e = Table::read(&out.join(format!("impact/{run}/energy.parquet"))).unwrap();
         let worst = e
             .f64("balance_error_relative", "")
             .unwrap()
             .into_iter()
             .fold(0.0, f64::max);
-        eprintln!("{run}: worst energy balance error {worst:.3e}");
-        assert!(worst <= 0.01, "{run}: energy balance error {worst}");
+        eprintln!("{run}: worst energy balance error {worst:.3e} (tolerance {tol:.1e})");
+        assert!(worst <= tol, "{run}: energy balance error {worst}");
     }
     let summary = |m: &str| {
         let t = Table::read(&out.join(format!("error/{m}/error_summary.parquet"))).unwrap();
@@ -271,12 +379,20 @@ fn woven_reduced_study_fits_the_girder_to_the_yarn_level_patch() {
     eprintln!(
         "T, max node error: trial {trial:?}, paper fit {paper:?}, extended fit {ext:?}, sliding links {sl:?}"
     );
-    assert!(
-        ext.0 <= paper.0,
-        "extended T {} above its start {}",
-        ext.0,
-        paper.0
-    );
+    // The paper's own reduced model, after its fit, still erred by 14 % at its worst
+    // reference node (§5, Fig. 11b: "Maximum error between reference nodes of the
+    // reference and reduced FE models was 14% after the adjustment"; the same measure,
+    // peak‖p − q‖/peak‖q‖ over the diagonal crossings). weft's extended fit and its
+    // sliding links, which add what the paper's links lack (slip at the crossings, the
+    // rods' effective modulus), must do better than that here too. Measured at this size:
+    // extended 5.5 %, sliding links 4.6 % (the paper's fit 14.0 %, the trial 13.9 %); the
+    // bound is 2.5× and 3× above them.
+    for (name, e) in [("extended fit", ext.1), ("sliding links", sl.1)] {
+        assert!(
+            e < 0.14,
+            "{name}: max nodal error {e} not below the paper's fitted 14 %"
+        );
+    }
     assert!(ext.0 < trial.0, "extended T {} vs trial {}", ext.0, trial.0);
     assert!(
         ext.1 < trial.1,

@@ -122,14 +122,16 @@ fn network_recovers_the_lattice_closed_forms_deterministically() {
     let a = L / n;
     let y = s.predict_network(&[r * a, n]);
     let exact = [E * r * r / 2.0, r * r * a, RHO_G * (2.0 - r)];
+    // Measured (1 and 2 threads alike, checked below): G 1.73e-5, s 1.92e-4, ρ 4.59e-7;
+    // tolerances 5e-5 (2.9×), 5e-4 (2.6×), 1.5e-6 (3.3×).
+    let tol = [5e-5, 5e-4, 1.5e-6];
     for k in 0..3 {
         let e = (y[k] - exact[k]).abs() / exact[k];
         eprintln!(
-            "{}: network {:.5e}, closed form {:.5e}, relative error {e:.2e}",
-            s.outputs[k], y[k], exact[k]
+            "{}: network {:.5e}, closed form {:.5e}, relative error {e:.2e} (tolerance {:.1e})",
+            s.outputs[k], y[k], exact[k], tol[k]
         );
-        // Measured: G 1.7e-5, s 1.9e-4, ρ 4.6e-7.
-        assert!(e < 1e-3, "{} off by {e}", s.outputs[k]);
+        assert!(e < tol[k], "{} off by {e}", s.outputs[k]);
     }
     // Deterministic: 1 and 2 threads give the same bits.
     let bits = |r: &surrogate::TrainReport| {
