@@ -372,7 +372,7 @@ fn membrane_mass_is_density_times_volume() {
 /// once 1 + 3E₁₁ exceeds that margin, and run below it. Measured: the threshold at
 /// dt_safety 0.9 is E₁₁ = 0.0782; 0.95 of it runs (energy drift 0), 1.05 of it stops at
 /// t = 0. Without the check such a band blows up a few steps later (the yarn-level
-/// impacts at 43–49 µs of 400 m/s variants, README).
+/// impacts at 43–49 µs of 400 m/s variants, docs/solver.md, "Features").
 #[test]
 fn a_band_stretched_past_the_steps_margin_stops_with_its_strain_named() {
     let (nx, ny, lx, ly) = (40, 2, 0.02, 1e-3);

@@ -26,9 +26,10 @@ pub enum YarnModel {
     /// paper's reference; contact on the band faces).
     Band,
     /// A chain of trusses along the band's centre line, of the band's section and mass,
-    /// with the band's centre thickness t_c as contact thickness (nodes and segments; the
-    /// issue's "beam chain with a contact radius"): 4–6 × faster, for studies that need
-    /// no yarn width (measured against the bands in the README).
+    /// with the band's centre thickness t_c as contact thickness (nodes and segments: a
+    /// chain with a contact radius in place of the band): 4–6 × faster, for studies that
+    /// need no yarn width (measured against the bands in docs/woven_patch.md, "The chain
+    /// representation").
     Chain,
 }
 
