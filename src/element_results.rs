@@ -156,7 +156,9 @@ impl ElementResults {
             let npe = kind.nodes_per_element();
             for e in 0..b.len() {
                 let part = &m.parts[b.part[e]];
-                if !chosen[b.part[e]] || kind == ElementKind::PointMass {
+                // Point masses carry no result; a hex's stress, plastic strain and temperature
+                // depend on the path, not on the history's positions alone: not recomputed.
+                if !chosen[b.part[e]] || matches!(kind, ElementKind::PointMass | ElementKind::Hex) {
                     continue;
                 }
                 let nodes = &b.nodes[npe * e..npe * (e + 1)];
@@ -196,7 +198,7 @@ impl ElementResults {
                     },
                     ElementKind::Tri => Item::Tri(Box::new(membrane_item(m, b, e, nodes)?)),
                     ElementKind::Quad => Item::Quad(Box::new(membrane_item(m, b, e, nodes)?)),
-                    ElementKind::PointMass => unreachable!("skipped above"),
+                    ElementKind::PointMass | ElementKind::Hex => unreachable!("skipped above"),
                 };
                 r.id.push(b.id[e]);
                 r.part_id.push(part.id);

@@ -79,6 +79,8 @@ pub fn vtk_cell_type(k: ElementKind) -> u8 {
         ElementKind::PointMass => 1,
         ElementKind::Tri => 5,
         ElementKind::Quad => 9,
+        // VTK_HEXAHEDRON: the same node order as LS-DYNA's (and weft's) hexahedron.
+        ElementKind::Hex => 12,
     }
 }
 

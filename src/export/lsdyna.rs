@@ -43,6 +43,7 @@ const FORMAT: &str = "LS-DYNA";
 
 /// What this deck does not map, in the order looked for, with the reasons.
 const REFUSED: &Refusals = &[
+    (Unsupported::Solids, "not mapped yet (*SECTION_SOLID ELFORM 1 with *HOURGLASS IHQ 1 and *MAT_PLASTIC_KINEMATIC or *MAT_JOHNSON_COOK with its equation of state: a later step)"),
     (Unsupported::Beams, "not mapped yet (an LS-DYNA beam needs an orientation node and the section's torsion constant)"),
     (Unsupported::TrussPrestrain, "not mapped yet (LS-DYNA's cable, MAT_071, is a discrete beam with its own offset law)"),
     (Unsupported::TrussArea, "not mapped yet (*ELEMENT_BEAM_THICKNESS)"),

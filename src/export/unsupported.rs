@@ -11,6 +11,8 @@ use crate::model::{ElementBlock, ElementKind, Model};
 pub(crate) enum Unsupported {
     /// Beam elements (the whole kind).
     Beams,
+    /// Solid elements (hexahedra, the whole kind).
+    Solids,
     /// Membrane elements, tri or quad (the whole kinds).
     Membranes,
     /// A truss's prestrain or tension-only law.
@@ -57,7 +59,7 @@ impl Unsupported {
     fn scope(self) -> Scope {
         use Unsupported::*;
         match self {
-            Beams | Membranes => Scope::Kinds,
+            Beams | Solids | Membranes => Scope::Kinds,
             TrussPrestrain | TrussArea | LinkDashpots | LinkSlider | LinkSliding
             | NoCompression | InitialStress => Scope::Element,
             Projectiles | Contacts | Ties | Formed | MassScaling => Scope::Model,
@@ -70,6 +72,7 @@ impl Unsupported {
         let held = |yes: bool, what: &str| yes.then(|| what.to_string());
         match self {
             Beams => held(m.block(ElementKind::Beam).is_some(), "beam elements"),
+            Solids => held(m.block(ElementKind::Hex).is_some(), "solid elements (hex)"),
             Membranes => [ElementKind::Tri, ElementKind::Quad]
                 .into_iter()
                 .find(|&k| m.block(k).is_some())

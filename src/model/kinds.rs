@@ -19,16 +19,20 @@ pub enum ElementKind {
     Quad,
     /// Two-node 3-D corotational beam with a rectangular section (rigid joints).
     Beam,
+    /// Eight-node hexahedron (solid) with one-point integration and Flanagan–Belytschko
+    /// hourglass control; isotropic elastic, J2 or Johnson–Cook material.
+    Hex,
 }
 
 impl ElementKind {
-    pub const ALL: [ElementKind; 6] = [
+    pub const ALL: [ElementKind; 7] = [
         ElementKind::Truss,
         ElementKind::Link,
         ElementKind::PointMass,
         ElementKind::Tri,
         ElementKind::Quad,
         ElementKind::Beam,
+        ElementKind::Hex,
     ];
     pub fn name(self) -> &'static str {
         match self {
@@ -38,6 +42,7 @@ impl ElementKind {
             ElementKind::Tri => "tri",
             ElementKind::Quad => "quad",
             ElementKind::Beam => "beam",
+            ElementKind::Hex => "hex",
         }
     }
     pub fn nodes_per_element(self) -> usize {
@@ -46,6 +51,7 @@ impl ElementKind {
             ElementKind::PointMass => 1,
             ElementKind::Tri => 3,
             ElementKind::Quad => 4,
+            ElementKind::Hex => 8,
         }
     }
     pub fn parse(s: &str) -> Option<Self> {

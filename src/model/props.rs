@@ -15,7 +15,7 @@
 //!
 //! The table's order is the column order of `parts.parquet` as written.
 
-use super::kinds::ElementKind::{self, Beam, Link, PointMass, Quad, Tri, Truss};
+use super::kinds::ElementKind::{self, Beam, Hex, Link, PointMass, Quad, Tri, Truss};
 use crate::error::{Result, WeftError};
 use crate::table::{Col, Table};
 
@@ -177,7 +177,7 @@ const NO_FAILURE: Option<Null> = null(
 part_properties! {
     youngs_modulus: f64 {
         unit: "Pa",
-        kinds: [Truss: Rule::Required, Beam: Rule::Required],
+        kinds: [Truss: Rule::Required, Beam: Rule::Required, Hex: Rule::Required],
         null: None,
         aliases: ["E"],
         meaning: "Young's modulus E",
@@ -187,7 +187,7 @@ part_properties! {
         // A truss may be a massless spring (SPRINGA in other codes) between nodes that
         // have mass from elsewhere (point masses): ρ = 0 is allowed, and the solver
         // refuses a free node that then has no mass at all.
-        kinds: [Truss: Rule::RequiredNonNegative, Tri: Rule::Required, Quad: Rule::Required, Beam: Rule::Required],
+        kinds: [Truss: Rule::RequiredNonNegative, Tri: Rule::Required, Quad: Rule::Required, Beam: Rule::Required, Hex: Rule::Required],
         null: None,
         aliases: ["rho"],
         meaning: "mass density ρ",
@@ -306,10 +306,10 @@ part_properties! {
     },
     hourglass: f64 {
         unit: "",
-        kinds: [Quad: Rule::NonNegative],
+        kinds: [Quad: Rule::NonNegative, Hex: Rule::NonNegative],
         null: null("0.1", "LS-DYNA's default"),
         aliases: [],
-        meaning: "hourglass coefficient κ of the one-point quad",
+        meaning: "hourglass coefficient κ of the one-point quad (stiffness form) and of the one-point hexahedron (Flanagan–Belytschko viscous form, Q_hg)",
     },
     material_angle: f64 {
         unit: "rad",
@@ -334,10 +334,13 @@ part_properties! {
     },
     poisson_ratio: f64 {
         unit: "",
-        kinds: [Beam: Rule::Open { lo: -1.0, hi: 0.5, expected: "−1 < ν < 0.5" }],
+        kinds: [
+            Beam: Rule::Open { lo: -1.0, hi: 0.5, expected: "−1 < ν < 0.5" },
+            Hex: Rule::Open { lo: -1.0, hi: 0.5, expected: "−1 < ν < 0.5" },
+        ],
         null: null("0.3", "a typical structural metal's"),
         aliases: [],
-        meaning: "Poisson's ratio ν for the shear modulus G = E/(2(1 + ν)) in torsion",
+        meaning: "Poisson's ratio ν: the beam's shear modulus G = E/(2(1 + ν)) in torsion; the hexahedron's isotropic elasticity",
     },
     prestrain: f64 {
         unit: "",
@@ -429,6 +432,98 @@ part_properties! {
         null: NO_FAILURE,
         aliases: [],
         meaning: "a link breaks when the length of its relative displacement d = x₂ − x₁ − d₀ reaches it (times the element's `failure_strain_factor`)",
+    },
+    yield_stress: f64 {
+        unit: "Pa",
+        kinds: [Hex: Rule::Positive],
+        null: null("elastic", "a solid is elastic unless given a yield stress (or Johnson–Cook's A)"),
+        aliases: [],
+        meaning: "initial yield stress σ_y0 of J2 (von Mises) plasticity with isotropic hardening, by radial return",
+    },
+    tangent_modulus: f64 {
+        unit: "Pa",
+        kinds: [Hex: Rule::NonNegative],
+        null: null("0", "perfectly plastic"),
+        aliases: [],
+        meaning: "tangent modulus E_t of the bilinear uniaxial curve (E_t < E): σ_y = σ_y0 + H ε_p with H = E E_t/(E − E_t)",
+    },
+    jc_a: f64 {
+        unit: "Pa",
+        kinds: [Hex: Rule::Positive],
+        null: null("no Johnson–Cook", "a solid is J2 with `yield_stress`, or elastic"),
+        aliases: [],
+        meaning: "Johnson–Cook A: σ_y = (A + B ε_pⁿ)(1 + C ln max(ε̇_p/ε̇₀, 1))(1 − T*ᵐ), T* = (T − T_room)/(T_melt − T_room) (Johnson & Cook 1983)",
+    },
+    jc_b: f64 {
+        unit: "Pa",
+        kinds: [Hex: Rule::NonNegative],
+        null: null("0", "no strain hardening"),
+        aliases: [],
+        meaning: "Johnson–Cook B",
+    },
+    jc_n: f64 {
+        unit: "",
+        kinds: [Hex: Rule::Positive],
+        null: null("1", "linear hardening"),
+        aliases: [],
+        meaning: "Johnson–Cook hardening exponent n",
+    },
+    jc_c: f64 {
+        unit: "",
+        kinds: [Hex: Rule::NonNegative],
+        null: null("0", "rate-independent"),
+        aliases: [],
+        meaning: "Johnson–Cook strain-rate coefficient C",
+    },
+    jc_reference_rate: f64 {
+        unit: "1/s",
+        kinds: [Hex: Rule::Positive],
+        null: null("1", "Johnson & Cook's own reference rate"),
+        aliases: [],
+        meaning: "Johnson–Cook reference strain rate ε̇₀",
+    },
+    jc_m: f64 {
+        unit: "",
+        kinds: [Hex: Rule::Positive],
+        null: null("no thermal softening", "the flow stress does not fall with temperature"),
+        aliases: [],
+        meaning: "Johnson–Cook thermal-softening exponent m",
+    },
+    room_temperature: f64 {
+        unit: "K",
+        kinds: [Hex: Rule::Positive],
+        null: null("293.15", "20 °C"),
+        aliases: [],
+        meaning: "room (and initial) temperature T_room of Johnson–Cook's T*",
+    },
+    melt_temperature: f64 {
+        unit: "K",
+        kinds: [Hex: Rule::Positive],
+        null: null("no thermal softening", "needed with `jc_m`"),
+        aliases: [],
+        meaning: "melting temperature T_melt of Johnson–Cook's T* (a temperature at or above it is refused)",
+    },
+    specific_heat: f64 {
+        unit: "J/(kg·K)",
+        kinds: [Hex: Rule::Positive],
+        null: null("no heating", "the temperature stays at T_room"),
+        aliases: [],
+        meaning: "specific heat c_p for the adiabatic heating ΔT = χ ΔW_p/(ρ c_p)",
+    },
+    taylor_quinney: f64 {
+        unit: "",
+        // χ ≤ 1 is checked with the material (a fraction of the plastic work).
+        kinds: [Hex: Rule::NonNegative],
+        null: null("0.9", "Taylor & Quinney's measured fraction"),
+        aliases: [],
+        meaning: "Taylor–Quinney coefficient χ: the fraction of the plastic work that heats the material",
+    },
+    erosion_plastic_strain: f64 {
+        unit: "",
+        kinds: [Hex: Rule::Positive],
+        null: NO_FAILURE,
+        aliases: [],
+        meaning: "a hexahedron is eroded (removed) when its equivalent plastic strain reaches it",
     },
 }
 

@@ -159,6 +159,9 @@ impl Model {
                     .at_row(row)
                     .expected("two distinct nodes"));
                 }
+                if *kind == ElementKind::Hex {
+                    self.validate_hex(*id, ns, &file, row)?;
+                }
                 if *kind == ElementKind::Truss {
                     let (a, c) = (self.coords[ns[0]], self.coords[ns[1]]);
                     let l = ((c[0] - a[0]).powi(2) + (c[1] - a[1]).powi(2) + (c[2] - a[2]).powi(2))
@@ -175,6 +178,40 @@ impl Model {
                     }
                 }
             }
+        }
+        Ok(())
+    }
+
+    /// A hexahedron: eight distinct nodes, and det J > 0 at every corner (a positive
+    /// volume everywhere: nodes 1–4 counter-clockwise seen from the face 5–8).
+    fn validate_hex(&self, id: i64, ns: &[usize], file: &str, row: usize) -> Result<()> {
+        let ids: Vec<String> = ns.iter().map(|&n| format!("`{}`", self.node_id[n])).collect();
+        for a in 0..8 {
+            if ns[a + 1..].contains(&ns[a]) {
+                return Err(WeftError::input(format!(
+                    "hexahedron `{id}` uses node `{}` twice (nodes {})",
+                    self.node_id[ns[a]],
+                    ids.join(", ")
+                ))
+                .in_file(file)
+                .at_row(row)
+                .expected("eight distinct nodes (degenerate hexahedra, wedges, are not supported)"));
+            }
+        }
+        let x: [[f64; 3]; 8] = std::array::from_fn(|a| self.coords[ns[a]]);
+        let j = crate::solver::solid::kernel::jacobian_at_nodes(&x);
+        if let Some(a) = (0..8).find(|&a| !(j[a] > 0.0)) {
+            return Err(WeftError::input(format!(
+                "hexahedron `{id}` (nodes {}) has a Jacobian determinant {:.3e} ≤ 0 at its node `{}` (n{})",
+                ids.join(", "),
+                j[a],
+                self.node_id[ns[a]],
+                a + 1
+            ))
+            .in_file(file)
+            .at_row(row)
+            .expected("a positive volume at every corner: n1–n4 counter-clockwise seen from n5–n8, the face n5–n8 above n1–n4 (LS-DYNA's order)")
+            .hint("an inside-out element has its two faces swapped; a folded one, a corner pushed through the opposite face"));
         }
         Ok(())
     }
@@ -703,6 +740,9 @@ pub fn validate_part(p: &Part) -> Result<()> {
     match p.kind {
         ElementKind::Link => validate_link_part(p),
         ElementKind::Tri | ElementKind::Quad => validate_membrane_part(p),
+        // The material's constants that involve each other (E_t < E, T_room < T_melt,
+        // Johnson–Cook's n ≤ 1, χ ≤ 1, one plasticity model).
+        ElementKind::Hex => crate::solver::solid::hex::part_material(&p.name, &p.props).map(|_| ()),
         _ => Ok(()),
     }
 }

@@ -3,7 +3,7 @@
 //! is in [`super::family`]). The order of the list is the order of the force slots, of
 //! the masses' accumulation and of the sums.
 
-use super::{beam, link, membrane, point_mass, sliding_link, truss};
+use super::{beam, link, membrane, point_mass, sliding_link, solid, truss};
 
 crate::families! {
     truss: truss::TrussGroup,
@@ -14,4 +14,5 @@ crate::families! {
     tri: membrane::MembraneGroup<3>,
     quad: membrane::MembraneGroup<4>,
     beam: beam::BeamGroup,
+    hex: solid::hex::HexGroup,
 }

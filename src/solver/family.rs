@@ -74,6 +74,8 @@ pub enum EnergyGroup {
     Membrane = 1,
     /// Beams (energy taken before the rotations advance).
     Beam = 2,
+    /// Solids (hexahedra), added last: a model without them sums as before, bit for bit.
+    Solid = 3,
 }
 
 /// One element family (see the module docs for the phases).
@@ -132,7 +134,7 @@ pub trait Family: Sized + Send + Sync {
 /// Totals of the energy ledger's groups (see [`EnergyGroup`]).
 #[derive(Debug, Clone, Copy, Default)]
 pub struct EnergySums {
-    pub groups: [EnergyPartial; 3],
+    pub groups: [EnergyPartial; 4],
 }
 
 impl EnergySums {
@@ -144,9 +146,9 @@ impl EnergySums {
             }
         }
     }
-    /// Component c of the total: (Line + Membrane) + Beam.
+    /// Component c of the total: ((Line + Membrane) + Beam) + Solid.
     pub fn total(&self, c: usize) -> f64 {
-        (self.groups[0][c] + self.groups[1][c]) + self.groups[2][c]
+        ((self.groups[0][c] + self.groups[1][c]) + self.groups[2][c]) + self.groups[3][c]
     }
 }
 

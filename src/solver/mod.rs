@@ -47,6 +47,7 @@ pub mod point_mass;
 pub mod relax;
 pub mod rotations;
 pub mod sliding_link;
+pub mod solid;
 pub mod stable;
 pub mod statics;
 pub mod ties;

@@ -155,6 +155,7 @@ impl NodalBound<'_> {
             .el
             .sliding_link
             .add_crowding(x, &mut k.extra, &mut k.most);
+        self.op.el.hex.add_stiffening(x, &mut k.extra, &mut k.most);
         for t in &self.op.ties.ties {
             for (a, &mn) in t.masters.iter().enumerate() {
                 k.extra[mn] += t.w[a] * k.extra[t.slave];
@@ -179,6 +180,10 @@ impl NodalBound<'_> {
                     .max_by(|a, b| a.0.total_cmp(&b.0))
             });
             let what = match who {
+                Some((_, ElementKind::Hex, id, q)) => format!(
+                    "hex `{id}` has been compressed to {:.3} of its volume and {:.3} of its length V/A_max",
+                    q[0], q[1]
+                ),
                 Some((_, ElementKind::Link, id, q)) => format!(
                     "sliding link `{id}` (its ends slid {:.2} and {:.2} segments, {:.3e} m apart)",
                     q[0], q[1], q[2]
@@ -199,10 +204,14 @@ impl NodalBound<'_> {
                 ),
                 step: self.state.step,
                 time: self.state.t,
-                hint: Some(format!(
+                hint: Some(if matches!(who, Some((_, ElementKind::Hex, ..))) {
+                    format!(
+                        "the stable step is set once, from the undeformed model, and a crushed solid needs a smaller one: lower dt_safety (now {dt_safety}) to run on"
+                    )
+                } else { format!(
                     "the stable step is set once, from the undeformed model; strains this large are beyond what most materials bear (aramid yarns break near 3.6 %) and weft models no failure: shorten end_time, lower the load or the impact velocity, or lower dt_safety (now {}) to run on",
                     dt_safety
-                )),
+                ) }),
             });
         }
         Ok(())

@@ -17,12 +17,16 @@ pub const FILES: &[&str] = &[
     "elements_tri.parquet",
     "elements_quad.parquet",
     "elements_beam.parquet",
+    "elements_hex.parquet",
 ];
 /// Expected columns, for error messages, by nodes per element.
 const ELEMS1: &str = "element_id, part_id, n1";
 const ELEMS2: &str = "element_id, part_id, n1, n2";
 const ELEMS3: &str = "element_id, part_id, n1, n2, n3";
 const ELEMS4: &str = "element_id, part_id, n1, n2, n3, n4";
+const ELEMS8: &str = "element_id, part_id, n1, n2, n3, n4, n5, n6, n7, n8";
+/// The node columns, n1… (as many as the kind has nodes).
+const NODE_COLUMNS: [&str; 8] = ["n1", "n2", "n3", "n4", "n5", "n6", "n7", "n8"];
 
 /// The columns of one element table, read and checked, before its rows become a block.
 struct ElementColumns {
@@ -95,14 +99,13 @@ fn read_columns(r: &Reading, t: &Table, kind: ElementKind) -> Result<ElementColu
         1 => ELEMS1,
         2 => ELEMS2,
         3 => ELEMS3,
-        _ => ELEMS4,
+        4 => ELEMS4,
+        _ => ELEMS8,
     };
     let id = t.i64("element_id", exp)?;
     let part_id = t.i64("part_id", exp)?;
     let mut nodes = Vec::new();
-    for c in ["n1", "n2", "n3", "n4"]
-        .iter()
-        .take(kind.nodes_per_element())
+    for c in NODE_COLUMNS.iter().take(kind.nodes_per_element())
     {
         let ids = t.i64(c, exp)?;
         nodes.push(r.node_refs(t, c, &ids)?);
@@ -257,7 +260,7 @@ pub fn write(m: &Model, w: &Writing) -> Result<()> {
             Col::I64("element_id", b.id.clone()),
             Col::I64("part_id", b.part.iter().map(|&i| m.parts[i].id).collect()),
         ];
-        for (j, c) in ["n1", "n2", "n3", "n4"].into_iter().take(npe).enumerate() {
+        for (j, c) in NODE_COLUMNS.into_iter().take(npe).enumerate() {
             let v: Vec<usize> = b.nodes.iter().skip(j).step_by(npe).copied().collect();
             cols.push(Col::I64(c, ids(&v)));
         }

@@ -38,6 +38,7 @@ pub const MODEL_TABLES: &[&str] = &[
     "elements_tri.parquet",
     "elements_quad.parquet",
     "elements_beam.parquet",
+    "elements_hex.parquet",
     "node_sets.parquet",
     "constraints.parquet",
     "curves.parquet",

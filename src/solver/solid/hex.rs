@@ -1,0 +1,454 @@
+//! The hexahedron family: eight-node solids with one-point integration (LS-DYNA's
+//! default solid, ELFORM 1), their materials and their share of the energy ledger.
+//!
+//! Each step (Belytschko, Liu & Moran, *Nonlinear Finite Elements*, Box 6.1; the
+//! Flanagan–Belytschko element, IJNME 17 (1981)), with v = v^{n−½} and Δt = Δt^{n−½}:
+//! 1. the rate of deformation D and the spin W from the mean gradient operator at the
+//!    mid-step configuration x^{n−½} = x^n − ½Δt v ([`kernel::hex_geometry`]);
+//! 2. the stress is rotated by the Hughes–Winget increment R = (I − ½WΔt)⁻¹(I + ½WΔt):
+//!    exactly orthogonal, so a rigid rotation leaves its invariants unchanged (objective;
+//!    chosen over the Jaumann rate's σ += (Wσ − σW)Δt, which is orthogonal only to first
+//!    order and lets a long rigid spin grow the stress);
+//! 3. the material updates the stress from the strain increment DΔt ([`material::update`]:
+//!    hypoelastic trial, radial return);
+//! 4. the nodal forces f_a = −V σ̃ b_a at x^n with σ̃ = σ − q I, q the bulk viscosity
+//!    (LS-DYNA's defaults Q₁ = 1.5, Q₂ = 0.06), plus the viscous hourglass forces of
+//!    Flanagan & Belytschko's projected modes, coefficient 16 × Q_hg ρ c V^{2/3}/4 (the
+//!    projected vectors are ¼ of LS-DYNA's ±1 base vectors, so the factor 16 gives the
+//!    magnitude of LS-DYNA's IHQ = 1 for the same Q_hg; 0.1 by default, the part's
+//!    `hourglass`).
+//!
+//! Energies, accumulated element by element each step (they depend on the path, not on
+//! the positions alone): internal ΔW = ½(σ^{n−1} + σ^n):DΔt V^{n−½} (the trapezoid of
+//! DYNA3D's energy update; it holds the elastic and the plastic work), bulk viscosity
+//! −q tr D V Δt (reported as damping), hourglass Σ_α coef|q_α|² Δt.
+//!
+//! Stable step: the nodal Gershgorin bound of [`crate::solver::stable`], each element
+//! adding to node a's row its stiffness matrix's row sum S_a = V max_i Σ_b Σ_j
+//! |λ b_ai b_bj + μ b_aj b_bi + μ δ_ij b_a·b_b| (the one-point element's K = V BᵀCB).
+//! For a cube of side h this gives Δt = 0.67 h/c at ν = 0 and 0.62 h/c at ν = 0.3, c the
+//! dilatational speed: smaller than LS-DYNA's l/c (l = V/A_max), which a lone element
+//! or a mesh's alternating dilatation (u = ((−1)^i, (−1)^j, (−1)^k) h: ω² = 8(1.5λ + μ)/(ρh²),
+//! 1.36 × the uniaxial (2c/h)² at ν = 0.3) outruns: a cube crushed from one face went
+//! unstable at 0.9 l/c within 20 steps. The damping row gets C_a = ρ V Q₂ c/(2 l) (the
+//! linear bulk viscosity, LS-DYNA's Q = Q₂c in Δt = l/(Q + √(Q² + c²))).
+//! The reference geometry sets them; a solid that is crushed shortens its l (the Taylor
+//! test), which the fixed step does not follow: [`HexGroup::add_stiffening`] lets the
+//! run's stiffening check stop it, naming the element, before it goes unstable.
+
+use super::kernel::{self, HexGeometry, BULK_Q1, BULK_Q2};
+use super::material::{self, Hardening, JohnsonCook, Material, Model, PointState};
+use crate::error::{Result, WeftError};
+use crate::model::{ElementKind, PartProps};
+use crate::solver::family::{
+    chunk_partials, Build, EnergyGroup, EnergyPartial, Family, ForceCtx, StiffCtx,
+    CHUNK,
+};
+use crate::solver::vec3::Vec3;
+
+/// The material of a part's hexahedra, from its columns (`docs/tables.md`): elastic;
+/// J2 with `yield_stress` (bilinear with `tangent_modulus`); Johnson–Cook with `jc_a`.
+pub fn part_material(name: &str, p: &PartProps) -> Result<Material> {
+    let e = p.youngs_modulus.unwrap_or(f64::NAN);
+    let nu = p.poisson_ratio.unwrap_or(0.3);
+    let rho = p.density.unwrap_or(f64::NAN);
+    let in_part = |err: WeftError| {
+        WeftError::input(format!("part `{name}` (hex): {err}"))
+            .in_file("parts.parquet")
+            .hint("see docs/tables.md, parts.parquet: the solid's material columns")
+    };
+    let model = match (p.yield_stress, p.jc_a) {
+        (Some(_), Some(_)) => {
+            return Err(WeftError::input(format!(
+                "part `{name}` (hex) has both `yield_stress` and `jc_a`"
+            ))
+            .in_file("parts.parquet")
+            .expected("one plasticity model: J2 (yield_stress, tangent_modulus) or Johnson–Cook (jc_a …)"))
+        }
+        (Some(sy), None) => Model::J2 {
+            yield_stress: sy,
+            hardening: Hardening::from_tangent_modulus(e, p.tangent_modulus.unwrap_or(0.0))
+                .map_err(in_part)?,
+        },
+        (None, Some(a)) => {
+            // Without m (or T_melt) no thermal softening, without c_p no heating: the
+            // material's T_melt and c_p then stand at f64::MAX, which makes T* = 0 and
+            // ΔT = 0 (to round-off) without a second code path.
+            let softening = p.jc_m.is_some() && p.melt_temperature.is_some();
+            if p.jc_m.is_some() != p.melt_temperature.is_some() {
+                return Err(WeftError::input(format!(
+                    "part `{name}` (hex) has {} without {}",
+                    if p.jc_m.is_some() { "`jc_m`" } else { "`melt_temperature`" },
+                    if p.jc_m.is_some() { "`melt_temperature`" } else { "`jc_m`" },
+                ))
+                .in_file("parts.parquet")
+                .expected("both (thermal softening) or neither"));
+            }
+            Model::JohnsonCook(JohnsonCook {
+                a,
+                b: p.jc_b.unwrap_or(0.0),
+                n: p.jc_n.unwrap_or(1.0),
+                c: p.jc_c.unwrap_or(0.0),
+                reference_rate: p.jc_reference_rate.unwrap_or(1.0),
+                m: if softening { p.jc_m.unwrap() } else { 1.0 },
+                room_temperature: p.room_temperature.unwrap_or(material::DEFAULT_TEMPERATURE),
+                melt_temperature: if softening {
+                    p.melt_temperature.unwrap()
+                } else {
+                    f64::MAX
+                },
+                specific_heat: p.specific_heat.unwrap_or(f64::MAX),
+                taylor_quinney: p.taylor_quinney.unwrap_or(material::TAYLOR_QUINNEY),
+            })
+        }
+        (None, None) => Model::Elastic,
+    };
+    Material::new(e, nu, rho, model, p.erosion_plastic_strain).map_err(in_part)
+}
+
+/// Hexahedra, struct-of-arrays.
+#[derive(Debug, Clone, Default)]
+pub struct HexGroup {
+    pub id: Vec<i64>,
+    pub nodes: Vec<[u32; 8]>,
+    /// Index into `materials`, per element.
+    pub material: Vec<u32>,
+    /// One per part that has hexahedra.
+    pub materials: Vec<Material>,
+    /// Q_hg of the element's part.
+    pub q_hg: Vec<f64>,
+    /// The integration point's state (stress, plastic strain, temperature).
+    pub state: Vec<PointState>,
+    /// Accumulated [internal, bulk viscosity, hourglass] energy [J] per element.
+    pub work: Vec<[f64; 3]>,
+    /// The last step's bulk viscosity and hourglass forces, for the energy booking.
+    pub previous: Vec<Previous>,
+    /// Reference volume [m³] and characteristic length [m], for the stable step.
+    pub v0: Vec<f64>,
+    pub l0: Vec<f64>,
+    /// The element's Gershgorin row sums S_a at the reference [N/m] (module docs).
+    pub rows: Vec<[f64; 8]>,
+    partials: Vec<EnergyPartial>,
+}
+
+impl HexGroup {
+    fn mat(&self, e: usize) -> &Material {
+        &self.materials[self.material[e] as usize]
+    }
+}
+
+/// The Gershgorin row sums of the one-point element's stiffness V BᵀCB (isotropic C):
+/// S_a = V max_i Σ_b Σ_j |λ b_ai b_bj + μ b_aj b_bi + μ δ_ij b_a·b_b|.
+pub fn gershgorin_rows(g: &HexGeometry, lam: f64, mu: f64) -> [f64; 8] {
+    let b = &g.b;
+    std::array::from_fn(|a| {
+        let mut best = 0.0f64;
+        for i in 0..3 {
+            let mut row = 0.0;
+            for bb in b {
+                let ab = b[a][0] * bb[0] + b[a][1] * bb[1] + b[a][2] * bb[2];
+                for j in 0..3 {
+                    let k = lam * b[a][i] * bb[j]
+                        + mu * b[a][j] * bb[i]
+                        + if i == j { mu * ab } else { 0.0 };
+                    row += k.abs();
+                }
+            }
+            best = best.max(row);
+        }
+        g.volume.abs() * best
+    })
+}
+
+/// Tensor contraction σ:ε of Voigt [xx, yy, zz, xy, yz, zx] tensor components.
+#[inline(always)]
+fn contract(s: &[f64; 6], e: &[f64; 6]) -> f64 {
+    s[0] * e[0] + s[1] * e[1] + s[2] * e[2] + 2.0 * (s[3] * e[3] + s[4] * e[4] + s[5] * e[5])
+}
+
+/// What the energy booking of the next step needs of this one: the bulk viscosity q^n
+/// [Pa] and the hourglass coefficient times the mode velocities, coef·q_α^n [N].
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Previous {
+    pub bulk: f64,
+    pub hourglass: [Vec3; 4],
+}
+
+/// One element's step: state and work updated, nodal forces into `out` (module docs).
+///
+/// The energies are booked as the work of the element's own nodal forces over the last
+/// step, the trapezoid ½(fⁿ⁻¹ + fⁿ)·Δx^{n−½} of the central difference: for the stress,
+/// ½(σⁿ⁻¹ + σⁿ):D^{n−½}Δt V (then the balance telescopes to round-off for small
+/// strains); for the bulk viscosity ½(qⁿ⁻¹ + qⁿ)(−tr D^{n−½})Δt V; for the hourglass
+/// forces −½(f_hgⁿ⁻¹ + f_hgⁿ)·v^{n−½}Δt.
+#[inline]
+#[allow(clippy::too_many_arguments)]
+fn element_step(
+    mat: &Material,
+    q_hg: f64,
+    st: &mut PointState,
+    prev: &mut Previous,
+    work: &mut [f64; 3],
+    x: &[Vec3; 8],
+    v: &[Vec3; 8],
+    dt: f64,
+    out: &mut [Vec3],
+) {
+    if st.eroded {
+        out.iter_mut().for_each(|f| *f = [0.0; 3]);
+        return;
+    }
+    // 1–3: the stress at tⁿ from the increment over the last step.
+    let mut d_mid = [0.0; 6];
+    let mut v_mid = 0.0;
+    if dt > 0.0 {
+        let xm: [Vec3; 8] =
+            std::array::from_fn(|a| std::array::from_fn(|i| x[a][i] - 0.5 * dt * v[a][i]));
+        let gm = kernel::hex_geometry(&xm);
+        let l = kernel::velocity_gradient(&gm.b, v);
+        let (d, w) = kernel::split_velocity_gradient(&l);
+        let r = kernel::hughes_winget(&w, dt);
+        kernel::rotate_stress(&mut st.stress, &r);
+        let before = st.stress;
+        let deps: [f64; 6] = std::array::from_fn(|i| d[i] * dt);
+        material::update(mat, st, &deps, dt);
+        let mid: [f64; 6] = std::array::from_fn(|i| 0.5 * (before[i] + st.stress[i]));
+        work[0] += contract(&mid, &deps) * gm.volume;
+        d_mid = d;
+        v_mid = gm.volume;
+    }
+    // 4: forces at xⁿ.
+    let g: HexGeometry = kernel::hex_geometry(x);
+    let c = mat.dilatational_wave_speed();
+    let mut s = st.stress;
+    let mut f = [[0.0; 3]; 8];
+    let mut q = 0.0;
+    if dt > 0.0 {
+        let l = kernel::velocity_gradient(&g.b, v);
+        let d_kk = l[0][0] + l[1][1] + l[2][2];
+        let le = kernel::characteristic_length(x, g.volume);
+        q = kernel::bulk_viscosity(mat.density, le, c, d_kk, BULK_Q1, BULK_Q2);
+        s[0] -= q;
+        s[1] -= q;
+        s[2] -= q;
+        let tr_mid = d_mid[0] + d_mid[1] + d_mid[2];
+        work[1] += -0.5 * (prev.bulk + q) * tr_mid * v_mid * dt;
+    }
+    prev.bulk = q;
+    kernel::internal_forces(&g.b, g.volume, &s, &mut f);
+    // The viscous forces (hourglass, bulk) act from the first step on: at t = 0 (Δt^{n−½}
+    // = 0) the velocities are the initial ones, not a step's, and the ledger's kinetic
+    // energy ½ m v^{−½}·v^{½} at t = 0 would count their first half step twice.
+    if q_hg > 0.0 && dt > 0.0 {
+        let gamma = kernel::hourglass_gamma(x, &g.b);
+        let coef = 16.0 * kernel::hourglass_coefficient(q_hg, mat.density, c, g.volume);
+        // Mode velocities q_α = Σ_a γ_aα v_a; forces f_a = −Σ_α γ_aα coef q_α
+        // (Flanagan & Belytschko's viscous form, kernel::hourglass_viscous).
+        let mut cq = [[0.0; 3]; 4];
+        for a in 0..8 {
+            for (al, m) in cq.iter_mut().enumerate() {
+                for i in 0..3 {
+                    m[i] += coef * gamma[a][al] * v[a][i];
+                }
+            }
+        }
+        let mut p = 0.0;
+        for a in 0..8 {
+            for al in 0..4 {
+                for i in 0..3 {
+                    let fh = -gamma[a][al] * cq[al][i];
+                    f[a][i] += fh;
+                    // −½(f^{n−1} + fⁿ)·v^{n−½}: this step's force against v^{n−½} now,
+                    // the last step's through its mode forces (γ of this step).
+                    p += 0.5 * gamma[a][al] * (cq[al][i] + prev.hourglass[al][i]) * v[a][i];
+                }
+            }
+        }
+        work[2] += p * dt;
+        prev.hourglass = cq;
+    }
+    out.copy_from_slice(&f);
+}
+
+impl HexGroup {
+    /// For the stiffening check of the fixed step ([`crate::solver::stable`]): each
+    /// element's rows S_a at its current shape less the reference ones it was given,
+    /// added to its nodes where they have grown (a crushed element: |b|²V grows as it
+    /// flattens); `most` gets (added, kind, id, [V/V₀, l/l₀, 0]).
+    pub fn add_stiffening(
+        &self,
+        x: &[Vec3],
+        extra: &mut [f64],
+        most: &mut [Option<(f64, ElementKind, i64, [f64; 3])>],
+    ) {
+        use rayon::prelude::*;
+        let grown: Vec<([f64; 8], [f64; 3])> = (0..self.nodes.len())
+            .into_par_iter()
+            .with_min_len(1024)
+            .map(|e| {
+                if self.state[e].eroded {
+                    return ([0.0; 8], [0.0; 3]);
+                }
+                let ns = &self.nodes[e];
+                let xe: [Vec3; 8] = std::array::from_fn(|a| x[ns[a] as usize]);
+                let g = kernel::hex_geometry(&xe);
+                let l = kernel::characteristic_length(&xe, g.volume);
+                let (lam, mu) = self.mat(e).lame();
+                let now = gershgorin_rows(&g, lam, mu);
+                let add = std::array::from_fn(|a| now[a] - self.rows[e][a]);
+                (add, [g.volume / self.v0[e], l / self.l0[e], 0.0])
+            })
+            .collect();
+        for (e, (ns, (add, q))) in self.nodes.iter().zip(&grown).enumerate() {
+            for (a, &n) in ns.iter().enumerate() {
+                if add[a] <= 0.0 {
+                    continue;
+                }
+                let n = n as usize;
+                extra[n] += add[a];
+                if most[n].is_none_or(|m| add[a] > m.0) {
+                    most[n] = Some((add[a], ElementKind::Hex, self.id[e], *q));
+                }
+            }
+        }
+    }
+}
+
+impl Family for HexGroup {
+    const KIND: ElementKind = ElementKind::Hex;
+    const SLOTS: usize = 8;
+    const GROUP: EnergyGroup = EnergyGroup::Solid;
+
+    fn build(bd: &mut Build) -> Result<Self> {
+        let (m, mass) = (bd.model, &mut *bd.mass);
+        let mut g = HexGroup::default();
+        let Some(b) = m.block(ElementKind::Hex) else {
+            return Ok(g);
+        };
+        let mut by_part: Vec<Option<u32>> = vec![None; m.parts.len()];
+        for e in 0..b.len() {
+            let pi = b.part[e];
+            let part = &m.parts[pi];
+            let mi = match by_part[pi] {
+                Some(i) => i,
+                None => {
+                    g.materials.push(part_material(&part.name, &part.props)?);
+                    let i = (g.materials.len() - 1) as u32;
+                    by_part[pi] = Some(i);
+                    i
+                }
+            };
+            let ns: [usize; 8] = std::array::from_fn(|a| b.nodes[8 * e + a]);
+            let x: [Vec3; 8] = std::array::from_fn(|a| m.coords[ns[a]]);
+            let geo = kernel::hex_geometry(&x);
+            let mat = &g.materials[mi as usize];
+            // Lumped mass: an eighth of ρV to each node.
+            for &n in &ns {
+                mass[n] += 0.125 * mat.density * geo.volume;
+            }
+            g.id.push(b.id[e]);
+            g.nodes.push(ns.map(|n| n as u32));
+            g.material.push(mi);
+            g.q_hg.push(part.props.hourglass_coefficient());
+            g.state.push(mat.initial_state());
+            g.work.push([0.0; 3]);
+            g.previous.push(Previous::default());
+            g.l0.push(kernel::characteristic_length(&x, geo.volume));
+            g.v0.push(geo.volume);
+            let (lam, mu) = mat.lame();
+            g.rows.push(gershgorin_rows(&geo, lam, mu));
+        }
+        Ok(g)
+    }
+    fn len(&self) -> usize {
+        self.id.len()
+    }
+    fn id(&self, e: usize) -> i64 {
+        self.id[e]
+    }
+    fn slot_nodes(&self, e: usize) -> &[u32] {
+        &self.nodes[e]
+    }
+    fn stiffness(&self, e: usize) -> f64 {
+        self.rows[e].iter().fold(0.0, |a: f64, &r| a.max(r))
+    }
+    fn forces(&mut self, ctx: &ForceCtx, fe: &mut [Vec3]) {
+        use rayon::prelude::*;
+        let HexGroup {
+            nodes,
+            material,
+            materials,
+            q_hg,
+            state,
+            work,
+            previous,
+            ..
+        } = self;
+        let (nodes, material, materials, q_hg) = (&*nodes, &*material, &*materials, &*q_hg);
+        // Each chunk of force slots travels with its elements' state, previous forces
+        // and work.
+        type Chunk<'a> = (
+            usize,
+            (((&'a mut [Vec3], &'a mut [PointState]), &'a mut [Previous]), &'a mut [[f64; 3]]),
+        );
+        let body = |(ci, (((out, st), pv), wk)): Chunk| {
+            let e0 = ci * CHUNK;
+            for (j, slots) in out.chunks_exact_mut(8).enumerate() {
+                let e = e0 + j;
+                let ns = &nodes[e];
+                let x: [Vec3; 8] = std::array::from_fn(|a| ctx.x[ns[a] as usize]);
+                let v: [Vec3; 8] = std::array::from_fn(|a| ctx.v[ns[a] as usize]);
+                element_step(
+                    &materials[material[e] as usize],
+                    q_hg[e],
+                    &mut st[j],
+                    &mut pv[j],
+                    &mut wk[j],
+                    &x,
+                    &v,
+                    ctx.dt_prev,
+                    slots,
+                );
+            }
+        };
+        if nodes.len() <= CHUNK {
+            fe.chunks_mut(8 * CHUNK)
+                .zip(state.chunks_mut(CHUNK))
+                .zip(previous.chunks_mut(CHUNK))
+                .zip(work.chunks_mut(CHUNK))
+                .enumerate()
+                .for_each(body);
+        } else {
+            fe.par_chunks_mut(8 * CHUNK)
+                .zip(state.par_chunks_mut(CHUNK))
+                .zip(previous.par_chunks_mut(CHUNK))
+                .zip(work.par_chunks_mut(CHUNK))
+                .enumerate()
+                .for_each(body);
+        }
+    }
+    fn stiffness_sums(&self, _ctx: &StiffCtx, s: &mut [f64], c: &mut [f64], _r: &mut [f64]) {
+        for (e, ns) in self.nodes.iter().enumerate() {
+            let mat = self.mat(e);
+            let (v, l) = (self.v0[e], self.l0[e]);
+            let ce = mat.density * v * BULK_Q2 * mat.dilatational_wave_speed() / (2.0 * l);
+            for (a, &n) in ns.iter().enumerate() {
+                s[n as usize] += self.rows[e][a];
+                c[n as usize] += ce;
+            }
+        }
+    }
+    fn energies(&mut self, _ctx: &ForceCtx) -> &[EnergyPartial] {
+        let work = &self.work;
+        chunk_partials(&mut self.partials, work.len(), |r| {
+            let mut p = [0.0; 4];
+            for w in &work[r] {
+                p[0] += w[0];
+                p[1] += w[1];
+                p[3] += w[2];
+            }
+            p
+        });
+        &self.partials
+    }
+}
