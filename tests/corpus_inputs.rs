@@ -213,12 +213,30 @@ static NUMBER_PARSE_REFUSED: Mutex<Vec<String>> = Mutex::new(Vec::new());
 /// stage is a size, count, modulus, ratio, tolerance, time or speed, for which −1 is never
 /// valid: run with it, exit 0 is a failure of the corpus.
 const SIGNED_FLAGS: &[(&str, &str)] = &[
-    ("weft-weave rod --force", "the end load's sign is its direction"),
-    ("weft-weave girder --force", "the edge load's sign is its direction"),
-    ("weft-weave membrane --force", "the edge load's sign is its direction"),
-    ("weft-weave combined --force", "the edge load's sign is its direction"),
-    ("weft-energy pulse --velocity", "a particle velocity, signed along x"),
-    ("weft-energy pulse --from", "a coordinate along the part, which may be negative"),
+    (
+        "weft-weave rod --force",
+        "the end load's sign is its direction",
+    ),
+    (
+        "weft-weave girder --force",
+        "the edge load's sign is its direction",
+    ),
+    (
+        "weft-weave membrane --force",
+        "the edge load's sign is its direction",
+    ),
+    (
+        "weft-weave combined --force",
+        "the edge load's sign is its direction",
+    ),
+    (
+        "weft-energy pulse --velocity",
+        "a particle velocity, signed along x",
+    ),
+    (
+        "weft-energy pulse --from",
+        "a coordinate along the part, which may be negative",
+    ),
 ];
 
 /// The cli refusals that name a generated table's column or a derived quantity rather than

@@ -281,11 +281,7 @@ fn run_documented(file: &Path) -> Result<(), Failed> {
         if b.skip || !(b.info == "sh" || b.info == "python") {
             continue;
         }
-        script.push_str(&format!(
-            "echo '@@ {}:{}' >&2\n",
-            rel(file),
-            b.line
-        ));
+        script.push_str(&format!("echo '@@ {}:{}' >&2\n", rel(file), b.line));
         if b.info == "sh" {
             script.push_str(&b.text);
             script.push('\n');
@@ -471,7 +467,10 @@ fn stage_table() -> String {
         } else {
             format!("`{b} {}`", subs.join("\\|"))
         };
-        s.push_str(&format!("| {name} | {} |\n", summary(&b).replace('|', "\\|")));
+        s.push_str(&format!(
+            "| {name} | {} |\n",
+            summary(&b).replace('|', "\\|")
+        ));
     }
     s
 }
@@ -482,7 +481,10 @@ fn the_stage_table_is_the_binaries_own_words() -> Result<(), Failed> {
         .filter(|b| !STAGE_ORDER.contains(&b.as_str()))
         .collect();
     if !missing.is_empty() {
-        return Err(format!("binaries not in STAGE_ORDER (add them where a study uses them): {missing:?}").into());
+        return Err(format!(
+            "binaries not in STAGE_ORDER (add them where a study uses them): {missing:?}"
+        )
+        .into());
     }
     let path = Path::new(ROOT).join("README.md");
     let text = std::fs::read_to_string(&path).unwrap();
@@ -525,7 +527,10 @@ fn every_help_has_an_example_and_takes_its_defaults_as_shown() -> Result<(), Fai
         }
         for (sub, h) in &pages {
             n += 1;
-            let who = format!("{b}{}", sub.as_ref().map(|s| format!(" {s}")).unwrap_or_default());
+            let who = format!(
+                "{b}{}",
+                sub.as_ref().map(|s| format!(" {s}")).unwrap_or_default()
+            );
             // The binary's own page or the subcommand's shows one example.
             if !h.to_lowercase().contains("example") {
                 bad.push(format!("`{who} --help` shows no example"));
@@ -551,7 +556,10 @@ fn every_help_has_an_example_and_takes_its_defaults_as_shown() -> Result<(), Fai
                     bad.push(format!(
                         "`{who} --help`'s example `{}` does not parse: {}",
                         cmd.join(" "),
-                        String::from_utf8_lossy(&o.stderr).lines().next().unwrap_or("")
+                        String::from_utf8_lossy(&o.stderr)
+                            .lines()
+                            .next()
+                            .unwrap_or("")
                     ));
                 }
             }
@@ -580,7 +588,10 @@ fn every_help_has_an_example_and_takes_its_defaults_as_shown() -> Result<(), Fai
                             bad.push(format!(
                                 "`{who} {f} {}` (its default as --help shows it) is refused: {}",
                                 values.join(" "),
-                                String::from_utf8_lossy(&o.stderr).lines().next().unwrap_or("")
+                                String::from_utf8_lossy(&o.stderr)
+                                    .lines()
+                                    .next()
+                                    .unwrap_or("")
                             ));
                         }
                     }

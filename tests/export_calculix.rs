@@ -354,9 +354,21 @@ fn main() -> std::process::ExitCode {
     common::optional::run(
         &CCX,
         vec![
-            ("calculix_runs_the_exported_rod_like_weft", true, calculix_runs_the_exported_rod_like_weft),
-            ("calculix_runs_the_exported_pretensioned_net_like_weft", true, calculix_runs_the_exported_pretensioned_net_like_weft),
-            ("what_calculix_cannot_run_faithfully_is_refused_with_the_reason", false, what_calculix_cannot_run_faithfully_is_refused_with_the_reason),
+            (
+                "calculix_runs_the_exported_rod_like_weft",
+                true,
+                calculix_runs_the_exported_rod_like_weft,
+            ),
+            (
+                "calculix_runs_the_exported_pretensioned_net_like_weft",
+                true,
+                calculix_runs_the_exported_pretensioned_net_like_weft,
+            ),
+            (
+                "what_calculix_cannot_run_faithfully_is_refused_with_the_reason",
+                false,
+                what_calculix_cannot_run_faithfully_is_refused_with_the_reason,
+            ),
         ],
     )
 }

@@ -536,13 +536,41 @@ fn main() -> std::process::ExitCode {
     common::optional::run(
         &SLURM_TOOL,
         vec![
-            ("rod_waves_through_slurm_equals_the_local_run_and_sweeps_become_arrays", true, rod_waves_through_slurm_equals_the_local_run_and_sweeps_become_arrays),
-            ("a_controller_killed_mid_run_leaves_its_jobs_running_and_a_rerun_adopts_them", true, a_controller_killed_mid_run_leaves_its_jobs_running_and_a_rerun_adopts_them),
-            ("a_failing_instance_cancels_its_dependants_and_keep_going_runs_the_rest", true, a_failing_instance_cancels_its_dependants_and_keep_going_runs_the_rest),
-            ("ctrl_c_cancels_the_jobs_of_the_run", true, ctrl_c_cancels_the_jobs_of_the_run),
-            ("an_upstream_rerun_with_the_same_bytes_leaves_its_dependant_fresh_inside_its_job", true, an_upstream_rerun_with_the_same_bytes_leaves_its_dependant_fresh_inside_its_job),
-            ("jobs_a_dying_controller_submitted_but_did_not_note_are_cancelled_by_the_next_run", true, jobs_a_dying_controller_submitted_but_did_not_note_are_cancelled_by_the_next_run),
-            ("a_job_held_back_for_a_reason_that_does_not_pass_is_reported_while_waiting", true, a_job_held_back_for_a_reason_that_does_not_pass_is_reported_while_waiting),
+            (
+                "rod_waves_through_slurm_equals_the_local_run_and_sweeps_become_arrays",
+                true,
+                rod_waves_through_slurm_equals_the_local_run_and_sweeps_become_arrays,
+            ),
+            (
+                "a_controller_killed_mid_run_leaves_its_jobs_running_and_a_rerun_adopts_them",
+                true,
+                a_controller_killed_mid_run_leaves_its_jobs_running_and_a_rerun_adopts_them,
+            ),
+            (
+                "a_failing_instance_cancels_its_dependants_and_keep_going_runs_the_rest",
+                true,
+                a_failing_instance_cancels_its_dependants_and_keep_going_runs_the_rest,
+            ),
+            (
+                "ctrl_c_cancels_the_jobs_of_the_run",
+                true,
+                ctrl_c_cancels_the_jobs_of_the_run,
+            ),
+            (
+                "an_upstream_rerun_with_the_same_bytes_leaves_its_dependant_fresh_inside_its_job",
+                true,
+                an_upstream_rerun_with_the_same_bytes_leaves_its_dependant_fresh_inside_its_job,
+            ),
+            (
+                "jobs_a_dying_controller_submitted_but_did_not_note_are_cancelled_by_the_next_run",
+                true,
+                jobs_a_dying_controller_submitted_but_did_not_note_are_cancelled_by_the_next_run,
+            ),
+            (
+                "a_job_held_back_for_a_reason_that_does_not_pass_is_reported_while_waiting",
+                true,
+                a_job_held_back_for_a_reason_that_does_not_pass_is_reported_while_waiting,
+            ),
         ],
     )
 }

@@ -286,12 +286,36 @@ fn main() -> std::process::ExitCode {
     common::optional::run(
         &PYTHON,
         vec![
-            ("tables_open_in_pandas_and_polars", true, tables_open_in_pandas_and_polars),
-            ("a_model_with_every_feature_opens_in_pandas_and_polars", true, a_model_with_every_feature_opens_in_pandas_and_polars),
-            ("a_generated_woven_model_opens_in_pandas_and_polars", true, a_generated_woven_model_opens_in_pandas_and_polars),
-            ("a_formed_woven_model_opens_in_pandas_and_polars", true, a_formed_woven_model_opens_in_pandas_and_polars),
-            ("fit_and_error_tables_open_in_pandas_and_polars", true, fit_and_error_tables_open_in_pandas_and_polars),
-            ("a_failing_impact_opens_in_pandas_and_polars", true, a_failing_impact_opens_in_pandas_and_polars),
+            (
+                "tables_open_in_pandas_and_polars",
+                true,
+                tables_open_in_pandas_and_polars,
+            ),
+            (
+                "a_model_with_every_feature_opens_in_pandas_and_polars",
+                true,
+                a_model_with_every_feature_opens_in_pandas_and_polars,
+            ),
+            (
+                "a_generated_woven_model_opens_in_pandas_and_polars",
+                true,
+                a_generated_woven_model_opens_in_pandas_and_polars,
+            ),
+            (
+                "a_formed_woven_model_opens_in_pandas_and_polars",
+                true,
+                a_formed_woven_model_opens_in_pandas_and_polars,
+            ),
+            (
+                "fit_and_error_tables_open_in_pandas_and_polars",
+                true,
+                fit_and_error_tables_open_in_pandas_and_polars,
+            ),
+            (
+                "a_failing_impact_opens_in_pandas_and_polars",
+                true,
+                a_failing_impact_opens_in_pandas_and_polars,
+            ),
         ],
     )
 }

@@ -15,8 +15,8 @@
 use weft::model::{ElementKind, Load, Model, PartProps, TimeLaw};
 use weft::solver::family::{Build, Family, ForceCtx};
 use weft::solver::rotations::Rotations;
-use weft::solver::solid::hex::HexGroup;
 use weft::solver::run_in_memory;
+use weft::solver::solid::hex::HexGroup;
 
 const E: f64 = 200e9;
 const RHO: f64 = 7850.0;
@@ -100,7 +100,10 @@ fn pulse_speed(m: &mut Model, n: usize, h: f64) -> (f64, f64) {
     let v1 = out.velocity_series(0, 0);
     let v2 = out.velocity_series(1, 0);
     let (t1, t2) = (arrival(&out.t, &v1), arrival(&out.t, &v2));
-    ((s2 - s1) as f64 * h / (t2 - t1), st.max_balance_error_relative)
+    (
+        (s2 - s1) as f64 * h / (t2 - t1),
+        st.max_balance_error_relative,
+    )
 }
 
 #[test]
@@ -132,7 +135,10 @@ fn a_laterally_confined_column_carries_a_pulse_at_the_dilatational_speed() {
         m.constraints.push((i, [false, true, true]));
     }
     let (c, balance) = pulse_speed(&mut m, n, h);
-    let (lam, mu) = (E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu)), E / (2.0 * (1.0 + nu)));
+    let (lam, mu) = (
+        E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu)),
+        E / (2.0 * (1.0 + nu)),
+    );
     let cd = ((lam + 2.0 * mu) / RHO).sqrt();
     let err = (c - cd) / cd;
     eprintln!("dilatational speed: {c:.2} m/s against √((λ+2μ)/ρ) = {cd:.2} m/s ({err:+.2e}); energy balance {balance:.2e}");
@@ -217,8 +223,8 @@ fn nodal(g: &HexGroup, fe: &[[f64; 3]], nn: usize) -> Vec<[f64; 3]> {
 }
 
 #[test]
-fn the_patch_test_a_linear_velocity_field_on_a_distorted_mesh_gives_one_stress_and_no_interior_force()
-{
+fn the_patch_test_a_linear_velocity_field_on_a_distorted_mesh_gives_one_stress_and_no_interior_force(
+) {
     let (m, centre) = distorted_patch();
     let mut g = family(&m);
     // v = A X, A with all nine entries (stretch, shear, spin); tr A > 0 so that no bulk
@@ -258,11 +264,17 @@ fn the_patch_test_a_linear_velocity_field_on_a_distorted_mesh_gives_one_stress_a
     let fc = f[centre].iter().fold(0.0f64, |a, v| a.max(v.abs())) / fmax;
     // The stress a homogeneous D gives: σ = λ tr(D)Δt I + 2μ DΔt (the spin turns zero).
     let (e, nu) = (E, 0.3);
-    let (lam, mu) = (e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu)), e / (2.0 * (1.0 + nu)));
+    let (lam, mu) = (
+        e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu)),
+        e / (2.0 * (1.0 + nu)),
+    );
     let tr = a[0][0] + a[1][1] + a[2][2];
     let expect_xx = (lam * tr + 2.0 * mu * a[0][0]) * dt;
     let expect_xy = mu * (a[0][1] + a[1][0]) * dt;
-    let (exx, exy) = ((s0[0] - expect_xx) / expect_xx, (s0[3] - expect_xy) / expect_xy);
+    let (exx, exy) = (
+        (s0[0] - expect_xx) / expect_xx,
+        (s0[3] - expect_xy) / expect_xy,
+    );
     eprintln!(
         "patch test: stress spread {spread:.2e} of {scale:.3e} Pa, interior node force {fc:.2e} of the largest, σ_xx {exx:+.1e}, σ_xy {exy:+.1e} from the closed form"
     );
@@ -287,7 +299,13 @@ fn a_rigid_rotation_of_ninety_degrees_turns_a_uniaxial_stress_with_the_body() {
     // the rotated positions, v^{n−½} the chords.
     let steps = 400;
     let dt = 1e-7;
-    let rot = |th: f64, x: &[f64; 3]| [th.cos() * x[0] - th.sin() * x[1], th.sin() * x[0] + th.cos() * x[1], x[2]];
+    let rot = |th: f64, x: &[f64; 3]| {
+        [
+            th.cos() * x[0] - th.sin() * x[1],
+            th.sin() * x[0] + th.cos() * x[1],
+            x[2],
+        ]
+    };
     let mut prev: Vec<[f64; 3]> = m.coords.clone();
     let mut fe = vec![[0.0; 3]; 8 * g.len()];
     for n in 1..=steps {
@@ -336,7 +354,10 @@ fn bad_solids_are_refused_naming_what_is_wrong() {
     }
     let err = m.validate().unwrap_err().to_string();
     eprintln!("{err}");
-    assert!(err.contains("hexahedron `1`") && err.contains("Jacobian") && err.contains("n5–n8"), "{err}");
+    assert!(
+        err.contains("hexahedron `1`") && err.contains("Jacobian") && err.contains("n5–n8"),
+        "{err}"
+    );
 
     let refused = |props: PartProps, what: &str| {
         let mut m = bar(1, 1e-3, 0.3);
@@ -410,7 +431,10 @@ fn a_solid_crushed_below_its_fixed_step_stops_the_run_naming_the_element() {
     }
     m.analysis.end_time = 8e-6;
     m.analysis.output_interval = 1e-7;
-    let err = run_in_memory(&m).err().expect("the run must stop").to_string();
+    let err = run_in_memory(&m)
+        .err()
+        .expect("the run must stop")
+        .to_string();
     eprintln!("{err}");
     assert!(
         err.contains("hex `1` has been compressed") && err.contains("dt_safety"),
@@ -449,7 +473,10 @@ fn a_solid_model_round_trips_through_its_tables_and_runs_from_them_as_in_memory(
     let back = read_model(&path).unwrap();
     let (_, a, _) = run_in_memory(&m).unwrap();
     let (s, b, _) = run_in_memory(&back).unwrap();
-    assert!(a.u == b.u && a.energy == b.energy, "the read model runs differently");
+    assert!(
+        a.u == b.u && a.energy == b.energy,
+        "the read model runs differently"
+    );
     // It yielded: 1.2 kN on 1 mm² is 1.2 GPa against 250 MPa.
     let ep = s.op.el.hex.state[0].plastic_strain;
     eprintln!("plastic strain of the loaded element: {ep:.3e}");
@@ -463,7 +490,10 @@ fn block(n: usize, nz: usize, h: f64, props: PartProps) -> Model {
     for k in 0..=nz {
         for j in 0..=n {
             for i in 0..=n {
-                m.add_node(id(i, j, k) as i64 + 1, [i as f64 * h, j as f64 * h, k as f64 * h]);
+                m.add_node(
+                    id(i, j, k) as i64 + 1,
+                    [i as f64 * h, j as f64 * h, k as f64 * h],
+                );
             }
         }
     }
@@ -514,8 +544,8 @@ fn copper() -> PartProps {
 }
 
 #[test]
-fn a_copper_block_struck_on_a_corner_region_balances_energy_and_runs_the_same_on_one_and_two_threads()
-{
+fn a_copper_block_struck_on_a_corner_region_balances_energy_and_runs_the_same_on_one_and_two_threads(
+) {
     // 11 × 11 × 10 = 1210 hexahedra (two chunks of 1024): every element path at once,
     // Johnson–Cook plasticity with heating, bulk viscosity, hourglass forces, on one and
     // on two threads. Energy: the explicit scheme conserves it to round-off plus
@@ -581,7 +611,11 @@ fn a_copper_block_struck_on_a_corner_region_balances_energy_and_runs_the_same_on
     );
     assert!(ep > 0.0 && t > 293.15);
     // Measured 1.0e-5 (the issue asks ≤ 1 %); tolerance 3e-5.
-    assert!(st.max_balance_error_relative < 3e-5, "balance {}", st.max_balance_error_relative);
+    assert!(
+        st.max_balance_error_relative < 3e-5,
+        "balance {}",
+        st.max_balance_error_relative
+    );
     // Measured 5.3 % of the internal energy (the cone's kinks at its axis and rim, on a
     // 1 mm grid); tolerance 11 %.
     assert!(e.hourglass < 0.11 * e.internal, "hourglass {}", e.hourglass);

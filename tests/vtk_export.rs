@@ -129,8 +129,16 @@ fn main() -> std::process::ExitCode {
     common::optional::run(
         &PYTHON_VTK,
         vec![
-            ("vtk_reads_every_element_kind_the_times_and_the_history_values", true, vtk_reads_every_element_kind_the_times_and_the_history_values),
-            ("a_history_without_every_node_is_refused_and_nothing_is_written", false, a_history_without_every_node_is_refused_and_nothing_is_written),
+            (
+                "vtk_reads_every_element_kind_the_times_and_the_history_values",
+                true,
+                vtk_reads_every_element_kind_the_times_and_the_history_values,
+            ),
+            (
+                "a_history_without_every_node_is_refused_and_nothing_is_written",
+                false,
+                a_history_without_every_node_is_refused_and_nothing_is_written,
+            ),
         ],
     )
 }

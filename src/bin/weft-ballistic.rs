@@ -37,10 +37,14 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Fit the ballistic limit of impact runs (one limit per group).
-    #[command(after_help = "Example:\n  weft-ballistic fit --runs runs/v60 runs/v80 runs/v100 runs/v120 --out runs/limit")]
+    #[command(
+        after_help = "Example:\n  weft-ballistic fit --runs runs/v60 runs/v80 runs/v100 runs/v120 --out runs/limit"
+    )]
     Fit(FitArgs),
     /// Run impacts of one model, bracketing its limit to a tolerance, then fit it.
-    #[command(after_help = "Example:\n  weft-weave woven --yarns 10 --layers 2 --failure-strain 0.036 --out runs/two\n  weft-ballistic search --model runs/two --lo 40 --hi 200 --tolerance 5 --out runs/two-limit")]
+    #[command(
+        after_help = "Example:\n  weft-weave woven --yarns 10 --layers 2 --failure-strain 0.036 --out runs/two\n  weft-ballistic search --model runs/two --lo 40 --hi 200 --tolerance 5 --out runs/two-limit"
+    )]
     Search(SearchArgs),
 }
 

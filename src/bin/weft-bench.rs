@@ -380,7 +380,10 @@ fn hex_block(n: usize) -> Model {
     for l in 0..=nz {
         for j in 0..=k {
             for i in 0..=k {
-                let node = m.add_node(id(i, j, l) as i64 + 1, [i as f64 * h, j as f64 * h, l as f64 * h]);
+                let node = m.add_node(
+                    id(i, j, l) as i64 + 1,
+                    [i as f64 * h, j as f64 * h, l as f64 * h],
+                );
                 if l == 0 {
                     m.constraints.push((node, [true, true, true]));
                 } else if l == nz {
@@ -446,7 +449,9 @@ fn bench_solid(sizes: &[usize], threads: &[usize], updates: f64) -> anyhow::Resu
                 .unwrap_or_default();
             base.get_or_insert(rate);
             println!("hex,{ne},{t},{},{secs:.3},{rate:.4e}", stats.steps);
-            eprintln!("  hex {ne:>8} elements, {t} thread(s): {rate:.3e} element-updates/s{speedup}");
+            eprintln!(
+                "  hex {ne:>8} elements, {t} thread(s): {rate:.3e} element-updates/s{speedup}"
+            );
         }
     }
     Ok(())

@@ -34,30 +34,44 @@ struct Cli {
 #[derive(Subcommand)]
 enum Figure {
     /// Displacement (or velocity) time laws of chosen nodes, one line style per model.
-    #[command(after_help = "Example:\n  weft-plot history --model runs/rod --history runs/rod-out/history.parquet \\\n    --set free_end --component vx --out vx.png")]
+    #[command(
+        after_help = "Example:\n  weft-plot history --model runs/rod --history runs/rod-out/history.parquet \\\n    --set free_end --component vx --out vx.png"
+    )]
     History(HistoryArgs),
     /// Wave speed against position along the line, one series per table.
-    #[command(after_help = "Example:\n  weft-plot wavespeed --table runs/speeds.parquet --label rod --out speeds.png")]
+    #[command(
+        after_help = "Example:\n  weft-plot wavespeed --table runs/speeds.parquet --label rod --out speeds.png"
+    )]
     Wavespeed(WavespeedArgs),
     /// Per-node peak relative error along the compared node set (error.parquet).
-    #[command(after_help = "Example:\n  weft-plot error --table runs/err/error.parquet --label membrane --out error.png")]
+    #[command(
+        after_help = "Example:\n  weft-plot error --table runs/err/error.parquet --label membrane --out error.png"
+    )]
     Error(ErrorArgs),
     /// Best T against evaluations (fit_trace.parquet), one series per trace.
-    #[command(after_help = "Example:\n  weft-plot fit --trace runs/fit/fit_trace.parquet --label static --out fit.png")]
+    #[command(
+        after_help = "Example:\n  weft-plot fit --trace runs/fit/fit_trace.parquet --label static --out fit.png"
+    )]
     Fit(FitArgs),
     /// Test MSE of a network search against the hidden neurons, per activation
     /// (weft-surrogate's search.parquet; the paper's Fig. 6b).
-    #[command(after_help = "Example:\n  weft-plot surrogate --search runs/net/search.parquet --surrogate runs/net/surrogate.json \\\n    --out search.png")]
+    #[command(
+        after_help = "Example:\n  weft-plot surrogate --search runs/net/search.parquet --surrogate runs/net/surrogate.json \\\n    --out search.png"
+    )]
     Surrogate(SurrogateArgs),
     /// A ballistic limit (weft-ballistic's tables): residual against striking velocity
     /// with the Lambert–Jonas fits, energy absorbed, probability of perforation, or the
     /// limit against layers.
-    #[command(after_help = "Example:\n  weft-plot ballistic --runs runs/limit/ballistic_runs.parquet \\\n    --limit runs/limit/ballistic_limit.parquet --kind residual --out residual.png")]
+    #[command(
+        after_help = "Example:\n  weft-plot ballistic --runs runs/limit/ballistic_runs.parquet \\\n    --limit runs/limit/ballistic_limit.parquet --kind residual --out residual.png"
+    )]
     Ballistic(BallisticArgs),
     /// Section of a woven patch along y = y₀: the yarn along x (centre line and ± t/2
     /// envelope) and the sections of the yarns across it; reference dashed and formed
     /// solid for a model from weft-form.
-    #[command(after_help = "Example:\n  weft-plot weave --model runs/woven-formed --y 0 --out weave.png")]
+    #[command(
+        after_help = "Example:\n  weft-plot weave --model runs/woven-formed --y 0 --out weave.png"
+    )]
     Weave(WeaveArgs),
     /// Colour map of a nodal quantity (uz, |u|, vx, ...) over the mesh at one output
     /// time, on the initial or deformed mesh, with a colour bar; several models side by

@@ -34,10 +34,14 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Fit the regression and search the networks on a table of x and y.
-    #[command(after_help = "Example:\n  weft-surrogate train --table sweep.parquet --inputs b_g,N_g \\\n    --outputs membrane.G12,membrane.s,membrane.rho --out runs/net")]
+    #[command(
+        after_help = "Example:\n  weft-surrogate train --table sweep.parquet --inputs b_g,N_g \\\n    --outputs membrane.G12,membrane.s,membrane.rho --out runs/net"
+    )]
     Train(Box<TrainArgs>),
     /// Predict y for a table of x with a trained surrogate.
-    #[command(after_help = "Example:\n  weft-surrogate predict --surrogate runs/net/surrogate.json --x b_g=1.2e-3,N_g=7 \\\n    --out prediction.parquet")]
+    #[command(
+        after_help = "Example:\n  weft-surrogate predict --surrogate runs/net/surrogate.json --x b_g=1.2e-3,N_g=7 \\\n    --out prediction.parquet"
+    )]
     Predict(PredictArgs),
 }
 

@@ -63,13 +63,17 @@ enum Model {
     Rod(RodArgs),
     /// A square L × L grid of rods (the paper's §4 girder), N cells per side, clamped at
     /// x = 0 and loaded at x = L; rods as beams (rigid joints) or trusses (pinned joints).
-    #[command(after_help = "Example:\n  weft-weave girder --cells 10 --load-case shear --out runs/girder")]
+    #[command(
+        after_help = "Example:\n  weft-weave girder --cells 10 --load-case shear --out runs/girder"
+    )]
     Girder(GirderArgs),
     /// The same square meshed with N × N membrane quads (the equivalent membrane),
     /// clamped at x = 0 and loaded at x = L. Defaults: the closed-form equivalent of the
     /// default girder (s = b²/a, ρ = ρ_g(2 − b/a), G = E(b/a)²/2 with b/a = 0.1). With
     /// --girder-cells, the paper's combined model (Fig. 5b): a girder zone at the centre.
-    #[command(after_help = "Example:\n  weft-weave membrane --cells 10 --load-case shear --out runs/membrane")]
+    #[command(
+        after_help = "Example:\n  weft-weave membrane --cells 10 --load-case shear --out runs/membrane"
+    )]
     Membrane(MembraneArgs),
     /// A dense centre zone (rigid girder or fine membrane) inside a coarse membrane whose
     /// elements grow with distance from the centre, joined by tied interfaces; pinned outer
@@ -88,7 +92,9 @@ enum Model {
     /// Quarter model (symmetry planes x = 0, y = 0) unless --full. Node sets: axis_x,
     /// axis_x_weft, diagonal, diagonal_weft (centre-line nodes at the crossings), edge.
     /// --yarn-model chain: truss chains along the bands' centre lines instead (faster).
-    #[command(after_help = "Example:\n  weft-weave woven --yarns 10 --out runs/woven\n  weft-weave woven --yarns 10 --layers 2 --failure-strain 0.036 --projectile-velocity 100 \\\n    --out runs/two")]
+    #[command(
+        after_help = "Example:\n  weft-weave woven --yarns 10 --out runs/woven\n  weft-weave woven --yarns 10 --layers 2 --failure-strain 0.036 --projectile-velocity 100 \\\n    --out runs/two"
+    )]
     Woven(WovenBandArgs),
 }
 

@@ -34,7 +34,9 @@ struct Cli {
 #[derive(Subcommand)]
 enum Cmd {
     /// Run the stale stages (all, or the named stages and what they need).
-    #[command(after_help = "Example:\n  weft run pipelines/woven_patch.toml\n  weft run -n pipelines/woven_patch.toml   (a dry run: what would run, and why)")]
+    #[command(
+        after_help = "Example:\n  weft run pipelines/woven_patch.toml\n  weft run -n pipelines/woven_patch.toml   (a dry run: what would run, and why)"
+    )]
     Run(RunArgs),
     /// Say for each stage instance whether it is fresh, or why it would run (and its
     /// Slurm job, while one of an interrupted `weft run --executor slurm` is queued or running).
@@ -48,7 +50,9 @@ enum Cmd {
         format: DagFormat,
     },
     /// The record of every stage instance (command, parameters, hashes, times, exit status).
-    #[command(after_help = "Example:\n  weft records pipelines/woven_patch.toml --out records.parquet")]
+    #[command(
+        after_help = "Example:\n  weft records pipelines/woven_patch.toml --out records.parquet"
+    )]
     Records {
         pipeline: Option<PathBuf>,
         /// Write the records as a Parquet table instead of printing them.
@@ -57,7 +61,9 @@ enum Cmd {
     },
     /// Gather one table of every instance of a (sweep) stage into one Parquet table, with
     /// the instance name and its parameters as columns.
-    #[command(after_help = "Example:\n  weft gather pipelines/ballistic_limit.toml --stage impact --table summary.parquet \\\n    --out impacts.parquet")]
+    #[command(
+        after_help = "Example:\n  weft gather pipelines/ballistic_limit.toml --stage impact --table summary.parquet \\\n    --out impacts.parquet"
+    )]
     Gather {
         pipeline: Option<PathBuf>,
         /// The stage whose instances to gather.

@@ -302,10 +302,12 @@ impl WovenParams {
             .expected("a speed ≥ 0 in m/s (the projectile moves along −z, towards the patch)"));
         }
         if !(self.crimp >= 0.0 && self.crimp < self.spacing) {
-            return Err(WeftError::input(format!("--crimp = `{}`", self.crimp)).expected(format!(
-                "an offset 0 ≤ a < the spacing {} m (warp and weft at ±a, alternating)",
-                self.spacing
-            )));
+            return Err(
+                WeftError::input(format!("--crimp = `{}`", self.crimp)).expected(format!(
+                    "an offset 0 ≤ a < the spacing {} m (warp and weft at ±a, alternating)",
+                    self.spacing
+                )),
+            );
         }
         let pf = self.projectile_friction;
         if !(pf >= 0.0 && pf.is_finite()) {

@@ -185,7 +185,10 @@ impl Model {
     /// A hexahedron: eight distinct nodes, and det J > 0 at every corner (a positive
     /// volume everywhere: nodes 1–4 counter-clockwise seen from the face 5–8).
     fn validate_hex(&self, id: i64, ns: &[usize], file: &str, row: usize) -> Result<()> {
-        let ids: Vec<String> = ns.iter().map(|&n| format!("`{}`", self.node_id[n])).collect();
+        let ids: Vec<String> = ns
+            .iter()
+            .map(|&n| format!("`{}`", self.node_id[n]))
+            .collect();
         for a in 0..8 {
             if ns[a + 1..].contains(&ns[a]) {
                 return Err(WeftError::input(format!(
@@ -195,7 +198,9 @@ impl Model {
                 ))
                 .in_file(file)
                 .at_row(row)
-                .expected("eight distinct nodes (degenerate hexahedra, wedges, are not supported)"));
+                .expected(
+                    "eight distinct nodes (degenerate hexahedra, wedges, are not supported)",
+                ));
             }
         }
         let x: [[f64; 3]; 8] = std::array::from_fn(|a| self.coords[ns[a]]);

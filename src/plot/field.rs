@@ -398,9 +398,17 @@ fn element_pieces(
                 ElementKind::Tri => tri_pieces(&x, v.as_deref(), div, &mut panel.faces),
                 ElementKind::Hex => {
                     // Its six faces, each a quad (the depth order hides the far ones).
-                    for f in [[0, 1, 2, 3], [4, 5, 6, 7], [0, 1, 5, 4], [1, 2, 6, 5], [2, 3, 7, 6], [3, 0, 4, 7]] {
+                    for f in [
+                        [0, 1, 2, 3],
+                        [4, 5, 6, 7],
+                        [0, 1, 5, 4],
+                        [1, 2, 6, 5],
+                        [2, 3, 7, 6],
+                        [3, 0, 4, 7],
+                    ] {
                         let xf: Vec<(f64, f64, f64)> = f.iter().map(|&k| x[k]).collect();
-                        let vf: Option<Vec<f64>> = v.as_ref().map(|v| f.iter().map(|&k| v[k]).collect());
+                        let vf: Option<Vec<f64>> =
+                            v.as_ref().map(|v| f.iter().map(|&k| v[k]).collect());
                         quad_pieces(&xf, vf.as_deref(), div, &mut panel.faces);
                     }
                 }

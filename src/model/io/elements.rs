@@ -105,8 +105,7 @@ fn read_columns(r: &Reading, t: &Table, kind: ElementKind) -> Result<ElementColu
     let id = t.i64("element_id", exp)?;
     let part_id = t.i64("part_id", exp)?;
     let mut nodes = Vec::new();
-    for c in NODE_COLUMNS.iter().take(kind.nodes_per_element())
-    {
+    for c in NODE_COLUMNS.iter().take(kind.nodes_per_element()) {
         let ids = t.i64(c, exp)?;
         nodes.push(r.node_refs(t, c, &ids)?);
     }

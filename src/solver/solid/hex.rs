@@ -41,8 +41,7 @@ use super::material::{self, Hardening, JohnsonCook, Material, Model, PointState}
 use crate::error::{Result, WeftError};
 use crate::model::{ElementKind, PartProps};
 use crate::solver::family::{
-    chunk_partials, Build, EnergyGroup, EnergyPartial, Family, ForceCtx, StiffCtx,
-    CHUNK,
+    chunk_partials, Build, EnergyGroup, EnergyPartial, Family, ForceCtx, StiffCtx, CHUNK,
 };
 use crate::solver::vec3::Vec3;
 
@@ -57,52 +56,61 @@ pub fn part_material(name: &str, p: &PartProps) -> Result<Material> {
             .in_file("parts.parquet")
             .hint("see docs/tables.md, parts.parquet: the solid's material columns")
     };
-    let model = match (p.yield_stress, p.jc_a) {
-        (Some(_), Some(_)) => {
-            return Err(WeftError::input(format!(
+    let model =
+        match (p.yield_stress, p.jc_a) {
+            (Some(_), Some(_)) => return Err(WeftError::input(format!(
                 "part `{name}` (hex) has both `yield_stress` and `jc_a`"
             ))
             .in_file("parts.parquet")
-            .expected("one plasticity model: J2 (yield_stress, tangent_modulus) or Johnson–Cook (jc_a …)"))
-        }
-        (Some(sy), None) => Model::J2 {
-            yield_stress: sy,
-            hardening: Hardening::from_tangent_modulus(e, p.tangent_modulus.unwrap_or(0.0))
-                .map_err(in_part)?,
-        },
-        (None, Some(a)) => {
-            // Without m (or T_melt) no thermal softening, without c_p no heating: the
-            // material's T_melt and c_p then stand at f64::MAX, which makes T* = 0 and
-            // ΔT = 0 (to round-off) without a second code path.
-            let softening = p.jc_m.is_some() && p.melt_temperature.is_some();
-            if p.jc_m.is_some() != p.melt_temperature.is_some() {
-                return Err(WeftError::input(format!(
-                    "part `{name}` (hex) has {} without {}",
-                    if p.jc_m.is_some() { "`jc_m`" } else { "`melt_temperature`" },
-                    if p.jc_m.is_some() { "`melt_temperature`" } else { "`jc_m`" },
-                ))
-                .in_file("parts.parquet")
-                .expected("both (thermal softening) or neither"));
+            .expected(
+                "one plasticity model: J2 (yield_stress, tangent_modulus) or Johnson–Cook (jc_a …)",
+            )),
+            (Some(sy), None) => Model::J2 {
+                yield_stress: sy,
+                hardening: Hardening::from_tangent_modulus(e, p.tangent_modulus.unwrap_or(0.0))
+                    .map_err(in_part)?,
+            },
+            (None, Some(a)) => {
+                // Without m (or T_melt) no thermal softening, without c_p no heating: the
+                // material's T_melt and c_p then stand at f64::MAX, which makes T* = 0 and
+                // ΔT = 0 (to round-off) without a second code path.
+                let softening = p.jc_m.is_some() && p.melt_temperature.is_some();
+                if p.jc_m.is_some() != p.melt_temperature.is_some() {
+                    return Err(WeftError::input(format!(
+                        "part `{name}` (hex) has {} without {}",
+                        if p.jc_m.is_some() {
+                            "`jc_m`"
+                        } else {
+                            "`melt_temperature`"
+                        },
+                        if p.jc_m.is_some() {
+                            "`melt_temperature`"
+                        } else {
+                            "`jc_m`"
+                        },
+                    ))
+                    .in_file("parts.parquet")
+                    .expected("both (thermal softening) or neither"));
+                }
+                Model::JohnsonCook(JohnsonCook {
+                    a,
+                    b: p.jc_b.unwrap_or(0.0),
+                    n: p.jc_n.unwrap_or(1.0),
+                    c: p.jc_c.unwrap_or(0.0),
+                    reference_rate: p.jc_reference_rate.unwrap_or(1.0),
+                    m: if softening { p.jc_m.unwrap() } else { 1.0 },
+                    room_temperature: p.room_temperature.unwrap_or(material::DEFAULT_TEMPERATURE),
+                    melt_temperature: if softening {
+                        p.melt_temperature.unwrap()
+                    } else {
+                        f64::MAX
+                    },
+                    specific_heat: p.specific_heat.unwrap_or(f64::MAX),
+                    taylor_quinney: p.taylor_quinney.unwrap_or(material::TAYLOR_QUINNEY),
+                })
             }
-            Model::JohnsonCook(JohnsonCook {
-                a,
-                b: p.jc_b.unwrap_or(0.0),
-                n: p.jc_n.unwrap_or(1.0),
-                c: p.jc_c.unwrap_or(0.0),
-                reference_rate: p.jc_reference_rate.unwrap_or(1.0),
-                m: if softening { p.jc_m.unwrap() } else { 1.0 },
-                room_temperature: p.room_temperature.unwrap_or(material::DEFAULT_TEMPERATURE),
-                melt_temperature: if softening {
-                    p.melt_temperature.unwrap()
-                } else {
-                    f64::MAX
-                },
-                specific_heat: p.specific_heat.unwrap_or(f64::MAX),
-                taylor_quinney: p.taylor_quinney.unwrap_or(material::TAYLOR_QUINNEY),
-            })
-        }
-        (None, None) => Model::Elastic,
-    };
+            (None, None) => Model::Elastic,
+        };
     Material::new(e, nu, rho, model, p.erosion_plastic_strain).map_err(in_part)
 }
 
@@ -389,7 +397,10 @@ impl Family for HexGroup {
         // and work.
         type Chunk<'a> = (
             usize,
-            (((&'a mut [Vec3], &'a mut [PointState]), &'a mut [Previous]), &'a mut [[f64; 3]]),
+            (
+                ((&'a mut [Vec3], &'a mut [PointState]), &'a mut [Previous]),
+                &'a mut [[f64; 3]],
+            ),
         );
         let body = |(ci, (((out, st), pv), wk)): Chunk| {
             let e0 = ci * CHUNK;

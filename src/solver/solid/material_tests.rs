@@ -450,13 +450,10 @@ fn bad_input_is_refused_by_name() {
     assert!(msg(Material::new(1e9, -1.0, 1.0, Model::Elastic, None)).contains("Poisson"));
     assert!(msg(Material::new(1e9, 0.3, 0.0, Model::Elastic, None)).contains("density"));
     assert!(msg(Material::new(1e9, 0.3, 1.0, Model::Elastic, Some(0.0))).contains("erosion"));
-    assert!(
-        msg(Material::new(1e9, 0.3, 1.0, j2(0.0, lin.clone()), None)).contains("yield stress")
-    );
+    assert!(msg(Material::new(1e9, 0.3, 1.0, j2(0.0, lin.clone()), None)).contains("yield stress"));
     assert!(msg(Material::new(1e9, 0.3, 1.0, j2(-1e6, lin), None)).contains("yield stress"));
     assert!(
-        format!("{}", Hardening::from_tangent_modulus(1e9, 1e9).unwrap_err())
-            .contains("tangent")
+        format!("{}", Hardening::from_tangent_modulus(1e9, 1e9).unwrap_err()).contains("tangent")
     );
     assert!(format!(
         "{}",
@@ -484,9 +481,7 @@ fn bad_input_is_refused_by_name() {
     )
     .contains("as many"));
     let t = Hardening::table(vec![0.0, 0.1], vec![2e8, 3e8]).unwrap();
-    assert!(
-        msg(Material::new(1e9, 0.3, 1.0, j2(2.5e8, t.clone()), None)).contains("table starts")
-    );
+    assert!(msg(Material::new(1e9, 0.3, 1.0, j2(2.5e8, t.clone()), None)).contains("table starts"));
     assert!(Material::new(1e9, 0.3, 1.0, j2(2e8, t), None).is_ok());
     let ok = jc(&copper());
     let cases: [(fn(&mut JohnsonCook), &str); 11] = [
