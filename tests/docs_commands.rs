@@ -518,7 +518,8 @@ fn the_stage_table_is_the_binaries_own_words() -> Result<(), Failed> {
 fn every_help_has_an_example_and_takes_its_defaults_as_shown() -> Result<(), Failed> {
     let mut bad = vec![];
     let (mut n, mut n_examples) = (0, 0);
-    for b in binaries() {
+    let bins = binaries();
+    for b in &bins {
         let top = help(&b, None, true);
         let mut pages = vec![(None, top.clone())];
         for s in subcommands(&top) {
@@ -541,7 +542,7 @@ fn every_help_has_an_example_and_takes_its_defaults_as_shown() -> Result<(), Fai
                 let Some((prog, args)) = cmd.split_first() else {
                     continue;
                 };
-                if !binaries().contains(prog) {
+                if !bins.contains(prog) {
                     continue;
                 }
                 n_examples += 1;

@@ -12,6 +12,7 @@
 //! - bad input: an inside-out hexahedron, a yield stress ≤ 0, a Johnson–Cook exponent out
 //!   of range, a room temperature at or above melt, each refused naming what is wrong.
 
+use weft::generate::block::hex_block;
 use weft::model::{ElementKind, Load, Model, PartProps, TimeLaw};
 use weft::solver::family::{Build, Family, ForceCtx};
 use weft::solver::rotations::Rotations;
@@ -152,12 +153,12 @@ fn a_laterally_confined_column_carries_a_pulse_at_the_dilatational_speed() {
 /// A unit cube in 2 × 2 × 2 hexahedra whose 27 nodes are moved off the grid (all but
 /// the corners), so that no element is a parallelepiped.
 fn distorted_patch() -> (Model, usize) {
-    let mut m = Model::default();
+    let mut m = hex_block(2, 2, 2, 0.5, "patch", steel(0.3));
     let id = |i: usize, j: usize, k: usize| 9 * k + 3 * j + i;
     for k in 0..3 {
         for j in 0..3 {
             for i in 0..3 {
-                let mut x = [0.5 * i as f64, 0.5 * j as f64, 0.5 * k as f64];
+                let x = &mut m.coords[id(i, j, k)];
                 // Deterministic, different offsets; the corners stay, faces stay planar
                 // only where the offset is along the face.
                 let s = (id(i, j, k) as f64 * 0.618_034).fract() - 0.5;
@@ -170,27 +171,6 @@ fn distorted_patch() -> (Model, usize) {
                         }
                     }
                 }
-                m.add_node(id(i, j, k) as i64 + 1, x);
-            }
-        }
-    }
-    let p = m.add_part(1, "patch", ElementKind::Hex, steel(0.3));
-    let mut eid = 1;
-    for k in 0..2 {
-        for j in 0..2 {
-            for i in 0..2 {
-                let n = [
-                    id(i, j, k),
-                    id(i + 1, j, k),
-                    id(i + 1, j + 1, k),
-                    id(i, j + 1, k),
-                    id(i, j, k + 1),
-                    id(i + 1, j, k + 1),
-                    id(i + 1, j + 1, k + 1),
-                    id(i, j + 1, k + 1),
-                ];
-                m.add_element(eid, p, &n);
-                eid += 1;
             }
         }
     }
@@ -483,44 +463,9 @@ fn a_solid_model_round_trips_through_its_tables_and_runs_from_them_as_in_memory(
     assert!(ep > 0.0);
 }
 
-/// A block of n × n × nz cubes of side h, node (i, j, k) at (i, j, k) h.
+/// A block of n × n × nz cubes of side h (`weft::generate::block`).
 fn block(n: usize, nz: usize, h: f64, props: PartProps) -> Model {
-    let mut m = Model::default();
-    let id = |i: usize, j: usize, k: usize| (k * (n + 1) + j) * (n + 1) + i;
-    for k in 0..=nz {
-        for j in 0..=n {
-            for i in 0..=n {
-                m.add_node(
-                    id(i, j, k) as i64 + 1,
-                    [i as f64 * h, j as f64 * h, k as f64 * h],
-                );
-            }
-        }
-    }
-    let p = m.add_part(1, "block", ElementKind::Hex, props);
-    let mut e = 1;
-    for k in 0..nz {
-        for j in 0..n {
-            for i in 0..n {
-                m.add_element(
-                    e,
-                    p,
-                    &[
-                        id(i, j, k),
-                        id(i + 1, j, k),
-                        id(i + 1, j + 1, k),
-                        id(i, j + 1, k),
-                        id(i, j, k + 1),
-                        id(i + 1, j, k + 1),
-                        id(i + 1, j + 1, k + 1),
-                        id(i, j + 1, k + 1),
-                    ],
-                );
-                e += 1;
-            }
-        }
-    }
-    m
+    hex_block(n, n, nz, h, "block", props)
 }
 
 /// OFHC copper, Johnson & Cook (1983), Table 1: A = 90 MPa, B = 292 MPa, n = 0.31,

@@ -375,27 +375,12 @@ fn hex_block(n: usize) -> Model {
     let k = ((n as f64).cbrt().floor() as usize).max(1);
     let nz = (n / (k * k)).max(1);
     let h = 1e-3;
-    let mut m = Model::default();
-    let id = |i: usize, j: usize, l: usize| (l * (k + 1) + j) * (k + 1) + i;
-    for l in 0..=nz {
-        for j in 0..=k {
-            for i in 0..=k {
-                let node = m.add_node(
-                    id(i, j, l) as i64 + 1,
-                    [i as f64 * h, j as f64 * h, l as f64 * h],
-                );
-                if l == 0 {
-                    m.constraints.push((node, [true, true, true]));
-                } else if l == nz {
-                    m.initial_velocities.push((node, [0.0, 0.0, -20.0]));
-                }
-            }
-        }
-    }
-    let p = m.add_part(
-        1,
+    let mut m = weft::generate::block::hex_block(
+        k,
+        k,
+        nz,
+        h,
         "block",
-        ElementKind::Hex,
         PartProps {
             youngs_modulus: Some(200e9),
             poisson_ratio: Some(0.3),
@@ -405,23 +390,13 @@ fn hex_block(n: usize) -> Model {
             ..Default::default()
         },
     );
-    let mut e = 1;
-    for l in 0..nz {
-        for j in 0..k {
-            for i in 0..k {
-                let ns = [
-                    id(i, j, l),
-                    id(i + 1, j, l),
-                    id(i + 1, j + 1, l),
-                    id(i, j + 1, l),
-                    id(i, j, l + 1),
-                    id(i + 1, j, l + 1),
-                    id(i + 1, j + 1, l + 1),
-                    id(i, j + 1, l + 1),
-                ];
-                m.add_element(e, p, &ns);
-                e += 1;
-            }
+    let top = nz as f64 * h;
+    for node in 0..m.num_nodes() {
+        let z = m.coords[node][2];
+        if z == 0.0 {
+            m.constraints.push((node, [true, true, true]));
+        } else if z == top {
+            m.initial_velocities.push((node, [0.0, 0.0, -20.0]));
         }
     }
     m

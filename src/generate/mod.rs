@@ -1,6 +1,7 @@
 //! Canonical model generators behind `weft-weave`. Each returns a validated [`Model`]
 //! with named node sets, ready to simulate.
 
+pub mod block;
 pub mod grid;
 pub mod layers;
 pub mod pulse;

@@ -250,24 +250,16 @@ fn element_step(
     if q_hg > 0.0 && dt > 0.0 {
         let gamma = kernel::hourglass_gamma(x, &g.b);
         let coef = 16.0 * kernel::hourglass_coefficient(q_hg, mat.density, c, g.volume);
-        // Mode velocities q_α = Σ_a γ_aα v_a; forces f_a = −Σ_α γ_aα coef q_α
-        // (Flanagan & Belytschko's viscous form, kernel::hourglass_viscous).
-        let mut cq = [[0.0; 3]; 4];
-        for a in 0..8 {
-            for (al, m) in cq.iter_mut().enumerate() {
-                for i in 0..3 {
-                    m[i] += coef * gamma[a][al] * v[a][i];
-                }
-            }
-        }
+        // Flanagan & Belytschko's viscous form: mode forces coef·q_α, nodal forces
+        // f_a = −Σ_α γ_aα coef q_α.
+        let cq = kernel::hourglass_mode_forces(&gamma, v, coef);
+        kernel::add_hourglass_forces(&gamma, &cq, &mut f);
+        // −½(f^{n−1} + fⁿ)·v^{n−½}: this step's force against v^{n−½} now, the last
+        // step's through its mode forces (γ of this step).
         let mut p = 0.0;
         for a in 0..8 {
             for al in 0..4 {
                 for i in 0..3 {
-                    let fh = -gamma[a][al] * cq[al][i];
-                    f[a][i] += fh;
-                    // −½(f^{n−1} + fⁿ)·v^{n−½}: this step's force against v^{n−½} now,
-                    // the last step's through its mode forces (γ of this step).
                     p += 0.5 * gamma[a][al] * (cq[al][i] + prev.hourglass[al][i]) * v[a][i];
                 }
             }

@@ -338,18 +338,42 @@ pub fn hourglass_viscous(
     coef: f64,
     f: &mut [[f64; 3]; 8],
 ) -> f64 {
-    let mut q = [[0.0; 3]; 4];
+    let cq = hourglass_mode_forces(gamma, v, coef);
+    add_hourglass_forces(gamma, &cq, f);
+    let mut p = 0.0;
     for a in 0..8 {
         for al in 0..4 {
-            axpy(&mut q[al], gamma[a][al], &v[a]);
+            for i in 0..3 {
+                p += gamma[a][al] * cq[al][i] * v[a][i];
+            }
         }
     }
+    p
+}
+
+/// The viscous hourglass control's mode forces coef·q_α = coef Σ_a γ_aα v_a [N], one
+/// vector per mode α (the family keeps them for the next step's energy booking).
+pub fn hourglass_mode_forces(gamma: &[[f64; 4]; 8], v: &[[f64; 3]; 8], coef: f64) -> [Vec3; 4] {
+    let mut cq = [[0.0; 3]; 4];
+    for a in 0..8 {
+        for (al, m) in cq.iter_mut().enumerate() {
+            for i in 0..3 {
+                m[i] += coef * gamma[a][al] * v[a][i];
+            }
+        }
+    }
+    cq
+}
+
+/// f_a −= Σ_α γ_aα (coef q_α): the nodal forces of the mode forces `cq`.
+pub fn add_hourglass_forces(gamma: &[[f64; 4]; 8], cq: &[Vec3; 4], f: &mut [[f64; 3]; 8]) {
     for a in 0..8 {
         for al in 0..4 {
-            axpy(&mut f[a], -coef * gamma[a][al], &q[al]);
+            for i in 0..3 {
+                f[a][i] += -gamma[a][al] * cq[al][i];
+            }
         }
     }
-    coef * q.iter().map(|qa| dot(qa, qa)).sum::<f64>()
 }
 
 /// The viscous hourglass coefficient coef = Q_hg ρ c V^{2/3} / 4 [kg/s] (LS-DYNA Theory
