@@ -477,6 +477,7 @@ fn run_columns(r: &Report, s: &Solver, st: &RunStats) -> Vec<Col> {
         Col::F64("end_time", vec![st.end_time]),
         Col::F64("dt", vec![r.dt]),
         Col::F64("dt_stable", vec![r.dt_stable]),
+        Col::F64("dt_min", vec![s.stable.dt_min]),
         Col::Str("controlling_kind", vec![kind]),
         Col::I64("controlling_element", vec![id]),
         Col::I64("controlling_node", vec![s.node_id[s.stable.node]]),

@@ -235,6 +235,8 @@ pub fn projectile_surface(
             v
         }
         ProjectileShape::Flat => vec![(0.0, 0.0), (0.0, r), (len, r), (len, 0.0)],
+        // A disc of the radius drawn in the plane (the wall has no edge).
+        ProjectileShape::Wall => vec![(0.0, 0.0), (0.0, r)],
     };
     // An orthonormal frame (a, e1, e2), a pointing from the body to the tip.
     let norm = |v: [f64; 3]| {

@@ -369,12 +369,16 @@ fn run_documented(file: &Path) -> Result<(), Failed> {
     }
 }
 
-/// The binaries of the project, from src/bin/.
+/// The binaries of the project, from src/bin/: `NAME.rs` and `NAME/main.rs` (cargo's
+/// two layouts).
 fn binaries() -> Vec<String> {
     let mut v: Vec<String> = std::fs::read_dir(Path::new(ROOT).join("src/bin"))
         .unwrap()
         .filter_map(|e| {
             let p = e.unwrap().path();
+            if p.is_dir() && p.join("main.rs").is_file() {
+                return Some(p.file_name().unwrap().to_string_lossy().to_string());
+            }
             (p.extension()? == "rs").then(|| p.file_stem().unwrap().to_string_lossy().to_string())
         })
         .collect();

@@ -2,12 +2,15 @@
 //! with named node sets, ready to simulate.
 
 pub mod block;
+pub mod cylinder;
 pub mod grid;
 pub mod layers;
+pub mod metals;
 pub mod pulse;
 pub mod rod;
 pub mod square;
 pub mod surround;
+pub mod taylor;
 pub mod weave;
 pub mod woven;
 pub mod woven_reduced;

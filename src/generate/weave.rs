@@ -5,6 +5,7 @@ use std::path::Path;
 
 use super::rod::{build, RodParams};
 use super::square::{girder, membrane, GirderParams, MembraneParams};
+use super::taylor::{taylor, TaylorParams};
 use super::woven::{woven, WovenBandParams};
 use super::woven_reduced::{woven_reduced, WovenParams};
 use super::zones::{combined, CombinedParams};
@@ -22,11 +23,12 @@ pub enum Spec {
     Combined(CombinedParams),
     WovenReduced(WovenParams),
     Woven(WovenBandParams),
+    Taylor(TaylorParams),
 }
 
 impl Spec {
     /// The subcommand's name: `rod`, `girder`, `membrane`, `combined`, `woven-reduced`,
-    /// `woven`.
+    /// `woven`, `taylor`.
     pub fn name(&self) -> &'static str {
         match self {
             Spec::Rod(_) => "rod",
@@ -35,6 +37,7 @@ impl Spec {
             Spec::Combined(_) => "combined",
             Spec::WovenReduced(_) => "woven-reduced",
             Spec::Woven(_) => "woven",
+            Spec::Taylor(_) => "taylor",
         }
     }
 }
@@ -49,9 +52,11 @@ pub fn run(spec: &Spec, out: &Path, on_warning: &mut dyn FnMut(&str)) -> Result<
         Spec::Combined(_) => "the combined model",
         Spec::WovenReduced(_) => "the reduced woven model",
         Spec::Woven(_) => "the yarn-level woven patch",
+        Spec::Taylor(_) => "the Taylor rod",
     };
     let built = match spec {
         Spec::Rod(p) => build(p),
+        Spec::Taylor(p) => taylor(p),
         Spec::Girder(p) => girder(p).map(|(m, warnings)| {
             warnings.iter().for_each(|w| on_warning(w));
             m
@@ -90,6 +95,7 @@ pub fn run(spec: &Spec, out: &Path, on_warning: &mut dyn FnMut(&str)) -> Result<
         Spec::Combined(p) => serde_json::to_value(p),
         Spec::WovenReduced(p) => serde_json::to_value(p),
         Spec::Woven(p) => serde_json::to_value(p),
+        Spec::Taylor(p) => serde_json::to_value(p),
     }
     .expect("parameters serialise");
     let prov = Provenance::new(&format!("weave {}", spec.name()), parameters);

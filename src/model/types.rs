@@ -171,6 +171,9 @@ pub enum ProjectileShape {
     Flat,
     /// Round-nosed cylinder (hemispherical nose).
     Round,
+    /// A rigid plane through the tip, normal to the axis, without bounds: the half-space
+    /// behind it is inside (the Taylor test's wall: prescribed, at rest).
+    Wall,
 }
 
 impl ProjectileShape {
@@ -179,6 +182,7 @@ impl ProjectileShape {
             ProjectileShape::Sphere => "sphere",
             ProjectileShape::Flat => "flat",
             ProjectileShape::Round => "round",
+            ProjectileShape::Wall => "wall",
         }
     }
     pub fn parse(s: &str) -> Option<Self> {
@@ -186,6 +190,7 @@ impl ProjectileShape {
             ProjectileShape::Sphere,
             ProjectileShape::Flat,
             ProjectileShape::Round,
+            ProjectileShape::Wall,
         ]
         .into_iter()
         .find(|k| k.name() == s)
@@ -273,6 +278,12 @@ pub struct Analysis {
     /// ballistic-limit sweep needs (docs/theory.md, "Failure, perforation and the
     /// ballistic limit"). Default false: the run goes to its end time.
     pub stop_on_outcome: bool,
+    /// Let the step follow the solids as they are crushed (LS-DYNA's default for solids):
+    /// each step the hexahedra's stable rows are taken at their current shape and the
+    /// step is lowered to keep the same margin as the first (it never grows back). The
+    /// contact penalties keep the first step's stiffness (so their ωΔt only falls).
+    /// Default false: one step for the whole run, and a crushed solid stops it, named.
+    pub variable_time_step: bool,
 }
 
 impl Default for Analysis {
@@ -287,6 +298,7 @@ impl Default for Analysis {
             history_sets: Vec::new(),
             max_energy_error: 0.1,
             stop_on_outcome: false,
+            variable_time_step: false,
         }
     }
 }

@@ -300,6 +300,7 @@ impl Solver {
                 dt_stable: 0.0,
                 node: 0,
                 element: None,
+                dt_min: 0.0,
             },
             scaling: None,
             analysis: m.analysis.clone(),
@@ -461,6 +462,7 @@ impl Solver {
             dt_stable,
             node,
             element: self.controlling_element(node),
+            dt_min: dt,
         };
         Ok(())
     }
@@ -653,13 +655,18 @@ impl Solver {
         let progress_every = (n_out / 200).max(1);
         let mut last_e = Energies::default();
         let mut stiffening = self.nodal_bound().stiffening_check();
+        // The step of the integration; `dt`, the first, stays the contact penalties' step.
+        let mut dt_step = self.stable.dt_min.min(dt);
         while k <= n_out {
+            if a.variable_time_step {
+                dt_step = self.follow_solids(&mut stiffening, dt_step)?;
+            }
             if self.state.step % STIFFENING_CHECK_EVERY == 0 {
                 self.nodal_bound()
-                    .check_stiffening(&mut stiffening, dt, a.dt_safety)?;
+                    .check_stiffening(&mut stiffening, dt_step, a.dt_safety)?;
             }
             let t2 = self.compute_forces(dt, &mut times);
-            let dt_next = dt;
+            let dt_next = dt_step;
             let snap = k as f64 * a.output_interval <= self.state.t + dt_next;
             let (ke, dp) = self.advance_nodes(snap, dt_next)?;
             // Element energies at t_n (x^n is in xn), before the rotations advance.
@@ -820,6 +827,40 @@ impl Solver {
         }
     }
 
+    /// The variable step (`Analysis::variable_time_step`): the step lowered, never
+    /// raised, to the hexahedra's current stable step times the margin the first step
+    /// had (dt/dt_stable: the safety factor, and the contact guard); a step fallen below
+    /// [`MIN_STEP_FRACTION`] of the first stops the run, naming the element.
+    fn follow_solids(&mut self, k: &mut stable::StiffeningCheck, dt_step: f64) -> Result<f64> {
+        let Some((dt_now, node, most)) = self.nodal_bound().solid_step(k) else {
+            return Ok(dt_step);
+        };
+        let margin = self.stable.dt / self.stable.dt_stable;
+        let dt = dt_step.min(margin * dt_now);
+        if dt < MIN_STEP_FRACTION * self.stable.dt {
+            let what = match most {
+                Some((kind, id, q)) => format!(
+                    "{} `{id}` (crushed to {:.3} of its volume and {:.3} of its length V/A_max)",
+                    kind.name(),
+                    q[0],
+                    q[1]
+                ),
+                None => "its elements".to_string(),
+            };
+            return Err(WeftError::Numerical {
+                what: format!(
+                    "the variable step fell to {dt:.4e} s, below {MIN_STEP_FRACTION} of the first {:.4e} s, at node `{}`: {what}",
+                    self.stable.dt, self.node_id[node]
+                ),
+                step: self.state.step,
+                time: self.state.t,
+                hint: Some("an element this crushed is near inversion: a finer mesh at the impact face, a stiffer hourglass or erosion (the part's erosion_plastic_strain) lets the run go on".into()),
+            });
+        }
+        self.stable.dt_min = self.stable.dt_min.min(dt);
+        Ok(dt)
+    }
+
     /// The projectiles' update from `dt_prev` to `dt_next` (`dt`: the step of their
     /// penalty): their kinetic energy, and at a sample step their state at t_n into `rows`
     /// (tip and contact force, before the update) and their contact energy at t_n.
@@ -963,6 +1004,9 @@ impl Solver {
 /// towards the margin (1/dt_safety² − 1 = 0.23 at 0.9, in 1 + 3E₁₁) is caught before it
 /// has run away; one check costs about one membrane force pass without the forces.
 const STIFFENING_CHECK_EVERY: u64 = 20;
+
+/// The smallest variable step, as a fraction of the first, before a run stops.
+const MIN_STEP_FRACTION: f64 = 1e-2;
 
 /// Set up and run a model in the current thread pool, keeping every output sample in
 /// memory (tests, and stages that run the solver in-process).

@@ -28,6 +28,9 @@ pub struct StableStep {
     pub node: usize,
     /// Its stiffest element.
     pub element: Option<(ElementKind, i64)>,
+    /// The smallest step taken so far [s]: `dt`, unless the analysis' variable step
+    /// lowered it for crushed solids.
+    pub dt_min: f64,
 }
 
 /// What [`NodalBound::check_stiffening`] keeps through a run: the stable step's nodal
@@ -38,6 +41,8 @@ pub struct StiffeningCheck {
     c: Vec<f64>,
     extra: Vec<f64>,
     most: Vec<Option<(f64, ElementKind, i64, [f64; 3])>>,
+    /// The nodes of the hexahedra, ascending (the variable step's nodes).
+    solid_nodes: Vec<usize>,
 }
 
 /// Mass added by mass scaling.
@@ -129,12 +134,52 @@ impl NodalBound<'_> {
     pub fn stiffening_check(&self) -> StiffeningCheck {
         let (s, c) = self.nodal_sums();
         let nn = s.len();
+        let mut solid = vec![false; nn];
+        for ns in &self.op.el.hex.nodes {
+            for &n in ns {
+                solid[n as usize] = true;
+            }
+        }
         StiffeningCheck {
             s,
             c,
             extra: vec![0.0; nn],
             most: vec![None; nn],
+            solid_nodes: (0..nn).filter(|&i| solid[i]).collect(),
         }
+    }
+
+    /// The variable step's bound: the hexahedra's nodal rows at their current shape
+    /// (the reference rows plus what each element's crushing added, as in
+    /// [`NodalBound::check_stiffening`]), and the smallest stable step of their nodes with
+    /// the node's id index and the element that stiffened it most (kind, id, [V/V₀, l/l₀,
+    /// 0]). `None` when the model has no hexahedra.
+    pub fn solid_step(
+        &self,
+        k: &mut StiffeningCheck,
+    ) -> Option<(f64, usize, Option<(ElementKind, i64, [f64; 3])>)> {
+        if k.solid_nodes.is_empty() {
+            return None;
+        }
+        for &i in &k.solid_nodes {
+            k.extra[i] = 0.0;
+            k.most[i] = None;
+        }
+        self.op
+            .el
+            .hex
+            .add_stiffening(&self.state.x, &mut k.extra, &mut k.most);
+        let mut best: Option<(f64, usize)> = None;
+        for &i in &k.solid_nodes {
+            if self.fixed[i] == 0b111 || self.mass[i] <= 0.0 {
+                continue;
+            }
+            let dt_i = nodal_dt(k.s[i] + k.extra[i], k.c[i], self.mass[i], self.alpha);
+            if best.is_none_or(|b| dt_i < b.0) {
+                best = Some((dt_i, i));
+            }
+        }
+        best.map(|(dt, i)| (dt, i, k.most[i].map(|m| (m.1, m.2, m.3))))
     }
 
     /// Stops a run whose membranes have stretched so far that the fixed step no longer

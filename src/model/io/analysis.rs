@@ -48,6 +48,10 @@ pub fn read(r: &mut Reading) -> Result<()> {
             .bool_opt("stop_on_outcome")?
             .and_then(|v| v[0])
             .unwrap_or(d.stop_on_outcome),
+        variable_time_step: t
+            .bool_opt("variable_time_step")?
+            .and_then(|v| v[0])
+            .unwrap_or(d.variable_time_step),
     };
     Ok(())
 }
@@ -67,6 +71,7 @@ pub fn write(m: &Model, w: &Writing) -> Result<()> {
             Col::Str("history_sets", vec![a.history_sets.join(",")]),
             Col::F64("max_energy_error", vec![a.max_energy_error]),
             Col::Bool("stop_on_outcome", vec![a.stop_on_outcome]),
+            Col::Bool("variable_time_step", vec![a.variable_time_step]),
         ]),
     )
 }

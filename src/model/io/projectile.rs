@@ -45,7 +45,7 @@ pub fn read(r: &mut Reading) -> Result<()> {
                 row,
                 format!("unknown projectile shape `{}`", shape[row]),
             )
-            .expected("one of `sphere`, `flat`, `round`")
+            .expected("one of `sphere`, `flat`, `round`, `wall`")
         })?;
         r.model.projectiles.push(ProjectileSpec {
             id: ids[row],

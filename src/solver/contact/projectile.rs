@@ -8,7 +8,8 @@
 //!
 //! Shapes: `sphere` (centre P − R a); `flat` (flat-nosed cylinder: face through P normal
 //! to a, side ρ = R); `round` (round-nosed cylinder: hemisphere of centre P − R a, then
-//! the cylinder ρ = R behind it).
+//! the cylinder ρ = R behind it); `wall` (the plane through P normal to a, unbounded:
+//! every point with s < 0 is inside, pushed out along a; the Taylor test's rigid wall).
 //!
 //! Force on the node f = k g n − friction, on the projectile the opposite (momentum is
 //! exchanged exactly). Friction: f_t = −μ k g t̂ min(1, |v_t|/v_reg), t̂ along the
@@ -97,7 +98,7 @@ impl Projectile {
             ProjectileShape::Sphere | ProjectileShape::Round => Some(std::array::from_fn(|d| {
                 self.tip[d] - self.radius * self.axis[d]
             })),
-            ProjectileShape::Flat => None,
+            ProjectileShape::Flat | ProjectileShape::Wall => None,
         }
     }
 
@@ -119,6 +120,9 @@ impl Projectile {
             let rr = (dc[0] * dc[0] + dc[1] * dc[1] + dc[2] * dc[2]).sqrt();
             (rr < r && rr > 0.0).then(|| (r - rr, [dc[0] / rr, dc[1] / rr, dc[2] / rr]))
         };
+        if self.shape == ProjectileShape::Wall {
+            return Some((-s, *a));
+        }
         let radial = [d[0] - s * a[0], d[1] - s * a[1], d[2] - s * a[2]];
         let rho2 = radial[0] * radial[0] + radial[1] * radial[1] + radial[2] * radial[2];
         // Every shape lies within the radius of the axis: a point farther out is not
@@ -157,6 +161,7 @@ impl Projectile {
                     None
                 }
             }
+            ProjectileShape::Wall => Some((-s, *a)),
         }
     }
 }

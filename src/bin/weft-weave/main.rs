@@ -9,6 +9,9 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
+mod taylor;
+use taylor::TaylorArgs;
+
 use weft::generate::rod::RodParams;
 use weft::generate::square::{
     GirderParams, GirderZoneOptions, LoadCase, MembraneOptions, MembraneParams, Square,
@@ -96,6 +99,15 @@ enum Model {
         after_help = "Example:\n  weft-weave woven --yarns 10 --out runs/woven\n  weft-weave woven --yarns 10 --layers 2 --failure-strain 0.036 --projectile-velocity 100 \\\n    --out runs/two"
     )]
     Woven(WovenBandArgs),
+    /// The Taylor test: a flat-ended metal cylinder (hexahedra, Johnson–Cook) strikes a
+    /// rigid frictionless wall at U. Quarter model (symmetry planes x = 0, y = 0); the
+    /// rod along z from the wall at z = 0; the step follows the crushed foot. Node sets:
+    /// axis, impact_face, impact_edge (the foot's rim), rear_face. Default: Johnson &
+    /// Cook's OFHC copper rod, 25.4 mm × 7.6 mm at 190 m/s.
+    #[command(
+        after_help = "Example:\n  weft-weave taylor --radial 8 --material aluminium --velocity 200 --out runs/taylor"
+    )]
+    Taylor(TaylorArgs),
 }
 
 #[derive(clap::Args)]
@@ -926,6 +938,7 @@ fn run() -> anyhow::Result<ExitCode> {
         Model::Combined(a) => a.weave(),
         Model::WovenReduced(a) => a.weave(),
         Model::Woven(a) => a.weave(),
+        Model::Taylor(a) => a.weave(),
     }?;
     Ok(ExitCode::SUCCESS)
 }
@@ -933,6 +946,7 @@ fn run() -> anyhow::Result<ExitCode> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use weft::generate::taylor::TaylorParams;
 
     /// The subcommand `args` with `--out` and nothing else given.
     fn parse(args: &[&str]) -> Model {
@@ -982,5 +996,9 @@ mod tests {
             panic!()
         };
         assert_eq!(json(&a.params().surround), json(&Some(Surround::default())));
+        let Model::Taylor(a) = parse(&["taylor"]) else {
+            panic!()
+        };
+        assert_eq!(json(&a.params()), json(&TaylorParams::default()));
     }
 }
