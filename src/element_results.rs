@@ -24,8 +24,8 @@
 //!   [`crate::solver::solid::hex::HexGroup::output`], which the simulate stage sets to
 //!   [`ElementResults::hex_elements`]; the hex nodes need no history):
 //!   `plastic_strain` the equivalent plastic strain ε_p = ∫√(⅔ ε̇ᵖ:ε̇ᵖ) dt,
-//!   `temperature` T [K] (Johnson–Cook's adiabatic heating; the room temperature, or
-//!   293.15 K, for J2 and elastic parts), `pressure` p = −tr σ/3 [Pa] (compression
+//!   `temperature` T [K] (Johnson–Cook: from the part's `room_temperature` up by the
+//!   adiabatic heating; J2 and elastic parts: 293.15 K throughout), `pressure` p = −tr σ/3 [Pa] (compression
 //!   positive; the Cauchy stress alone, without the bulk viscosity q that the element
 //!   adds to it in its forces), `von_mises_stress` σ̄ = √(3/2 s:s) [Pa], s the deviator.
 //!   The other quantity columns are null (`energy` too: the element's internal work in

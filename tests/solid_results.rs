@@ -205,6 +205,26 @@ fn a_j2_cube_pulled_past_yield_reports_the_bilinear_plastic_strain_pressure_and_
     // Measured 4.0e-5 relative (p = −σ/3, compression positive: the sign swapped is 2/3
     // off); tolerance 1.5e-4.
     assert!(e_p < 1.5e-4, "pressure off by {e_p:e}");
+    // weft-vtk carries the new columns as cell data.
+    let vtk = weft::vtk::run(&weft::vtk::Config {
+        model: dir.path().join("model"),
+        history: out.join("history.parquet"),
+        out: dir.path().join("vtk"),
+        every: 50,
+        reference_points: false,
+    })
+    .unwrap();
+    for c in [
+        "plastic_strain",
+        "temperature",
+        "pressure",
+        "von_mises_stress",
+    ] {
+        assert!(
+            vtk.element_results.iter().any(|x| x == c),
+            "{c} not in the VTK cell data"
+        );
+    }
 }
 
 #[test]
