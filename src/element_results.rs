@@ -1,6 +1,7 @@
 //! Element results at the output times (`weft-simulate --element-results PART`):
 //! `elements.parquet`, one row per output time and selected element, computed from the
-//! nodal positions and velocities of the history sample with the solver's own kernels.
+//! nodal positions and velocities of the history sample with the solver's own kernels;
+//! a hexahedron's row instead from the solver's own state (below).
 //!
 //! Glossary: X reference (stress-free) positions, u₀ a formed model's initial
 //! displacement, u(t), v(t) the history's displacement and velocity, so the current
@@ -17,19 +18,40 @@
 //! - tri, quad: Green strain [E₁₁, E₂₂, 2E₁₂] in material axes, second Piola–Kirchhoff
 //!   stress S = D E + S₀ (tension field applied), membrane strain energy A₀ s (½E·DE + S₀·E)
 //!   without the hourglass part ([`crate::solver::membrane`]);
+//! - hex: the integration point's state, which depends on the path and not on the
+//!   positions alone, handed over by the solver at its sample steps
+//!   ([`crate::solver::Sink::solids`], the elements of
+//!   [`crate::solver::solid::hex::HexGroup::output`], which the simulate stage sets to
+//!   [`ElementResults::hex_elements`]; the hex nodes need no history):
+//!   `plastic_strain` the equivalent plastic strain ε_p = ∫√(⅔ ε̇ᵖ:ε̇ᵖ) dt,
+//!   `temperature` T [K] (Johnson–Cook: from the part's `room_temperature` up by the
+//!   adiabatic heating; J2 and elastic parts: 293.15 K throughout), `pressure` p = −tr σ/3 [Pa] (compression
+//!   positive; the Cauchy stress alone, without the bulk viscosity q that the element
+//!   adds to it in its forces), `von_mises_stress` σ̄ = √(3/2 s:s) [Pa], s the deviator.
+//!   The other quantity columns are null (`energy` too: the element's internal work in
+//!   the ledger holds the plastic work, which is no stored energy). An eroded hexahedron
+//!   keeps its row: `plastic_strain` and `temperature` as it eroded, `pressure` and
+//!   `von_mises_stress` 0 (its forces are zero from then on; at an output time between
+//!   the step before its erosion and the erosion step they are interpolated like any
+//!   other value). The static solve has no solid stiffness: it writes no hex rows;
 //! - point masses have no row.
 //!
 //! `energy` [J]: the element's stored elastic energy as above (truss, link without a
-//! slider, membranes; null for beams, whose bending energy needs the rotations).
+//! slider, membranes; null for beams, whose bending energy needs the rotations, and for
+//! hexahedra).
 //!
 //! Between solver steps the history is interpolated linearly; the element quantities
-//! here are those of the interpolated positions (the same at the steps themselves).
+//! here are those of the interpolated positions (the same at the steps themselves). A
+//! hexahedron's σ, ε_p and T are interpolated linearly between the two steps around the
+//! output time, and p and σ̄ taken of the interpolated σ.
 
 use std::path::Path;
 
 use crate::error::{Result, WeftError};
 use crate::model::{ElementKind, Model};
 use crate::solver::membrane::{self, Material, Reference};
+use crate::solver::output::SolidValues;
+use crate::solver::solid::material;
 use crate::solver::{truss, Energies, Sink};
 use crate::table::{batch, write_table, Col, Provenance};
 
@@ -74,6 +96,10 @@ pub struct ElementResults {
     x0: Vec<[f64; 3]>,
     /// Model node index → position in the history's node list.
     slot: Vec<usize>,
+    /// The selected hexahedra: rows of the model's hex table, their ids and part ids.
+    hex: Vec<u32>,
+    hex_id: Vec<i64>,
+    hex_part_id: Vec<i64>,
     rows: Rows,
 }
 
@@ -84,11 +110,14 @@ struct Rows {
     part_id: Vec<i64>,
     kind: Vec<String>,
     /// Nullable quantity columns, in [`COLUMNS`] order.
-    q: [Vec<Option<f64>>; 15],
+    q: [Vec<Option<f64>>; 19],
 }
 
+/// The quantity columns computed from the history (all but the hexahedra's).
+const HISTORY_COLUMNS: usize = 15;
+
 /// The quantity columns of `elements.parquet`, in order.
-pub const COLUMNS: [&str; 15] = [
+pub const COLUMNS: [&str; 19] = [
     "axial_strain",
     "axial_force",
     "relative_displacement_x",
@@ -104,6 +133,10 @@ pub const COLUMNS: [&str; 15] = [
     "stress_22",
     "stress_12",
     "energy",
+    "plastic_strain",
+    "temperature",
+    "pressure",
+    "von_mises_stress",
 ];
 
 impl ElementResults {
@@ -146,6 +179,9 @@ impl ElementResults {
             items: vec![],
             x0,
             slot,
+            hex: vec![],
+            hex_id: vec![],
+            hex_part_id: vec![],
             rows: Rows::default(),
         };
         let sub = |a: usize, b: usize| -> [f64; 3] {
@@ -157,8 +193,15 @@ impl ElementResults {
             for e in 0..b.len() {
                 let part = &m.parts[b.part[e]];
                 // Point masses carry no result; a hex's stress, plastic strain and temperature
-                // depend on the path, not on the history's positions alone: not recomputed.
-                if !chosen[b.part[e]] || matches!(kind, ElementKind::PointMass | ElementKind::Hex) {
+                // depend on the path, not on the history's positions alone: the solver hands
+                // them over ([`ElementResults::sample_solids`]), its nodes need no history.
+                if !chosen[b.part[e]] || kind == ElementKind::PointMass {
+                    continue;
+                }
+                if kind == ElementKind::Hex {
+                    r.hex.push(e as u32);
+                    r.hex_id.push(b.id[e]);
+                    r.hex_part_id.push(part.id);
                     continue;
                 }
                 let nodes = &b.nodes[npe * e..npe * (e + 1)];
@@ -209,13 +252,54 @@ impl ElementResults {
         Ok(r)
     }
 
-    /// Number of selected elements.
+    /// Number of selected elements whose quantities come from the history (all but the
+    /// hexahedra).
     pub fn len(&self) -> usize {
         self.items.len()
     }
 
     pub fn is_empty(&self) -> bool {
         self.items.is_empty()
+    }
+
+    /// The selected hexahedra, as rows of the model's hex table (the indices of the
+    /// solver's hex family): what [`crate::solver::solid::hex::HexGroup::output`] must
+    /// hold for the run to hand over their states.
+    pub fn hex_elements(&self) -> &[u32] {
+        &self.hex
+    }
+
+    /// Add the hexahedra's rows of output time `t` from their states (in the order of
+    /// [`ElementResults::hex_elements`]).
+    pub fn sample_solids(&mut self, t: f64, states: &[SolidValues]) -> Result<()> {
+        if states.len() != self.hex.len() {
+            return Err(WeftError::input(format!(
+                "element results: the run handed over {} hexahedra at t = {t:e} s, {} were selected",
+                states.len(),
+                self.hex.len()
+            ))
+            .hint("set the solver's hex output to ElementResults::hex_elements before the run"));
+        }
+        for (j, st) in states.iter().enumerate() {
+            let s: [f64; 6] = std::array::from_fn(|c| st[c]);
+            self.rows.t.push(t);
+            self.rows.id.push(self.hex_id[j]);
+            self.rows.part_id.push(self.hex_part_id[j]);
+            self.rows.kind.push(ElementKind::Hex.name().to_string());
+            for c in &mut self.rows.q[..HISTORY_COLUMNS] {
+                c.push(None);
+            }
+            let new = [
+                st[6],
+                st[7],
+                material::pressure(&s),
+                material::von_mises(&s),
+            ];
+            for (c, v) in self.rows.q[HISTORY_COLUMNS..].iter_mut().zip(new) {
+                c.push(Some(v));
+            }
+        }
+        Ok(())
     }
 
     /// Add the rows of output time `t` from the history sample (u, v of the output
@@ -229,6 +313,9 @@ impl ElementResults {
             self.rows.kind.push(self.kind[e].to_string());
             for (c, v) in q.into_iter().enumerate() {
                 self.rows.q[c].push(v);
+            }
+            for c in &mut self.rows.q[HISTORY_COLUMNS..] {
+                c.push(None);
             }
         }
     }
@@ -398,5 +485,9 @@ impl<S: Sink> Sink for WithElementResults<'_, S> {
     }
     fn layers(&mut self, t: f64, rows: &[crate::solver::watch::LayerValues]) -> Result<()> {
         self.inner.layers(t, rows)
+    }
+    fn solids(&mut self, t: f64, rows: &[SolidValues]) -> Result<()> {
+        self.results.sample_solids(t, rows)?;
+        self.inner.solids(t, rows)
     }
 }

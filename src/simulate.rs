@@ -191,6 +191,10 @@ pub fn run(c: &Config, progress: &mut (dyn FnMut(f64) + Send)) -> Result<Report>
     let mut elements = (!c.element_results.is_empty())
         .then(|| ElementResults::new(&m, &c.element_results, &solver.output_nodes))
         .transpose()?;
+    if let Some(e) = &elements {
+        // The selected hexahedra's states come from the run itself (path-dependent).
+        solver.op.el.hex.output = e.hex_elements().to_vec();
+    }
     std::fs::create_dir_all(&c.out).map_err(|e| WeftError::io(&c.out, e))?;
     if c.static_solve {
         return run_static(c, &m, &solver, &prov, t_setup, elements);

@@ -21,9 +21,10 @@
 //! `node_id` (Int64), and for models with membranes `thickness` (Float64: the nodal
 //! thickness of the bands, the mean over the membrane elements at the node of their
 //! thickness there, 0 at nodes without membranes). Cell data: `element_id`, `part_id`
-//! (Int64), `kind` (Int32: 0 truss, 1 link, 2 point mass, 3 tri, 4 quad, 5 beam), and the
-//! element results of `elements.parquet` when the run wrote them (`axial_force`,
-//! `strain_11`, … : NaN where a quantity does not apply to the element).
+//! (Int64), `kind` (Int32: 0 truss, 1 link, 2 point mass, 3 tri, 4 quad, 5 beam, 6 hex),
+//! and the element results of `elements.parquet` when the run wrote them (`axial_force`,
+//! `strain_11`, …, a hexahedron's `plastic_strain`, `temperature`, `pressure`,
+//! `von_mises_stress`: NaN where a quantity does not apply to the element).
 //!
 //! Format: VTK XML, version 0.1, `binary` inline data (base64 of a UInt32 byte count
 //! followed by the little-endian values), so values round-trip exactly. The writer is

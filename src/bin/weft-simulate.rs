@@ -61,8 +61,10 @@ struct Cli {
     all_nodes: bool,
     /// Write element results of this part at the output times to elements.parquet
     /// (repeatable; `all`: every part): axial strain and force (trusses, beams), relative
-    /// displacement and force (links), Green strain and stress (membranes), energy. The
-    /// history must hold the parts' nodes (--all-nodes).
+    /// displacement and force (links), Green strain and stress (membranes), energy;
+    /// plastic strain, temperature, pressure and von Mises stress (hexahedra, from the
+    /// solver's state). The history must hold the parts' nodes (--all-nodes), but for
+    /// hexahedra.
     #[arg(long = "element-results", value_name = "PART")]
     element_results: Vec<String>,
     /// Stop when the energy balance error exceeds this fraction [model default 0.1].

@@ -686,6 +686,7 @@ impl Solver {
             times.update += t3 - t2;
             if snap {
                 last_e = self.book_sample(ke, &el_e, contact_e, &mut sampler)?;
+                self.op.el.hex.sample_states(&mut sampler.cur.solids);
                 if self.watch.is_active() {
                     self.watch_sample(&mut sampler.cur.layers);
                 }

@@ -2,6 +2,12 @@
 //! `Sampler` that interpolates the steps onto that grid, and the sinks: in memory (tests,
 //! the fit stage) and streaming Parquet (the `simulate` stage). Layouts of
 //! `history.parquet` and `energy.parquet`: docs/tables.md.
+//!
+//! Solver state that the nodal history cannot give (a hexahedron's stress, plastic strain
+//! and temperature depend on the path) goes out the same way: the elements listed in
+//! [`crate::solver::solid::hex::HexGroup::output`] (empty unless element results of hex
+//! parts were asked for: then nothing is collected) are read at the sample steps into
+//! the snapshot and interpolated onto the grid like the nodes ([`Sink::solids`]).
 
 use std::path::Path;
 use std::sync::Arc;
@@ -27,7 +33,17 @@ pub trait Sink {
     fn layers(&mut self, _t: f64, _rows: &[LayerValues]) -> Result<()> {
         Ok(())
     }
+    /// The states of the sampled hexahedra at time t, in the order of
+    /// [`crate::solver::solid::hex::HexGroup::output`] (only when that is not empty).
+    fn solids(&mut self, _t: f64, _rows: &[SolidValues]) -> Result<()> {
+        Ok(())
+    }
 }
+
+/// One hexahedron's integration point at a sample: σ [Pa] (Voigt xx, yy, zz, xy, yz, zx),
+/// the equivalent plastic strain ε_p and the temperature T [K]. An eroded element's σ is
+/// 0 (it carries none), its ε_p and T those it eroded with.
+pub type SolidValues = [f64; 8];
 
 /// One snapshot of the output nodes at a step.
 #[derive(Debug, Clone, Default)]
@@ -40,6 +56,8 @@ pub(super) struct Snapshot {
     pub(super) proj: Vec<[f64; 9]>,
     /// Per layer of a fabric (layer 1 first), its values (see [`super::watch`]).
     pub(super) layers: Vec<LayerValues>,
+    /// The sampled hexahedra's states (see [`SolidValues`]).
+    pub(super) solids: Vec<SolidValues>,
 }
 
 /// Linear interpolation of the step snapshots onto the fixed output grid t_k = k·Δt_out.
@@ -50,6 +68,7 @@ pub(super) struct Sampler {
     interp_u: Vec<[f64; 3]>,
     interp_v: Vec<[f64; 3]>,
     interp_layers: Vec<LayerValues>,
+    interp_solids: Vec<SolidValues>,
 }
 
 impl Sampler {
@@ -66,6 +85,7 @@ impl Sampler {
             interp_u: vec![[0.0; 3]; nout],
             interp_v: vec![[0.0; 3]; nout],
             interp_layers: vec![],
+            interp_solids: vec![],
         }
     }
 
@@ -129,6 +149,19 @@ impl Sampler {
                     &self.interp_layers
                 };
                 sink.layers(tk, rows)?;
+            }
+            if !cur.solids.is_empty() {
+                let rows = if w >= 1.0 || prev.solids.len() != cur.solids.len() {
+                    &cur.solids
+                } else {
+                    self.interp_solids.clear();
+                    for (a, b) in prev.solids.iter().zip(&cur.solids) {
+                        self.interp_solids
+                            .push(std::array::from_fn(|c| a[c] + w * (b[c] - a[c])));
+                    }
+                    &self.interp_solids
+                };
+                sink.solids(tk, rows)?;
             }
             progress(*k, tk);
             *k += 1;

@@ -43,6 +43,7 @@ use crate::model::{ElementKind, PartProps};
 use crate::solver::family::{
     chunk_partials, Build, EnergyGroup, EnergyPartial, Family, ForceCtx, StiffCtx, CHUNK,
 };
+use crate::solver::output::SolidValues;
 use crate::solver::vec3::Vec3;
 
 /// The material of a part's hexahedra, from its columns (`docs/tables.md`): elastic;
@@ -136,6 +137,10 @@ pub struct HexGroup {
     pub l0: Vec<f64>,
     /// The element's Gershgorin row sums S_a at the reference [N/m] (module docs).
     pub rows: Vec<[f64; 8]>,
+    /// The elements (indices into this group, which are the rows of the model's hex
+    /// table) whose state the run's output samples carry ([`HexGroup::sample_states`]);
+    /// empty (the default): none, and sampling costs nothing.
+    pub output: Vec<u32>,
     partials: Vec<EnergyPartial>,
 }
 
@@ -271,6 +276,27 @@ fn element_step(
 }
 
 impl HexGroup {
+    /// At an output sample step: the state at tⁿ of the elements in [`HexGroup::output`],
+    /// in that order, into `rows` (σ, ε_p, T; an eroded element's σ as 0: its forces are
+    /// zero from then on, while its point keeps the stress it eroded with).
+    pub fn sample_states(&self, rows: &mut Vec<SolidValues>) {
+        rows.clear();
+        for &e in &self.output {
+            let st = &self.state[e as usize];
+            let s = if st.eroded { [0.0; 6] } else { st.stress };
+            rows.push([
+                s[0],
+                s[1],
+                s[2],
+                s[3],
+                s[4],
+                s[5],
+                st.plastic_strain,
+                st.temperature,
+            ]);
+        }
+    }
+
     /// For the stiffening check of the fixed step ([`crate::solver::stable`]): each
     /// element's rows S_a at its current shape less the reference ones it was given,
     /// added to its nodes where they have grown (a crushed element: |b|²V grows as it
