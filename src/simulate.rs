@@ -98,16 +98,7 @@ pub fn apply_overrides(m: &mut Model, c: &Config) {
         a.stop_on_outcome = v;
     }
     if let Some(speed) = c.projectile_velocity {
-        for p in &mut m.projectiles {
-            let v = p.velocity;
-            let n = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-            let dir = if n > 0.0 {
-                [v[0] / n, v[1] / n, v[2] / n]
-            } else {
-                p.axis
-            };
-            p.velocity = [speed * dir[0], speed * dir[1], speed * dir[2]];
-        }
+        m.set_striking_speed(speed);
     }
 }
 
@@ -118,12 +109,12 @@ fn check_overrides(m: &Model, c: &Config) -> Result<()> {
             return Err(WeftError::input(format!("--projectile-velocity = `{v}`"))
                 .expected("a striking speed ≥ 0 in m/s"));
         }
-        if m.projectiles.is_empty() {
+        if !m.has_striker() {
             return Err(WeftError::input(format!(
                 "--projectile-velocity {v} for a model without a projectile"
             ))
             .in_file(c.model.join("projectile.parquet"))
-            .expected("a model with a projectile (weft-weave woven or woven-reduced)"));
+            .expected("a model with a projectile, or a deformable bullet (node set `bullet`): weft-weave woven or woven-reduced"));
         }
     }
     Ok(())

@@ -52,16 +52,7 @@ impl Sink for Discard {
 /// One impact of `m` at `v` [m/s], run to its outcome.
 pub fn impact(m: &Model, v: f64, label: &str) -> Result<(Run, u64, f64)> {
     let mut m = m.clone();
-    for p in &mut m.projectiles {
-        let d = p.velocity;
-        let n = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
-        let dir = if n > 0.0 {
-            [d[0] / n, d[1] / n, d[2] / n]
-        } else {
-            p.axis
-        };
-        p.velocity = [v * dir[0], v * dir[1], v * dir[2]];
-    }
+    m.set_striking_speed(v);
     m.analysis.stop_on_outcome = true;
     let mut s = Solver::new(&m)?;
     let stats = s
@@ -130,10 +121,10 @@ pub fn search(
         ))
         .expected("a tolerance > 0 in m/s and at least one impact per round"));
     }
-    if m.projectiles.is_empty() {
+    if !m.has_striker() {
         return Err(WeftError::input("the model has no projectile")
             .in_file("projectile.parquet")
-            .expected("a model with a projectile (weft-weave woven)"));
+            .expected("a model with a projectile or a deformable bullet (node set `bullet`): weft-weave woven"));
     }
     let mut runs: Vec<Impact> = Vec::new();
     // The first round takes the bracket's ends and points between them.

@@ -20,7 +20,7 @@ pub struct Disk {
 }
 
 impl Disk {
-    fn point(&mut self, p: [f64; 2]) -> usize {
+    pub(crate) fn point(&mut self, p: [f64; 2]) -> usize {
         let k = (
             (p[0] / self.unit).round() as i64,
             (p[1] / self.unit).round() as i64,

@@ -2,6 +2,7 @@
 //! with named node sets, ready to simulate.
 
 pub mod block;
+pub mod bullet;
 pub mod cylinder;
 pub mod grid;
 pub mod layers;

@@ -16,6 +16,7 @@ pub mod contacts;
 pub mod io;
 pub mod kinds;
 pub mod props;
+pub mod striker;
 pub mod types;
 pub mod validate;
 mod validate_contacts;

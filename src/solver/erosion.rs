@@ -74,13 +74,40 @@ impl Solver {
             .projectiles
             .projectiles
             .first()
-            .map(|p| (p.tip, p.v_full, p.force, p.radius));
+            .map(|p| (p.tip, p.v_full, p.force, p.radius))
+            .or_else(|| self.bullet_state());
         let w = &mut self.watch;
         w.back_face_peak = w.back_face_peak.max(back);
         w.last_rows.clone_from(rows);
         if let Some((tip, v, f, radius)) = proj {
             w.judge(t, &tip, &v, &f, radius);
         }
+    }
+
+    /// A deformable bullet as the watch judges it at t_n: its most advanced node's
+    /// position as the tip, its momentum over its mass as the velocity, the contact forces
+    /// on its nodes summed, its radius.
+    fn bullet_state(&self) -> Option<([f64; 3], [f64; 3], [f64; 3], f64)> {
+        let w = &self.watch;
+        let a = w.axis()?;
+        if w.bullet.is_empty() {
+            return None;
+        }
+        let (xn, vn, fcon) = (&self.state.xn, &self.state.vn, &self.op.fcon);
+        let (mut tip, mut best) = ([0.0; 3], f64::NEG_INFINITY);
+        let (mut p, mut m, mut f) = ([0.0; 3], 0.0, [0.0; 3]);
+        for &i in &w.bullet {
+            let s = dot(&xn[i], &a);
+            if s > best {
+                (tip, best) = (xn[i], s);
+            }
+            m += self.mass[i];
+            for d in 0..3 {
+                p[d] += self.mass[i] * vn[i][d];
+                f[d] += fcon[i][d];
+            }
+        }
+        Some((tip, [p[0] / m, p[1] / m, p[2] / m], f, w.bullet_radius))
     }
 
     /// The failures of the force pass just done: logged, their nodes' attachments

@@ -99,6 +99,12 @@ pub struct Watch {
     pub back_face_peak: f64,
     /// The layers' values at the last sample.
     pub last_rows: Vec<LayerValues>,
+    /// A deformable bullet's nodes (`Model::bullet_nodes`), judged as the projectile is:
+    /// its most advanced node as the tip, its mass-weighted velocity, the sum of the
+    /// contact forces on its nodes; empty with a rigid projectile or none.
+    pub bullet: Vec<usize>,
+    /// The bullet's radius about the line through its initial tip along the axis [m].
+    pub bullet_radius: f64,
 }
 
 impl Watch {
@@ -113,6 +119,29 @@ impl Watch {
             }),
             ..Default::default()
         };
+        if w.axis.is_none() {
+            if let (Some(nodes), Some(a)) = (m.bullet_nodes(), m.bullet_direction()) {
+                let along = |x: &[f64; 3]| x[0] * a[0] + x[1] * a[1] + x[2] * a[2];
+                let tip = nodes
+                    .iter()
+                    .map(|&i| m.coords[i])
+                    .max_by(|p, q| along(p).total_cmp(&along(q)));
+                if let Some(tip) = tip {
+                    w.bullet_radius = nodes
+                        .iter()
+                        .map(|&i| {
+                            let x = m.coords[i];
+                            let d = [x[0] - tip[0], x[1] - tip[1], x[2] - tip[2]];
+                            let s = along(&d);
+                            let r = [d[0] - s * a[0], d[1] - s * a[1], d[2] - s * a[2]];
+                            (r[0] * r[0] + r[1] * r[1] + r[2] * r[2]).sqrt()
+                        })
+                        .fold(0.0, f64::max);
+                    w.bullet = nodes.to_vec();
+                    w.axis = Some(a);
+                }
+            }
+        }
         let mut yarn_index: HashMap<(usize, i64), u32> = HashMap::new();
         let mut section_index: HashMap<(u32, i64), u32> = HashMap::new();
         for kind in [ElementKind::Truss, ElementKind::Tri, ElementKind::Quad] {

@@ -9,7 +9,9 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
+mod bullet;
 mod taylor;
+use bullet::BulletArgs;
 use taylor::TaylorArgs;
 
 use weft::generate::rod::RodParams;
@@ -215,6 +217,8 @@ struct WovenBandArgs {
     /// Projectile–yarn friction coefficient.
     #[arg(long, default_value_t = WovenBandParams::default().projectile_friction)]
     projectile_friction: f64,
+    #[command(flatten)]
+    bullet: BulletArgs,
     /// Simulated time [s].
     #[arg(long, default_value_t = WovenBandParams::default().end_time)]
     end_time: f64,
@@ -901,6 +905,7 @@ impl WovenBandArgs {
                 contact_damping: self.projectile_contact_damping,
             },
             stop_on_outcome: self.stop_on_outcome,
+            bullet: self.bullet.params(),
         }
     }
 

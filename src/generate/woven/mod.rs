@@ -253,7 +253,26 @@ pub fn woven(p: &WovenBandParams) -> Result<(Model, WovenInfo)> {
             });
         }
     }
-    add_projectile(&mut m, p, &weave.section, built.top);
+    let yarn_parts: Vec<usize> = built.parts.iter().flat_map(|&(a, b)| [a, b]).collect();
+    match &p.bullet {
+        None => add_projectile(&mut m, p, &weave.section, built.top),
+        Some(b) => {
+            let b = crate::generate::bullet::BulletParams {
+                diameter: 2.0 * p.projectile_radius,
+                mass: p.projectile_mass,
+                ..b.clone()
+            };
+            crate::generate::bullet::add_to(
+                &mut m,
+                &b,
+                [0.0, 0.0, built.top + 1e-6],
+                p.projectile_velocity,
+                p.quarter,
+                p.projectile_friction,
+                &yarn_parts,
+            )?;
+        }
+    }
     insert_sets(&mut m, built);
     m.analysis = Analysis {
         end_time: p.end_time,
@@ -266,8 +285,12 @@ pub fn woven(p: &WovenBandParams) -> Result<(Model, WovenInfo)> {
             "diagonal_weft".into(),
         ],
         stop_on_outcome: p.stop_on_outcome,
+        variable_time_step: p.bullet.is_some(),
         ..Analysis::default()
     };
+    if p.bullet.is_some() {
+        m.analysis.history_sets.push("bullet".into());
+    }
     let area = weave.section.lens.area();
     let info = WovenInfo {
         thickness_scale: weave.section.scale,

@@ -179,6 +179,10 @@ pub struct WovenBandParams {
     /// End the run once the projectile is arrested or has perforated (analysis
     /// `stop_on_outcome`: a ballistic sweep's runs).
     pub stop_on_outcome: bool,
+    /// A deformable bullet of hexahedra instead of the rigid projectile (its diameter
+    /// twice `projectile_radius`, its mass `projectile_mass`, at `projectile_velocity`,
+    /// friction `projectile_friction`): [`crate::generate::bullet`]. None: rigid.
+    pub bullet: Option<crate::generate::bullet::BulletParams>,
 }
 
 /// A graded orthotropic membrane around a quarter patch (the paper's §3: a small woven
@@ -263,6 +267,7 @@ impl Default for WovenBandParams {
             surround: None,
             failure: YarnFailure::default(),
             stop_on_outcome: false,
+            bullet: None,
         }
     }
 }

@@ -1,0 +1,54 @@
+//! The deformable bullet's flags, shared by `weft-weave woven` (flattened into its
+//! arguments).
+
+use weft::generate::bullet::{BulletKind, BulletParams};
+use weft::generate::metals::Metal;
+
+/// Rigid projectile or deformable bullet.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum Projectile {
+    /// A rigid shape (--projectile-shape).
+    Rigid,
+    /// A bullet of hexahedra with Johnson–Cook metals (--bullet, --bullet-material).
+    Deformable,
+}
+
+#[derive(clap::Args)]
+pub struct BulletArgs {
+    /// The projectile: a rigid shape, or a deformable 9 mm round-nose bullet of
+    /// hexahedra (its diameter 2 × --projectile-radius, its mass --projectile-mass; docs/
+    /// theory.md, "The deformable bullet").
+    #[arg(long, value_enum, default_value_t = Projectile::Rigid)]
+    projectile: Projectile,
+    /// The deformable bullet: homogeneous (`lead`, the paper's) or a full metal jacket
+    /// (`fmj`: a core in a jacket).
+    #[arg(long, value_enum, default_value_t = BulletParams::default().kind)]
+    bullet: BulletKind,
+    /// The bullet's metal (the core's for fmj).
+    #[arg(long, value_enum, default_value_t = BulletParams::default().core)]
+    bullet_material: Metal,
+    /// The fmj bullet's jacket metal.
+    #[arg(long, value_enum, default_value_t = BulletParams::default().jacket)]
+    bullet_jacket: Metal,
+    /// Cells from the bullet's axis to its rim (even, ≥ 2).
+    #[arg(long, default_value_t = BulletParams::default().radial)]
+    bullet_radial: usize,
+    /// Erode a bullet hexahedron at this equivalent plastic strain [default: never].
+    #[arg(long)]
+    bullet_erosion_strain: Option<f64>,
+}
+
+impl BulletArgs {
+    /// The bullet's parameters when deformable (diameter and mass are set from the
+    /// projectile's flags by the generator).
+    pub fn params(&self) -> Option<BulletParams> {
+        (self.projectile == Projectile::Deformable).then(|| BulletParams {
+            kind: self.bullet,
+            core: self.bullet_material,
+            jacket: self.bullet_jacket,
+            radial: self.bullet_radial,
+            erosion_plastic_strain: self.bullet_erosion_strain,
+            ..Default::default()
+        })
+    }
+}

@@ -1,0 +1,78 @@
+//! What strikes the target: the rigid projectiles (`projectile.parquet`) or a deformable
+//! bullet, the hexahedra whose nodes form the node set [`BULLET_SET`] (`weft-weave woven
+//! --projectile deformable` writes it). One place for what the stages that set a striking
+//! speed (`weft-simulate --projectile-velocity`, `weft-ballistic search`) and the run's
+//! watch of the outcome need of either.
+
+use super::types::Model;
+
+/// The node set of a deformable projectile.
+pub const BULLET_SET: &str = "bullet";
+
+impl Model {
+    /// Whether something strikes: a rigid projectile or a deformable bullet.
+    pub fn has_striker(&self) -> bool {
+        !self.projectiles.is_empty() || self.node_sets.contains_key(BULLET_SET)
+    }
+
+    /// The deformable bullet's nodes, when the model has one (and no rigid projectile,
+    /// which takes precedence).
+    pub fn bullet_nodes(&self) -> Option<&[usize]> {
+        if !self.projectiles.is_empty() {
+            return None;
+        }
+        self.node_sets.get(BULLET_SET).map(|v| v.as_slice())
+    }
+
+    /// The direction a deformable bullet flies: the mean of its nodes' initial
+    /// velocities, unit; −z when they start at rest.
+    pub fn bullet_direction(&self) -> Option<[f64; 3]> {
+        let nodes = self.bullet_nodes()?;
+        let mut in_set = vec![false; self.num_nodes()];
+        for &i in nodes {
+            in_set[i] = true;
+        }
+        let mut s = [0.0; 3];
+        for (i, v) in &self.initial_velocities {
+            if in_set[*i] {
+                for d in 0..3 {
+                    s[d] += v[d];
+                }
+            }
+        }
+        let n = (s[0] * s[0] + s[1] * s[1] + s[2] * s[2]).sqrt();
+        Some(if n > 0.0 {
+            [s[0] / n, s[1] / n, s[2] / n]
+        } else {
+            [0.0, 0.0, -1.0]
+        })
+    }
+
+    /// Strike at `speed` [m/s] along the striker's direction: each rigid projectile's
+    /// velocity (along its axis when at rest), or every node of the deformable bullet's
+    /// initial velocity.
+    pub fn set_striking_speed(&mut self, speed: f64) {
+        for p in &mut self.projectiles {
+            let v = p.velocity;
+            let n = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+            let dir = if n > 0.0 {
+                [v[0] / n, v[1] / n, v[2] / n]
+            } else {
+                p.axis
+            };
+            p.velocity = [speed * dir[0], speed * dir[1], speed * dir[2]];
+        }
+        let Some(dir) = self.bullet_direction() else {
+            return;
+        };
+        let v = [speed * dir[0], speed * dir[1], speed * dir[2]];
+        let nodes = self.node_sets[BULLET_SET].clone();
+        let mut in_set = vec![false; self.num_nodes()];
+        for &i in &nodes {
+            in_set[i] = true;
+        }
+        self.initial_velocities.retain(|(i, _)| !in_set[*i]);
+        self.initial_velocities
+            .extend(nodes.iter().map(|&i| (i, v)));
+    }
+}
