@@ -73,6 +73,13 @@ enum Figure {
         after_help = "Example:\n  weft-plot weave --model runs/woven-formed --y 0 --out weave.png"
     )]
     Weave(WeaveArgs),
+    /// A deformable bullet's length and diameter (the mushroom) against time, from the
+    /// history of its node set `bullet` (weft-weave woven --projectile deformable), one
+    /// pair of lines per run.
+    #[command(
+        after_help = "Example:\n  weft-plot bullet --model runs/lead --history runs/lead-out/history.parquet --label lead \\\n    --out bullet.png"
+    )]
+    Bullet(BulletArgs),
     /// Colour map of a nodal quantity (uz, |u|, vx, ...) over the mesh at one output
     /// time, on the initial or deformed mesh, with a colour bar; several models side by
     /// side on one colour scale (the paper's Fig. 4).
@@ -89,6 +96,21 @@ enum Figure {
         --component uy --time 5e-4 --out field.png"
     )]
     Field(FieldArgs),
+}
+
+#[derive(Args)]
+struct BulletArgs {
+    /// Model folder (repeat, one per run).
+    #[arg(long, required = true)]
+    model: Vec<PathBuf>,
+    /// Its history.parquet (repeat, in the same order).
+    #[arg(long, required = true)]
+    history: Vec<PathBuf>,
+    /// Legend label of each run (default: the folder name).
+    #[arg(long)]
+    label: Vec<String>,
+    #[command(flatten)]
+    common: Common,
 }
 
 #[derive(Args)]
@@ -411,6 +433,14 @@ fn run() -> anyhow::Result<()> {
                 kind: a.kind,
                 x_factor: a.x_factor,
                 x_label: a.x_label,
+            }),
+            a.common,
+        ),
+        Figure::Bullet(a) => (
+            plot::Figure::Bullet(plot::bullet::BulletFigure {
+                model: a.model,
+                history: a.history,
+                label: a.label,
             }),
             a.common,
         ),

@@ -8,6 +8,7 @@
 //! the file system and the drawing backend fail with their own errors under a context.
 
 pub mod ballistic;
+pub mod bullet;
 mod chart;
 pub mod field;
 mod history;
@@ -56,6 +57,8 @@ pub enum Figure {
     Surrogate(SurrogateFigure),
     /// A ballistic limit's figures (weft-ballistic's tables).
     Ballistic(ballistic::BallisticFigure),
+    /// A deformable bullet's length and diameter against time.
+    Bullet(bullet::BulletFigure),
 }
 
 /// What drawing a figure reports back to the binary.
@@ -78,6 +81,7 @@ pub fn run(c: &Config) -> anyhow::Result<Report> {
         Figure::Fit(a) => tables::fit(a)?,
         Figure::Surrogate(a) => tables::surrogate(a)?,
         Figure::Ballistic(a) => ballistic::ballistic(a)?,
+        Figure::Bullet(a) => bullet::bullet(a)?,
         Figure::Weave(a) => weave::weave(a)?,
         Figure::Field(a) => {
             let (f, report) = field::build(a)?;
