@@ -3,10 +3,12 @@
 //!
 //! A definition pairs slave nodes — the nodes of a part (`slave_part`) or a node set
 //! (`slave_set`) — with the master surface of a part (`master_part`): the faces of a
-//! membrane part (triangles, quads) offset by ± half the nodal thickness, or the
-//! segments of a truss or beam part with a radius. `two_way` also checks the master
-//! part's nodes against the slave part's surface; a part against itself is self-contact
-//! (a node never meets the faces it belongs to).
+//! membrane part (triangles, quads) offset by ± half the nodal thickness, the
+//! segments of a truss or beam part with a radius, or the boundary faces of a
+//! hexahedron part (one-sided: a node behind one is pushed back out of the solid; a
+//! solid's slaves are its boundary nodes). `two_way` also checks the master part's nodes
+//! against the slave part's surface; a part against itself is self-contact (a node never
+//! meets the faces it belongs to), except for a solid, which is refused.
 //!
 //! The table's codec is `io::contacts`; its checks are part of [`super::Model::validate`].
 
@@ -92,11 +94,15 @@ impl ContactDef {
     }
 }
 
-/// Part kinds that can form a contact surface.
+/// Part kinds that can form a contact surface (a hexahedron part by its boundary faces).
 pub fn is_surface_kind(k: ElementKind) -> bool {
     matches!(
         k,
-        ElementKind::Tri | ElementKind::Quad | ElementKind::Truss | ElementKind::Beam
+        ElementKind::Tri
+            | ElementKind::Quad
+            | ElementKind::Truss
+            | ElementKind::Beam
+            | ElementKind::Hex
     )
 }
 

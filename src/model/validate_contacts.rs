@@ -4,6 +4,7 @@
 use std::collections::HashMap;
 
 use super::contacts::{self, ContactDef, Slave};
+use super::kinds::ElementKind;
 use super::types::Model;
 use crate::error::{Result, WeftError};
 
@@ -23,6 +24,7 @@ impl Model {
             }
             self.validate_contact_master(row, c)?;
             self.validate_contact_slave(row, c)?;
+            self.validate_solid_self_contact(row, c)?;
             validate_contact_coefficients(row, c)?;
         }
         Ok(())
@@ -48,8 +50,8 @@ impl Model {
                     mp.kind.name()
                 ),
             )
-            .expected("a part of triangles, quads, trusses or beams")
-            .hint("a contact surface is made of membrane faces or of rod segments"));
+            .expected("a part of triangles, quads, trusses, beams or hexahedra")
+            .hint("a contact surface is made of membrane faces, rod segments or a solid's boundary faces"));
         }
         let has_elements = m
             .elements
@@ -84,7 +86,7 @@ impl Model {
                 }
                 if c.two_way && !contacts::is_surface_kind(m.parts[*p].kind) {
                     return Err(contact_err(row, "two_way", format!("two-way contact needs a surface on the slave side, but `{}` is a {} part", m.parts[*p].name, m.parts[*p].kind.name()))
-                        .expected("false, or a slave part of triangles, quads, trusses or beams"));
+                        .expected("false, or a slave part of triangles, quads, trusses, beams or hexahedra"));
                 }
             }
             Slave::Set(s) => {
@@ -110,6 +112,51 @@ impl Model {
             }
         }
         Ok(())
+    }
+}
+
+impl Model {
+    /// A solid (hexahedron part) against itself is refused: its one-sided faces would
+    /// meet its own boundary nodes across an element (a node one element under a face
+    /// lies behind it), and a bullet does not fold onto itself. Self-contact is a slave
+    /// part equal to the master, or a slave set holding one of the master's nodes.
+    fn validate_solid_self_contact(&self, row: usize, c: &ContactDef) -> Result<()> {
+        let mp = &self.parts[c.master];
+        if mp.kind != ElementKind::Hex {
+            return Ok(());
+        }
+        let (col, what) = match &c.slave {
+            Slave::Part(p) if *p == c.master => (
+                "slave_part",
+                format!(
+                    "contact `{}` is self-contact of the hexahedron part `{}` (slave_part = master_part)",
+                    c.id, mp.name
+                ),
+            ),
+            Slave::Set(s) => {
+                let b = &self.elements[&ElementKind::Hex];
+                let mut own = vec![false; self.num_nodes()];
+                for e in (0..b.len()).filter(|&e| b.part[e] == c.master) {
+                    for &n in &b.nodes[8 * e..8 * e + 8] {
+                        own[n] = true;
+                    }
+                }
+                let Some(&n) = self.node_sets[s].iter().find(|&&n| own[n]) else {
+                    return Ok(());
+                };
+                (
+                    "slave_set",
+                    format!(
+                        "contact `{}`: node `{}` of slave set `{s}` belongs to the hexahedron part `{}`, its own master surface",
+                        c.id, self.node_id[n], mp.name
+                    ),
+                )
+            }
+            _ => return Ok(()),
+        };
+        Err(contact_err(row, col, what)
+            .expected("slave nodes of other parts than the solid master part (a solid has no self-contact)")
+            .hint("make the slaves another part, or split the solid into two parts that meet by a two-way contact"))
     }
 }
 

@@ -78,6 +78,7 @@ pub mod grid;
 pub mod kernels;
 pub mod narrow;
 pub mod side;
+pub mod solid;
 
 use rayon::prelude::*;
 

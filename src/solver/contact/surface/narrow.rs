@@ -9,6 +9,7 @@ use super::kernels::{
     box_distance2, fmax, pair_force, release, thickness_gradient, Friction, SlaveState,
 };
 use super::side::{ChunkSums, PairOut, Reaction, Side, SLAVE_CHUNK};
+use super::solid::evaluate_solid;
 use crate::model::contacts::InitialPenetration;
 use crate::solver::contact::closest::closest_on_face;
 use crate::solver::vec3::{cross, dot, sub};
@@ -22,14 +23,16 @@ const MAX_SHARED: usize = 8;
 
 /// A face a slave penetrates: the weights `w` of its foot q, the penetration `g` = c − |r|
 /// (c = (t_s + t_F)/2), |r| and r = x_s − q, the face's in-plane thickness gradient (when
-/// |r| > 0) and, for a slave on the mid-surface (|r| = 0), the face's unit normal.
-struct Hit {
-    w: [f64; 4],
-    g: f64,
-    dist: f64,
-    r: [f64; 3],
-    tg: [f64; 3],
-    flat: [f64; 3],
+/// |r| > 0) and, for a slave on the mid-surface (|r| = 0), the face's unit normal. (A
+/// solid's face behind which the slave lies gives g = c − s, |s| and |s| n instead, n its
+/// outward normal: see [`super::solid`].)
+pub(super) struct Hit {
+    pub(super) w: [f64; 4],
+    pub(super) g: f64,
+    pub(super) dist: f64,
+    pub(super) r: [f64; 3],
+    pub(super) tg: [f64; 3],
+    pub(super) flat: [f64; 3],
 }
 
 /// The closest point of face `f` (thicknesses `ft`) to a slave at (px, py, pz) of
@@ -256,6 +259,8 @@ struct Narrow<'a> {
     keep: bool,
     /// Round-off allowance η of the box tests [m].
     eta: f64,
+    /// A solid's faces: their contact thickness t_F (see [`super::solid`]; 0 otherwise).
+    solid_t: f64,
 }
 
 /// One fixed chunk of slaves as the narrow phase writes it: (chunk index, ((((results,
@@ -288,15 +293,17 @@ impl Side {
         initial: bool,
         spread: Option<&[f64]>,
     ) {
-        // One copy per face kind, so that the loops over a face's nodes are unrolled.
-        match self.nf {
-            2 => self.narrow_n::<2>(x, v, dt, dt_prev, initial, spread),
-            3 => self.narrow_n::<3>(x, v, dt, dt_prev, initial, spread),
-            _ => self.narrow_n::<4>(x, v, dt, dt_prev, initial, spread),
+        // One copy per face kind, so that the loops over a face's nodes are unrolled (and
+        // the solid's one-sided faces are a copy of their own: no branch in the others).
+        match (self.nf, self.solid.is_some()) {
+            (4, true) => self.narrow_n::<4, true>(x, v, dt, dt_prev, initial, spread),
+            (2, _) => self.narrow_n::<2, false>(x, v, dt, dt_prev, initial, spread),
+            (3, _) => self.narrow_n::<3, false>(x, v, dt, dt_prev, initial, spread),
+            _ => self.narrow_n::<4, false>(x, v, dt, dt_prev, initial, spread),
         }
     }
 
-    fn narrow_n<const NF: usize>(
+    fn narrow_n<const NF: usize, const SOLID: bool>(
         &mut self,
         x: &[[f64; 3]],
         v: &[[f64; 3]],
@@ -329,12 +336,13 @@ impl Side {
             zeta: self.damping,
             keep: self.on_initial == InitialPenetration::Keep,
             eta: self.box_margin,
+            solid_t: self.solid.unwrap_or(0.0),
         };
         let nchunks = self.slaves.len().div_ceil(SLAVE_CHUNK);
         self.chunk_active.resize_with(nchunks, Vec::new);
         self.chunk_reactions.resize_with(nchunks, Vec::new);
         self.chunk_sums.resize(nchunks, ChunkSums::default());
-        let body = |c: Chunk| nar.chunk::<NF>(c);
+        let body = |c: Chunk| nar.chunk::<NF, SOLID>(c);
         if self.slaves.len() <= SLAVE_CHUNK {
             self.out
                 .chunks_mut(SLAVE_CHUNK)
@@ -375,7 +383,7 @@ impl Narrow<'_> {
     /// at the setup its initial penetration) into its result, state and the chunk's
     /// lists and sums.
     #[inline(always)]
-    fn chunk<const NF: usize>(&self, c: Chunk) {
+    fn chunk<const NF: usize, const SOLID: bool>(&self, c: Chunk) {
         let (ci, ((((outs, (sts, held)), active), reactions), sums)) = c;
         active.clear();
         reactions.clear();
@@ -409,7 +417,7 @@ impl Narrow<'_> {
                 continue;
             }
             let s = self.slaves[si] as usize;
-            let found = self.search::<NF>(si, &self.x[s], &mut near, &mut pen, sums);
+            let found = self.search::<NF, SOLID>(si, &self.x[s], &mut near, &mut pen, sums);
             let mut out = PairOut {
                 face: u32::MAX,
                 ..Default::default()
@@ -457,7 +465,7 @@ impl Narrow<'_> {
     /// The faces slave `si` at `p` penetrates, among its candidates (counted into `sums`),
     /// in candidate order.
     #[inline(always)]
-    fn search<const NF: usize>(
+    fn search<const NF: usize, const SOLID: bool>(
         &self,
         si: usize,
         p: &[f64; 3],
@@ -496,15 +504,29 @@ impl Narrow<'_> {
             );
             sums.evaluated += nn as u64;
             for &fi in &near[..nn] {
-                let Some(hit) = evaluate_face::<NF>(
-                    p[0],
-                    p[1],
-                    p[2],
-                    self.slave_t[si],
-                    &self.faces[fi as usize],
-                    &self.face_t[fi as usize],
-                    self.x,
-                ) else {
+                let hit = if SOLID {
+                    evaluate_solid(
+                        p[0],
+                        p[1],
+                        p[2],
+                        self.slave_t[si],
+                        self.solid_t,
+                        &self.faces[fi as usize],
+                        &self.face_t[fi as usize],
+                        self.x,
+                    )
+                } else {
+                    evaluate_face::<NF>(
+                        p[0],
+                        p[1],
+                        p[2],
+                        self.slave_t[si],
+                        &self.faces[fi as usize],
+                        &self.face_t[fi as usize],
+                        self.x,
+                    )
+                };
+                let Some(hit) = hit else {
                     continue;
                 };
                 sums.penetrated += 1;

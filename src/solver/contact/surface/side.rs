@@ -6,6 +6,7 @@
 use rayon::prelude::*;
 
 use super::kernels::{bbox, envelope_directions, thickness_box, Friction, SlaveState};
+use super::solid::{boundary_faces, boundary_nodes};
 use crate::model::contacts::{ContactDef, InitialPenetration, Slave};
 use crate::model::{ElementKind, Model};
 use crate::solver::contact::projectile::PENALTY_FACTOR;
@@ -75,6 +76,10 @@ pub struct Side {
     /// model's block of that kind, ascending).
     pub master_kind: ElementKind,
     pub(super) face_elem: Vec<u32>,
+    /// A solid's (hexahedron part's) boundary as the master surface: the faces' contact
+    /// thickness t_F, while `face_t` holds their box thickness 2R (see [`super::solid`]);
+    /// None for membranes, trusses and beams.
+    pub(super) solid: Option<f64>,
     /// Per face, whether its element is still in the model; an eroded face has an empty
     /// thickness box (no slave passes its box test) and leaves the grid at the next build.
     pub(super) face_alive: Vec<bool>,
@@ -195,6 +200,16 @@ fn nodal_thickness(m: &Model, part: Option<usize>) -> Vec<f64> {
         .collect()
 }
 
+/// The slave nodes of a part: its boundary nodes for a solid (see [`super::solid`]),
+/// else the nodes of its elements; sorted.
+fn slave_part_nodes(m: &Model, part: usize) -> Vec<u32> {
+    if m.parts[part].kind == ElementKind::Hex {
+        boundary_nodes(m, part)
+    } else {
+        part_nodes(m, part)
+    }
+}
+
 /// The nodes of a part's elements, sorted.
 pub(super) fn part_nodes(m: &Model, part: usize) -> Vec<u32> {
     let kind = m.parts[part].kind;
@@ -216,7 +231,7 @@ pub(super) fn part_nodes(m: &Model, part: usize) -> Vec<u32> {
 /// The slave nodes of a definition, sorted, each once.
 fn slave_nodes(m: &Model, slave: &Slave) -> Vec<u32> {
     match slave {
-        Slave::Part(p) => part_nodes(m, *p),
+        Slave::Part(p) => slave_part_nodes(m, *p),
         Slave::Set(s) => {
             let mut v: Vec<u32> = m.node_sets[s].iter().map(|&n| n as u32).collect();
             v.sort_unstable();
@@ -228,7 +243,7 @@ fn slave_nodes(m: &Model, slave: &Slave) -> Vec<u32> {
 
 /// The faces of a definition's master part, in element order: their nodes (unused
 /// entries 0; `npe` per face), nodal contact thicknesses, nodal masses [kg] and element
-/// ids.
+/// ids; for a solid its boundary faces and their contact thickness (`solid`).
 struct MasterFaces {
     faces: Vec<[u32; 4]>,
     npe: usize,
@@ -236,6 +251,7 @@ struct MasterFaces {
     face_m: Vec<[f64; 4]>,
     face_id: Vec<i64>,
     face_elem: Vec<u32>,
+    solid: Option<f64>,
 }
 
 impl MasterFaces {
@@ -244,6 +260,9 @@ impl MasterFaces {
     /// nodal thickness, else its nodal thickness from its elements.
     fn new(m: &Model, d: &ContactDef, master: usize, mass: &[f64]) -> MasterFaces {
         let kind = m.parts[master].kind;
+        if kind == ElementKind::Hex {
+            return MasterFaces::solid(m, d, master, mass);
+        }
         let b = &m.elements[&kind];
         let npe = kind.nodes_per_element();
         let mt = nodal_thickness(m, Some(master));
@@ -254,6 +273,7 @@ impl MasterFaces {
             face_m: vec![],
             face_id: vec![],
             face_elem: vec![],
+            solid: None,
         };
         for e in 0..b.len() {
             if b.part[e] != master {
@@ -281,6 +301,30 @@ impl MasterFaces {
         }
         mf
     }
+
+    /// The boundary faces of hexahedron part `master` of definition `d`: contact
+    /// thickness t_F = `master_thickness` (0 when null), box thickness 2 max(t_F/2, D) at
+    /// each node (D half the element's depth across the face; see [`super::solid`]).
+    fn solid(m: &Model, d: &ContactDef, master: usize, mass: &[f64]) -> MasterFaces {
+        let b = &m.elements[&ElementKind::Hex];
+        let tf = d.master_thickness.unwrap_or(0.0);
+        let bf = boundary_faces(m, master);
+        MasterFaces {
+            faces: bf.iter().map(|f| f.nodes).collect(),
+            npe: 4,
+            face_t: bf
+                .iter()
+                .map(|f| [2.0 * (0.5 * tf).max(f.depth); 4])
+                .collect(),
+            face_m: bf
+                .iter()
+                .map(|f| f.nodes.map(|n| mass[n as usize]))
+                .collect(),
+            face_id: bf.iter().map(|f| b.id[f.elem as usize]).collect(),
+            face_elem: bf.iter().map(|f| f.elem).collect(),
+            solid: Some(tf),
+        }
+    }
 }
 
 impl Side {
@@ -307,9 +351,12 @@ impl Side {
             face_m,
             face_id,
             face_elem,
+            solid,
         } = MasterFaces::new(m, d, master, mass);
         let ts_max = slave_t.iter().cloned().fold(0.0, f64::max);
-        let tf_max = face_t.iter().flatten().cloned().fold(0.0, f64::max);
+        let tf_box = face_t.iter().flatten().cloned().fold(0.0, f64::max);
+        // (A solid's contact thickness is t_F; its `face_t` the boxes' 2R.)
+        let tf_max = solid.unwrap_or(tf_box);
         // The largest coordinate of the side's nodes, the scale of the round-off.
         let x_max = slaves
             .iter()
@@ -340,6 +387,7 @@ impl Side {
             master_kind: m.parts[master].kind,
             face_alive: vec![true; face_elem.len()],
             face_elem,
+            solid,
             dead_faces: 0,
             friction: Friction {
                 mu_s: d.static_friction,
@@ -351,7 +399,7 @@ impl Side {
             on_initial: d.initial_penetration,
             reach: 0.5 * (ts_max + tf_max),
             slave_t_max: ts_max,
-            box_margin: BOX_MARGIN * (x_max + 0.5 * (ts_max + tf_max)),
+            box_margin: BOX_MARGIN * (x_max + 0.5 * (ts_max + tf_box)),
             cand_ptr: vec![],
             cand: vec![],
             margin: vec![],
@@ -400,9 +448,12 @@ impl Side {
             });
     }
 
-    /// The face of element `e` (of the master's kind) leaves the surface.
+    /// The faces of element `e` (of the master's kind) leave the surface (one, or a
+    /// solid's boundary faces of it: `face_elem` is ascending).
     pub(super) fn erode(&mut self, e: usize) {
-        if let Ok(f) = self.face_elem.binary_search(&(e as u32)) {
+        let lo = self.face_elem.partition_point(|&x| x < e as u32);
+        let hi = self.face_elem.partition_point(|&x| x <= e as u32);
+        for f in lo..hi {
             if self.face_alive[f] {
                 self.face_alive[f] = false;
                 self.face_box[f] = DEAD_BOX;
