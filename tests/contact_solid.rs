@@ -274,7 +274,7 @@ fn the_nodes_of_a_fine_solid_stop_on_a_coarse_rod() {
     // rod's nodes lie beyond the block, so only the block's nodes (slaves of the two-way
     // contact's reverse side) against the rod's segment can stop it.
     let (h, v) = (1e-3, 20.0);
-    let (s, chain, block, bal) = block_on_chain(4, h, (1, -2e-3, 6e-3), v, 3e-6);
+    let (s, chain, block, bal) = block_on_chain(4, h, (1, -2e-3, 6e-3), v, 8e-6);
     let (err, share) = momentum_check(&s, block.clone(), chain.clone(), v);
     // The rod's axis under each of the block's bottom nodes on it (y = 2 mm): the
     // clearance (node − axis) must stay positive.
@@ -295,7 +295,8 @@ fn the_nodes_of_a_fine_solid_stop_on_a_coarse_rod() {
     // As above, but the five nodes strike through the block's own stiffness: measured
     // 1.9861 v; tolerance 3e-2 v.
     assert!((share - 2.0).abs() < 3e-2, "the rod left at {share} v");
-    // Measured 1.40e-4 m (the rod flew ahead); through the rod fails.
+    // Measured 2.40e-4 m at 8 µs (the rod flew ahead; without the block's nodes as
+    // slaves the block is 50 µm through it by then).
     assert!(worst > 0.0, "the block went through the rod by {worst} m");
     // Measured 5.7e-5; tolerance 1.5e-4.
     assert!(bal < 1.5e-4, "balance {bal}");

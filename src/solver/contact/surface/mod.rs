@@ -1,6 +1,8 @@
 //! General contact: slave nodes against master surfaces — membrane faces offset by
-//! ± half their nodal thickness (LS-DYNA's shell contact thickness), or truss and beam
-//! segments with a radius — with penalty forces and Coulomb friction.
+//! ± half their nodal thickness (LS-DYNA's shell contact thickness), truss and beam
+//! segments with a radius, or a solid's boundary faces, one-sided ([`solid`]: their boxes
+//! are those of a membrane face as thick as the depth the kernel looks behind them, so
+//! every claim below holds for them) — with penalty forces and Coulomb friction.
 //!
 //! Glossary: s a slave node, x_s its position, t_s its contact thickness; F a master face
 //! (2 nodes: a segment, 3: a triangle, 4: a quad), q = Σ_a w_a x_a the closest point of
@@ -69,7 +71,8 @@
 //!
 //! Where things live: [`kernels`] (the pure kernels: thickness box and envelope bounds,
 //! distance tests, the pair force with friction; the closest points are
-//! [`super::closest`]'s), [`side`] (a definition's side and its per-step data), [`grid`]
+//! [`super::closest`]'s), [`solid`] (a hexahedron part's boundary faces and nodes, and
+//! its faces' one-sided kernel), [`side`] (a definition's side and its per-step data), [`grid`]
 //! (the broad phase), [`narrow`] (the narrow phase), and this module: the driver
 //! ([`SurfaceContact`]: setup, the step's phases in order, the gather onto the nodes, the
 //! report).

@@ -221,7 +221,10 @@ mod tests {
             }
         }
         assert!(hit([0.3, 0.6, 0.1]).is_none(), "at the contact distance");
-        assert!(hit([0.3, 0.6, -0.61]).is_none(), "beyond the zone R + t_s/2");
+        assert!(
+            hit([0.3, 0.6, -0.61]).is_none(),
+            "beyond the zone R + t_s/2"
+        );
         // Under the edge x = 1, just outside the cube: beside the face.
         assert!(hit([1.0 + 1e-3, 0.5, -0.05]).is_none(), "beside the face");
         // On the edge's plane (a matched mesh's node under a vertex): inside.
