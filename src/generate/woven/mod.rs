@@ -265,7 +265,7 @@ pub fn woven(p: &WovenBandParams) -> Result<(Model, WovenInfo)> {
             crate::generate::bullet::add_to(
                 &mut m,
                 &b,
-                [0.0, 0.0, built.top + 1e-6],
+                [0.0, 0.0, built.top + 1e-4],
                 p.projectile_velocity,
                 p.quarter,
                 p.projectile_friction,

@@ -1,0 +1,121 @@
+//! The deformable 9 mm bullet in the yarn-level patch (`weft-weave woven --projectile
+//! deformable`): lead hexahedra meeting aramid chains both ways through the general
+//! contact, the yarns failing.
+//!
+//! Oracles:
+//! - energy conservation: the ledger's balance (the issue asks ≤ 1 %);
+//! - the lead's volume: its pressure is hypoelastic, dp = −K tr D dt, and plasticity is
+//!   deviatoric (J2 and Johnson–Cook return along the deviator), so each hexahedron's
+//!   pressure is −K ln(V/V₀) (tr D dt sums to ln V/V₀ for the mid-step gradient, to
+//!   O(Δt²)); K = E/(3(1 − 2ν)) (Simo & Hughes, *Computational Inelasticity*, §9.1 for the
+//!   split, Belytschko, Liu & Moran §5.6 for hypoelastic rates);
+//! - mass: the meshed bullet is the NIJ round's 8.0 g (a quarter, 2 g), to round-off;
+//! - the same bits on one and two threads.
+
+use weft::generate::bullet::{BulletKind, BulletParams};
+use weft::generate::woven::{woven, WovenBandParams, YarnFailure, YarnModel};
+use weft::model::Model;
+use weft::solver::solid::kernel::hex_geometry;
+use weft::solver::solid::material::pressure;
+use weft::solver::{run_in_memory, RunStats, Solver};
+
+fn patch(kind: BulletKind, velocity: f64, end_time: f64) -> Model {
+    let p = WovenBandParams {
+        yarns: 10,
+        yarn_model: YarnModel::Chain,
+        failure: YarnFailure {
+            strain: 0.036,
+            ..Default::default()
+        },
+        projectile_velocity: velocity,
+        end_time,
+        output_interval: end_time / 20.0,
+        bullet: Some(BulletParams {
+            kind,
+            ..Default::default()
+        }),
+        ..Default::default()
+    };
+    woven(&p).unwrap().0
+}
+
+/// (length along z, diameter) of the bullet at positions `x`.
+fn bullet_shape(m: &Model, x: &[[f64; 3]]) -> (f64, f64) {
+    let nodes = m.bullet_nodes().unwrap();
+    let (mut lo, mut hi, mut r) = (f64::MAX, f64::MIN, 0.0f64);
+    for &i in nodes {
+        lo = lo.min(x[i][2]);
+        hi = hi.max(x[i][2]);
+        r = r.max(x[i][0].hypot(x[i][1]));
+    }
+    (hi - lo, 2.0 * r)
+}
+
+fn run(m: &Model) -> (Solver, RunStats) {
+    let (s, _, st) = run_in_memory(m).unwrap();
+    (s, st)
+}
+
+#[test]
+fn a_lead_bullet_in_a_chain_patch_balances_energy_and_keeps_its_volume_law() {
+    let m = patch(BulletKind::Lead, 400.0, 1.5e-5);
+    let bullet_mass: f64 = {
+        let s = weft::solver::Solver::new(&m).unwrap();
+        m.bullet_nodes().unwrap().iter().map(|&i| s.mass[i]).sum()
+    };
+    // A quarter of 8.0 g (the mesh's exact volume times ρ; lumped masses sum to it).
+    assert!((bullet_mass - 2e-3).abs() < 1e-15, "{bullet_mass}");
+    let (s, st) = run(&m);
+    let (len0, dia0) = bullet_shape(&m, &m.coords);
+    let (len, dia) = bullet_shape(&m, &s.state.xn);
+    let hex = &s.op.el.hex;
+    let (mut worst, mut pmax) = (0.0f64, 0.0f64);
+    for e in 0..hex.nodes.len() {
+        // The stress is that of x^n, the last sample's positions (`xn`; `x` is a step
+        // ahead).
+        let x: [[f64; 3]; 8] = std::array::from_fn(|a| s.state.xn[hex.nodes[e][a] as usize]);
+        let v = hex_geometry(&x).volume;
+        let mat = &hex.materials[hex.material[e] as usize];
+        let (lam, mu) = mat.lame();
+        let k = lam + 2.0 * mu / 3.0;
+        let p = pressure(&hex.state[e].stress);
+        worst = worst.max((p + k * (v / hex.v0[e]).ln()).abs());
+        pmax = pmax.max(p.abs());
+    }
+    let e = st.final_energies;
+    eprintln!(
+        "lead bullet at 400 m/s, 15 µs: length {:.4} mm, diameter {:.4} mm ({:.4}, {:.4} at rest); balance {:.2e}; hourglass {:.2e} J; pressure against −K ln(V/V₀): {worst:.3e} Pa of {pmax:.3e} Pa; {} steps, smallest step {:.3} of the first",
+        len * 1e3,
+        dia * 1e3,
+        len0 * 1e3,
+        dia0 * 1e3,
+        st.max_balance_error_relative,
+        e.hourglass,
+        st.steps,
+        s.stable.dt_min / s.stable.dt
+    );
+    // Measured 1.38e-3 (the issue asks ≤ 1 %).
+    assert!(st.max_balance_error_relative < 3e-3);
+    // Measured 6.4 Pa of 82 MPa (7.7e-8): the sum of the mid-step tr D Δt is ln V/V₀ to
+    // round-off here; tolerance 2e-7.
+    assert!(worst < 2e-7 * pmax, "{worst} of {pmax}");
+    // The nose has started to flatten on the yarns: shorter and wider than at rest.
+    assert!(dia > dia0 && len < len0, "{len0} {dia0} -> {len} {dia}");
+}
+
+#[test]
+fn an_fmj_bullet_runs_the_same_on_one_and_two_threads() {
+    let m = patch(BulletKind::Fmj, 400.0, 5e-6);
+    let go = |threads: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| run_in_memory(&m).unwrap())
+    };
+    let (s1, o1, st1) = go(1);
+    let (s2, o2, st2) = go(2);
+    assert!(o1.u == o2.u && o1.energy == o2.energy && st1.steps == st2.steps);
+    assert!(s1.state.x == s2.state.x);
+    assert!(s1.op.el.hex.state == s2.op.el.hex.state);
+}
