@@ -13,7 +13,7 @@
 //! a meplat (a flat tip) of 0.35 D, so that the O-grid's core stays a hexahedron at the
 //! tip; the nose's stations are spaced evenly in the polar angle. The body's length is
 //! what makes the mesh's mass the bullet's mass exactly (the facets of the polygonal
-//! section included): 8.0 g of lead gives 12.3 mm overall (the real round-nose FMJ,
+//! section included): 8.0 g of lead 9.0 mm across gives 12.68 mm overall (the real FMJ RN,
 //! ogival and with its jacket, is 15.6 mm; the mass, diameter and presented area are what
 //! the impact sees first).
 //!

@@ -9,6 +9,25 @@ use super::types::Model;
 /// The node set of a deformable projectile.
 pub const BULLET_SET: &str = "bullet";
 
+/// A point of a bullet's axis, from its initial positions `x` and direction `a`: of its
+/// most advanced nodes (its tip face, within 10⁻⁹ of the largest x·a), the one nearest
+/// the line through the origin along `a`, where the generators put the axis (a quarter or
+/// whole bullet alike: the tip face's centre node).
+pub fn axis_point(x: &[[f64; 3]], a: [f64; 3]) -> [f64; 3] {
+    let along = |p: &[f64; 3]| p[0] * a[0] + p[1] * a[1] + p[2] * a[2];
+    let lateral = |p: &[f64; 3]| {
+        let s = along(p);
+        let r = [p[0] - s * a[0], p[1] - s * a[1], p[2] - s * a[2]];
+        r[0] * r[0] + r[1] * r[1] + r[2] * r[2]
+    };
+    let front = x.iter().map(along).fold(f64::NEG_INFINITY, f64::max);
+    x.iter()
+        .filter(|p| along(p) >= front - 1e-9)
+        .copied()
+        .min_by(|p, q| lateral(p).total_cmp(&lateral(q)))
+        .unwrap_or([0.0; 3])
+}
+
 impl Model {
     /// Whether something strikes: a rigid projectile or a deformable bullet.
     pub fn has_striker(&self) -> bool {

@@ -1,6 +1,6 @@
 //! A deformable bullet's shape against time (`weft-plot bullet`): its length along the
-//! strike direction and its diameter (twice the largest distance of its nodes from the
-//! line through its initial tip along that direction: the mushroom), from the history of
+//! strike direction and its diameter (twice the largest distance of its nodes from its
+//! axis, [`crate::model::striker::axis_point`]: the mushroom), from the history of
 //! its node set `bullet` (`weft-weave woven --projectile deformable` writes it into the
 //! history), one pair of series per model.
 
@@ -31,12 +31,7 @@ pub fn shape(model: &std::path::Path, history: &std::path::Path) -> Result<Vec<(
     })?;
     let s = read_series_of(model, history, BULLET_SET, &[0, 1, 2])?;
     let along = |x: &[f64; 3]| x[0] * a[0] + x[1] * a[1] + x[2] * a[2];
-    let tip = s
-        .x0
-        .iter()
-        .copied()
-        .max_by(|p, q| along(p).total_cmp(&along(q)))
-        .unwrap_or([0.0; 3]);
+    let tip = crate::model::striker::axis_point(&s.x0, a);
     Ok(s.t
         .iter()
         .zip(&s.values)

@@ -103,7 +103,7 @@ pub struct Watch {
     /// its most advanced node as the tip, its mass-weighted velocity, the sum of the
     /// contact forces on its nodes; empty with a rigid projectile or none.
     pub bullet: Vec<usize>,
-    /// The bullet's radius about the line through its initial tip along the axis [m].
+    /// The bullet's radius about its axis (`striker::axis_point`) [m].
     pub bullet_radius: f64,
 }
 
@@ -122,11 +122,9 @@ impl Watch {
         if w.axis.is_none() {
             if let (Some(nodes), Some(a)) = (m.bullet_nodes(), m.bullet_direction()) {
                 let along = |x: &[f64; 3]| x[0] * a[0] + x[1] * a[1] + x[2] * a[2];
-                let tip = nodes
-                    .iter()
-                    .map(|&i| m.coords[i])
-                    .max_by(|p, q| along(p).total_cmp(&along(q)));
-                if let Some(tip) = tip {
+                let xs: Vec<[f64; 3]> = nodes.iter().map(|&i| m.coords[i]).collect();
+                if !xs.is_empty() {
+                    let tip = crate::model::striker::axis_point(&xs, a);
                     w.bullet_radius = nodes
                         .iter()
                         .map(|&i| {
