@@ -65,7 +65,11 @@ pub(super) fn bullet(a: &BulletFigure) -> Result<Chart> {
         let name = label(&a.label, k, m);
         let rows = shape(m, h)?;
         for (what, style, f) in [
-            ("length", Style::Line, (|r: &(f64, f64, f64)| r.1) as fn(&_) -> f64),
+            (
+                "length",
+                Style::Line,
+                (|r: &(f64, f64, f64)| r.1) as fn(&_) -> f64,
+            ),
             ("diameter", Style::Dashed, |r: &(f64, f64, f64)| r.2),
         ] {
             series.push(Series {

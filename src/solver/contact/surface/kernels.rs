@@ -419,3 +419,17 @@ mod tests {
         assert_eq!((st.ft, st.k), ([0.0; 3], 0.0));
     }
 }
+
+/// A face a slave penetrates: the weights `w` of its foot q, the penetration `g` = c − |r|
+/// (c = (t_s + t_F)/2), |r| and r = x_s − q, the face's in-plane thickness gradient (when
+/// |r| > 0) and, for a slave on the mid-surface (|r| = 0), the face's unit normal. (A
+/// solid's face behind which the slave lies gives g = c − s, |s| and |s| n instead, n its
+/// outward normal: see [`super::solid`].)
+pub(super) struct Hit {
+    pub(super) w: [f64; 4],
+    pub(super) g: f64,
+    pub(super) dist: f64,
+    pub(super) r: [f64; 3],
+    pub(super) tg: [f64; 3],
+    pub(super) flat: [f64; 3],
+}

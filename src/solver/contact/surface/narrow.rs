@@ -6,7 +6,7 @@
 use rayon::prelude::*;
 
 use super::kernels::{
-    box_distance2, fmax, pair_force, release, thickness_gradient, Friction, SlaveState,
+    box_distance2, fmax, pair_force, release, thickness_gradient, Friction, Hit, SlaveState,
 };
 use super::side::{ChunkSums, PairOut, Reaction, Side, SLAVE_CHUNK};
 use super::solid::evaluate_solid;
@@ -20,20 +20,6 @@ const NARROW_TASK_CHUNKS: usize = 4;
 /// Most faces one slave's reaction is shared over (a node at a quad vertex penetrates the
 /// four faces around it; more only in crushed regions, where the deepest are kept).
 const MAX_SHARED: usize = 8;
-
-/// A face a slave penetrates: the weights `w` of its foot q, the penetration `g` = c − |r|
-/// (c = (t_s + t_F)/2), |r| and r = x_s − q, the face's in-plane thickness gradient (when
-/// |r| > 0) and, for a slave on the mid-surface (|r| = 0), the face's unit normal. (A
-/// solid's face behind which the slave lies gives g = c − s, |s| and |s| n instead, n its
-/// outward normal: see [`super::solid`].)
-pub(super) struct Hit {
-    pub(super) w: [f64; 4],
-    pub(super) g: f64,
-    pub(super) dist: f64,
-    pub(super) r: [f64; 3],
-    pub(super) tg: [f64; 3],
-    pub(super) flat: [f64; 3],
-}
 
 /// The closest point of face `f` (thicknesses `ft`) to a slave at (px, py, pz) of
 /// thickness `ts`, and whether the slave penetrates it. (A function of its own: inlined in

@@ -35,7 +35,7 @@
 //! (the erosion hook passes only membranes and trusses), and the faces it would uncover
 //! are not added.
 
-use super::narrow::Hit;
+use super::kernels::Hit;
 use crate::model::{ElementKind, Model};
 use crate::solver::contact::closest::closest_on_quad;
 use crate::solver::vec3::{cross, dot, sub};
