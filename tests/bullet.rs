@@ -94,11 +94,11 @@ fn a_lead_bullet_in_a_chain_patch_balances_energy_and_keeps_its_volume_law() {
         st.steps,
         s.stable.dt_min / s.stable.dt
     );
-    // Measured 1.38e-3 (the issue asks ≤ 1 %).
-    assert!(st.max_balance_error_relative < 3e-3);
-    // Measured 6.4 Pa of 82 MPa (7.7e-8): the sum of the mid-step tr D Δt is ln V/V₀ to
-    // round-off here; tolerance 2e-7.
-    assert!(worst < 2e-7 * pmax, "{worst} of {pmax}");
+    // Measured 4.5e-5 (the issue asks ≤ 1 %).
+    assert!(st.max_balance_error_relative < 1.5e-4);
+    // Measured 8.9 Pa of 35 MPa (2.5e-7): the mid-step rule's Σ tr D Δt differs from
+    // ln V/V₀ by O(Δt²) a step; tolerance 6e-7.
+    assert!(worst < 6e-7 * pmax, "{worst} of {pmax}");
     // The nose has started to flatten on the yarns: shorter and wider than at rest.
     assert!(dia > dia0 && len < len0, "{len0} {dia0} -> {len} {dia}");
 }

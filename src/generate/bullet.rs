@@ -227,14 +227,6 @@ pub fn mesh(p: &BulletParams, tip: [f64; 3], quarter: bool) -> Result<BulletMesh
     })
 }
 
-/// The bullet's contacts' penalty_scale. Both ways, a light yarn node can be pushed at
-/// once by the faces it penetrates and by the heavy bullet nodes that penetrate its
-/// segments, several at a time, each spring κ_c m*/Δt² with m* the yarn's mass: with the
-/// default scale 1 (and 0.5) a 10-yarn chain patch without failure went unstable 16 µs
-/// into a 400 m/s impact, with 0.3 it did not (measured). A quarter, as the rigid
-/// projectile's face samples have (`SEGMENT_FACTOR`), for the same reason.
-pub const PENALTY_SCALE: f64 = 0.25;
-
 /// Where the bullet went in a model: its parts (core, then the jacket when it has one)
 /// and its node set.
 #[derive(Debug, Clone)]
@@ -248,7 +240,7 @@ pub struct Placed {
 /// hexahedra after the model's largest ids, parts `bullet` (core) and `bullet_jacket`
 /// (FMJ), node set `bullet`, and a two-way contact with friction `friction` between
 /// each of its parts and each part of `targets` (the yarns: their nodes against the
-/// bullet's faces, the bullet's nodes against theirs), penalty scale [`PENALTY_SCALE`].
+/// bullet's faces, the bullet's nodes against theirs), the default penalty.
 pub fn add_to(
     m: &mut crate::model::Model,
     p: &BulletParams,
@@ -301,7 +293,6 @@ pub fn add_to(
         for &b in &parts {
             let mut c = ContactDef::new(cid, Slave::Part(t), b).with_friction(friction);
             c.two_way = true;
-            c.penalty_scale = PENALTY_SCALE;
             m.contacts.push(c);
             cid += 1;
         }
