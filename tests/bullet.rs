@@ -94,11 +94,12 @@ fn a_lead_bullet_in_a_chain_patch_balances_energy_and_keeps_its_volume_law() {
         st.steps,
         s.stable.dt_min / s.stable.dt
     );
-    // Measured 4.5e-5 (the issue asks ≤ 1 %).
-    assert!(st.max_balance_error_relative < 1.5e-4);
-    // Measured 8.9 Pa of 35 MPa (2.5e-7): the mid-step rule's Σ tr D Δt differs from
-    // ln V/V₀ by O(Δt²) a step; tolerance 6e-7.
-    assert!(worst < 6e-7 * pmax, "{worst} of {pmax}");
+    // Measured 1.53e-4 (the issue asks ≤ 1 %; 1.38e-3 before solid faces stopped
+    // catching nodes deep behind them).
+    assert!(st.max_balance_error_relative < 4e-4);
+    // Measured 7.0 Pa of 22 MPa (3.2e-7): the mid-step rule's Σ tr D Δt differs from
+    // ln V/V₀ by O(Δt²) a step; tolerance 8e-7.
+    assert!(worst < 8e-7 * pmax, "{worst} of {pmax}");
     // The nose has started to flatten on the yarns: shorter and wider than at rest.
     assert!(dia > dia0 && len < len0, "{len0} {dia0} -> {len} {dia}");
 }

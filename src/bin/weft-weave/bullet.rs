@@ -40,15 +40,18 @@ pub struct BulletArgs {
 
 impl BulletArgs {
     /// The bullet's parameters when deformable (diameter and mass are set from the
-    /// projectile's flags by the generator).
-    pub fn params(&self) -> Option<BulletParams> {
-        (self.projectile == Projectile::Deformable).then(|| BulletParams {
+    /// projectile's flags by the generator); its flags are checked either way, so that a
+    /// bad value is not silently ignored with a rigid projectile.
+    pub fn params(&self) -> weft::error::Result<Option<BulletParams>> {
+        let p = BulletParams {
             kind: self.bullet,
             core: self.bullet_material,
             jacket: self.bullet_jacket,
             radial: self.bullet_radial,
             erosion_plastic_strain: self.bullet_erosion_strain,
             ..Default::default()
-        })
+        };
+        weft::generate::bullet::check(&p)?;
+        Ok((self.projectile == Projectile::Deformable).then_some(p))
     }
 }

@@ -905,11 +905,13 @@ impl WovenBandArgs {
                 contact_damping: self.projectile_contact_damping,
             },
             stop_on_outcome: self.stop_on_outcome,
-            bullet: self.bullet.params(),
+            // (Checked in `weave`, before the model is built.)
+            bullet: self.bullet.params().ok().flatten(),
         }
     }
 
     fn weave(&self) -> anyhow::Result<()> {
+        self.bullet.params()?;
         let m = weave(&Spec::Woven(self.params()), &self.out)?;
         eprintln!(
             "weft-weave woven: {} nodes, {} elements, {} contact definitions -> {}",
