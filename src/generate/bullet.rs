@@ -121,10 +121,8 @@ pub fn check(p: &BulletParams) -> Result<()> {
     }
     if let Some(e) = p.erosion_plastic_strain {
         if !(e > 0.0 && e.is_finite()) {
-            return Err(
-                WeftError::input(format!("--bullet-erosion-strain = `{e}`"))
-                    .expected("an equivalent plastic strain > 0 (leave it out: no erosion)"),
-            );
+            return Err(WeftError::input(format!("--bullet-erosion-strain = `{e}`"))
+                .expected("an equivalent plastic strain > 0 (leave it out: no erosion)"));
         }
     }
     if !(p.hourglass > 0.0 && p.hourglass.is_finite()) {

@@ -241,7 +241,10 @@ mod tests {
             "beyond the zone R + t_s/2"
         );
         // Deeper behind the face than max(c, R/10) = 0.1: not caught.
-        assert!(hit([0.3, 0.6, -0.1 - 1e-9]).is_none(), "deep behind the face");
+        assert!(
+            hit([0.3, 0.6, -0.1 - 1e-9]).is_none(),
+            "deep behind the face"
+        );
         assert!(hit([0.3, 0.6, -0.3]).is_none(), "deep behind the face");
         // Under the edge x = 1, just outside the cube: beside the face.
         assert!(hit([1.0 + 1e-3, 0.5, -0.05]).is_none(), "beside the face");
