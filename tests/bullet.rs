@@ -14,6 +14,7 @@
 
 use weft::generate::bullet::{BulletKind, BulletParams};
 use weft::generate::woven::{woven, WovenBandParams, YarnFailure, YarnModel};
+use weft::generate::woven_reduced::{woven_reduced, WovenParams};
 use weft::model::Model;
 use weft::solver::solid::kernel::hex_geometry;
 use weft::solver::solid::material::pressure;
@@ -68,20 +69,8 @@ fn a_lead_bullet_in_a_chain_patch_balances_energy_and_keeps_its_volume_law() {
     let (s, st) = run(&m);
     let (len0, dia0) = bullet_shape(&m, &m.coords);
     let (len, dia) = bullet_shape(&m, &s.state.xn);
-    let hex = &s.op.el.hex;
-    let (mut worst, mut pmax) = (0.0f64, 0.0f64);
-    for e in 0..hex.nodes.len() {
-        // The stress is that of x^n, the last sample's positions (`xn`; `x` is a step
-        // ahead).
-        let x: [[f64; 3]; 8] = std::array::from_fn(|a| s.state.xn[hex.nodes[e][a] as usize]);
-        let v = hex_geometry(&x).volume;
-        let mat = &hex.materials[hex.material[e] as usize];
-        let (lam, mu) = mat.lame();
-        let k = lam + 2.0 * mu / 3.0;
-        let p = pressure(&hex.state[e].stress);
-        worst = worst.max((p + k * (v / hex.v0[e]).ln()).abs());
-        pmax = pmax.max(p.abs());
-    }
+    // The stress is that of x^n, the last sample's positions (`xn`; `x` is a step ahead).
+    let (worst, pmax) = pressure_law(&s);
     let e = st.final_energies;
     eprintln!(
         "lead bullet at 400 m/s, 15 µs: length {:.4} mm, diameter {:.4} mm ({:.4}, {:.4} at rest); balance {:.2e}; hourglass {:.2e} J; pressure against −K ln(V/V₀): {worst:.3e} Pa of {pmax:.3e} Pa; {} steps, smallest step {:.3} of the first",
@@ -101,6 +90,51 @@ fn a_lead_bullet_in_a_chain_patch_balances_energy_and_keeps_its_volume_law() {
     // ln V/V₀ by O(Δt²) a step; tolerance 8e-7.
     assert!(worst < 8e-7 * pmax, "{worst} of {pmax}");
     // The nose has started to flatten on the yarns: shorter and wider than at rest.
+    assert!(dia > dia0 && len < len0, "{len0} {dia0} -> {len} {dia}");
+}
+
+/// Each hexahedron's pressure against −K ln(V/V₀) at the last sample: the worst
+/// difference and the largest pressure [Pa].
+fn pressure_law(s: &Solver) -> (f64, f64) {
+    let hex = &s.op.el.hex;
+    let (mut worst, mut pmax) = (0.0f64, 0.0f64);
+    for e in 0..hex.nodes.len() {
+        let x: [[f64; 3]; 8] = std::array::from_fn(|a| s.state.xn[hex.nodes[e][a] as usize]);
+        let v = hex_geometry(&x).volume;
+        let (lam, mu) = hex.materials[hex.material[e] as usize].lame();
+        let p = pressure(&hex.state[e].stress);
+        worst = worst.max((p + (lam + 2.0 * mu / 3.0) * (v / hex.v0[e]).ln()).abs());
+        pmax = pmax.max(p.abs());
+    }
+    (worst, pmax)
+}
+
+#[test]
+fn a_lead_bullet_in_the_reduced_girder_balances_energy_and_keeps_its_volume_law() {
+    // The paper's §5 reduced model (trusses and links in the graded membrane) against
+    // the lead bullet at 400 m/s, 30 µs.
+    let m = woven_reduced(&WovenParams {
+        end_time: 3e-5,
+        bullet: Some(BulletParams::default()),
+        ..Default::default()
+    })
+    .unwrap();
+    let (s, st) = run(&m);
+    let (len0, dia0) = bullet_shape(&m, &m.coords);
+    let (len, dia) = bullet_shape(&m, &s.state.xn);
+    let (worst, pmax) = pressure_law(&s);
+    eprintln!(
+        "lead bullet into the reduced model, 30 µs: length {:.4} mm, diameter {:.4} mm ({:.4}, {:.4} at rest); balance {:.2e}; pressure law {worst:.3e} Pa of {pmax:.3e} Pa",
+        len * 1e3,
+        dia * 1e3,
+        len0 * 1e3,
+        dia0 * 1e3,
+        st.max_balance_error_relative
+    );
+    // Measured 3.4e-5 (the issue asks ≤ 1 %); the pressure law 12 Pa of 194 MPa (6.4e-8,
+    // tolerance 2e-7); the nose 12.68 → 12.32 mm long, 9.00 → 9.28 mm across.
+    assert!(st.max_balance_error_relative < 1e-4);
+    assert!(worst < 2e-7 * pmax, "{worst} of {pmax}");
     assert!(dia > dia0 && len < len0, "{len0} {dia0} -> {len} {dia}");
 }
 

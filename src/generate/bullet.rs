@@ -285,6 +285,10 @@ pub fn add_to(
         let k = m.add_node(next_node + i as i64, *x);
         m.initial_velocities.push((k, [0.0, 0.0, -velocity]));
     }
+    if !m.initial_displacement.is_empty() {
+        // A formed or relaxed model's start: the bullet starts where it is meshed.
+        m.initial_displacement.resize(m.num_nodes(), [0.0; 3]);
+    }
     let mut parts = vec![m.add_part(
         next_part,
         "bullet",

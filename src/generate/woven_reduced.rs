@@ -163,6 +163,11 @@ pub struct WovenParams {
     /// Safety factor on the stable step [–], 0 < f ≤ 1 (the model's `dt_safety`; 0.9 by
     /// default): the projectile's contact penalty is κ m*/Δt².
     pub dt_safety: f64,
+    /// A deformable bullet of hexahedra instead of the rigid projectile (diameter twice
+    /// `projectile_radius`, mass `projectile_mass`, at `projectile_velocity`, friction
+    /// `projectile_friction`; its faces and nodes in contact with the yarns' trusses, of
+    /// contact thickness √(4A/π)): [`crate::generate::bullet`]. None: rigid.
+    pub bullet: Option<crate::generate::bullet::BulletParams>,
 }
 
 impl Default for WovenParams {
@@ -212,6 +217,7 @@ impl WovenParams {
             end_time: 5e-5,
             output_interval: 1e-6,
             dt_safety: 0.9,
+            bullet: None,
         }
     }
 
@@ -349,7 +355,9 @@ pub fn woven_reduced(p: &WovenParams) -> Result<Model> {
     }
     let interface = tie_boundary(&mut m, &layout, &yarns, &coarse)?;
     hold_outer_edge(&mut m, &coarse, p.quarter, p.length);
-    add_projectile(&mut m, p);
+    if p.bullet.is_none() {
+        add_projectile(&mut m, p);
+    }
     m.node_sets.insert("reference".into(), yarns.warp.clone());
     m.node_sets.insert("interface".into(), interface);
     centre_line_sets(&mut m, &yarns.warp, layout.c);
@@ -363,7 +371,38 @@ pub fn woven_reduced(p: &WovenParams) -> Result<Model> {
     if p.pretension_strain != 0.0 && p.pretension_start == PretensionStart::Relaxed {
         relax_start(&mut m, p)?;
     }
+    if let Some(b) = &p.bullet {
+        add_bullet(&mut m, p, b, &parts)?;
+    }
     Ok(m)
+}
+
+/// The deformable bullet at the centre (after the relaxed start, which it takes no part
+/// in), its tip 0.1 mm above the yarns' contact surface (the crimp plus the trusses'
+/// contact radius √(A/π)), in contact with both yarn parts.
+fn add_bullet(
+    m: &mut Model,
+    p: &WovenParams,
+    b: &crate::generate::bullet::BulletParams,
+    parts: &ReducedParts,
+) -> Result<()> {
+    let b = crate::generate::bullet::BulletParams {
+        diameter: 2.0 * p.projectile_radius,
+        mass: p.projectile_mass,
+        ..b.clone()
+    };
+    let top = p.crimp + (p.yarn_area / std::f64::consts::PI).sqrt();
+    crate::generate::bullet::add_to(
+        m,
+        &b,
+        [0.0, 0.0, top + 1e-4],
+        p.projectile_velocity,
+        p.quarter,
+        p.projectile_friction,
+        &[parts.yarn, parts.half_yarn],
+    )?;
+    m.analysis.variable_time_step = true;
+    m.validate()
 }
 
 /// Where the reduced patch's crossing lines and the membrane's hole lie.

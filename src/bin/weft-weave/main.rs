@@ -448,6 +448,8 @@ struct WovenArgs {
     /// default is 0.1).
     #[arg(long, default_value_t = WovenParams::default().projectile_friction)]
     projectile_friction: f64,
+    #[command(flatten)]
+    bullet: BulletArgs,
     /// Simulated time [s].
     #[arg(long, default_value_t = WovenParams::default().end_time)]
     end_time: f64,
@@ -832,10 +834,13 @@ impl WovenArgs {
             end_time: self.end_time,
             output_interval: self.output_interval,
             dt_safety: self.dt_safety,
+            // (Checked in `weave`, before the model is built.)
+            bullet: self.bullet.params().ok().flatten(),
         }
     }
 
     fn weave(&self) -> anyhow::Result<()> {
+        self.bullet.params()?;
         let p = self.params();
         let m = weave(&Spec::WovenReduced(p.clone()), &self.out)?;
         let mp = p.membrane();
