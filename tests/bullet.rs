@@ -12,6 +12,8 @@
 //! - mass: the meshed bullet is the NIJ round's 8.0 g (a quarter, 2 g), to round-off;
 //! - the same bits on one and two threads.
 
+mod common;
+use common::solid::on_threads;
 use weft::generate::bullet::{BulletKind, BulletParams};
 use weft::generate::woven::{woven, WovenBandParams, YarnFailure, YarnModel};
 use weft::generate::woven_reduced::{woven_reduced, WovenParams};
@@ -141,13 +143,7 @@ fn a_lead_bullet_in_the_reduced_girder_balances_energy_and_keeps_its_volume_law(
 #[test]
 fn an_fmj_bullet_runs_the_same_on_one_and_two_threads() {
     let m = patch(BulletKind::Fmj, 400.0, 5e-6);
-    let go = |threads: usize| {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap()
-            .install(|| run_in_memory(&m).unwrap())
-    };
+    let go = |threads: usize| on_threads(threads, || run_in_memory(&m).unwrap());
     let (s1, o1, st1) = go(1);
     let (s2, o2, st2) = go(2);
     assert!(o1.u == o2.u && o1.energy == o2.energy && st1.steps == st2.steps);

@@ -19,17 +19,8 @@ use weft::model::contacts::{ContactDef, Slave};
 use weft::model::{Analysis, ElementKind, Model, PartProps};
 use weft::solver::{run_in_memory, Solver};
 
-const E: f64 = 200e9;
-const RHO: f64 = 7850.0;
-
-fn steel(nu: f64) -> PartProps {
-    PartProps {
-        youngs_modulus: Some(E),
-        density: Some(RHO),
-        poisson_ratio: Some(nu),
-        ..Default::default()
-    }
-}
+mod common;
+use common::solid::{on_threads, steel, STEEL_E as E, STEEL_RHO as RHO};
 
 /// A bar of `n` cubes of side h along x from `x0` (one element across), added to `m` as
 /// part `id`; returns (part, first node index). Node first + 4i + 2j + k is at
@@ -375,13 +366,7 @@ fn block_on_band() -> (Vec<[f64; 3]>, Vec<f64>, f64, usize) {
 
 #[test]
 fn a_block_on_a_band_is_bit_identical_on_one_and_two_threads() {
-    let run = |threads: usize| {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap()
-            .install(block_on_band)
-    };
+    let run = |threads: usize| on_threads(threads, block_on_band);
     let (x1, e1, bal, active) = run(1);
     let (x2, e2, _, _) = run(2);
     eprintln!("block on band: {active} penetrated pairs over the run, balance {bal:.2e}");

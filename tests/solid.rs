@@ -19,17 +19,8 @@ use weft::solver::rotations::Rotations;
 use weft::solver::run_in_memory;
 use weft::solver::solid::hex::HexGroup;
 
-const E: f64 = 200e9;
-const RHO: f64 = 7850.0;
-
-fn steel(nu: f64) -> PartProps {
-    PartProps {
-        youngs_modulus: Some(E),
-        density: Some(RHO),
-        poisson_ratio: Some(nu),
-        ..Default::default()
-    }
-}
+mod common;
+use common::solid::{on_threads, steel, struck_block, STEEL_E as E, STEEL_RHO as RHO};
 
 /// A bar of `n` cubes of side h along x (one element across), nodes at
 /// (i h, j h, k h), j, k ∈ {0, 1}; node index 4i + 2j + k.
@@ -463,31 +454,6 @@ fn a_solid_model_round_trips_through_its_tables_and_runs_from_them_as_in_memory(
     assert!(ep > 0.0);
 }
 
-/// A block of n × n × nz cubes of side h (`weft::generate::block`).
-fn block(n: usize, nz: usize, h: f64, props: PartProps) -> Model {
-    hex_block(n, n, nz, h, "block", props)
-}
-
-/// OFHC copper, Johnson & Cook (1983), Table 1: A = 90 MPa, B = 292 MPa, n = 0.31,
-/// C = 0.025, m = 1.09, T_melt = 1356 K; ρ = 8960 kg/m³, c_p = 383 J/(kg K),
-/// E = 124 GPa, ν = 0.34 (handbook values).
-fn copper() -> PartProps {
-    PartProps {
-        youngs_modulus: Some(124e9),
-        poisson_ratio: Some(0.34),
-        density: Some(8960.0),
-        jc_a: Some(90e6),
-        jc_b: Some(292e6),
-        jc_n: Some(0.31),
-        jc_c: Some(0.025),
-        jc_m: Some(1.09),
-        room_temperature: Some(293.15),
-        melt_temperature: Some(1356.0),
-        specific_heat: Some(383.0),
-        ..Default::default()
-    }
-}
-
 #[test]
 fn a_copper_block_struck_on_a_corner_region_balances_energy_and_runs_the_same_on_one_and_two_threads(
 ) {
@@ -496,32 +462,9 @@ fn a_copper_block_struck_on_a_corner_region_balances_energy_and_runs_the_same_on
     // on two threads. Energy: the explicit scheme conserves it to round-off plus
     // what the ledger books (internal with the plastic work, bulk viscosity as damping,
     // hourglass), so the balance must stay near round-off.
-    let (n, nz, h) = (11, 10, 1e-3);
-    let mut m = block(n, nz, h, copper());
-    for (i, x) in m.coords.clone().iter().enumerate() {
-        if x[2] == 0.0 {
-            m.constraints.push((i, [true, true, true]));
-        }
-        // A smooth velocity field, v_z = −150 m/s (1 − r/6 mm)₊ z/H, r the distance from
-        // the corner's vertical edge: the block's top struck around that edge, the held
-        // base at rest; not symmetric about any element (a field that jumps across one
-        // layer of one-point elements, a struck face alone, puts half its energy into
-        // hourglass modes: measured 46 %).
-        let r = x[0].hypot(x[1]);
-        if x[2] > 0.0 && r < 6.0 * h {
-            let vz = -150.0 * (1.0 - r / (6.0 * h)) * x[2] / (nz as f64 * h);
-            m.initial_velocities.push((i, [0.0, 0.0, vz]));
-        }
-    }
-    m.analysis.end_time = 3e-6;
-    m.analysis.output_interval = 1e-7;
-    let run = |threads: usize| {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap()
-            .install(|| run_in_memory(&m).unwrap())
-    };
+    // The block and its velocity field: `common::solid::struck_block`.
+    let m = struck_block();
+    let run = |threads: usize| on_threads(threads, || run_in_memory(&m).unwrap());
     let (s1, o1, st) = run(1);
     let (s2, o2, _) = run(2);
     assert!(

@@ -22,6 +22,8 @@
 
 use std::path::{Path, PathBuf};
 
+mod common;
+use common::solid::{copper, struck_block};
 use weft::generate::block::hex_block;
 use weft::model::io::write_model;
 use weft::model::{Load, Model, PartProps, TimeLaw};
@@ -40,24 +42,6 @@ fn steel() -> PartProps {
         density: Some(7850.0),
         yield_stress: Some(SY),
         tangent_modulus: Some(ET),
-        ..Default::default()
-    }
-}
-
-/// OFHC copper, Johnson & Cook (1983), Table 1 (as in tests/solid.rs).
-fn copper() -> PartProps {
-    PartProps {
-        youngs_modulus: Some(124e9),
-        poisson_ratio: Some(0.34),
-        density: Some(8960.0),
-        jc_a: Some(90e6),
-        jc_b: Some(292e6),
-        jc_n: Some(0.31),
-        jc_c: Some(0.025),
-        jc_m: Some(1.09),
-        room_temperature: Some(293.15),
-        melt_temperature: Some(1356.0),
-        specific_heat: Some(383.0),
         ..Default::default()
     }
 }
@@ -269,25 +253,6 @@ fn a_johnson_cook_cube_heats_by_the_taylor_quinney_share_of_its_plastic_work() {
     // Measured 2.4e-4 relative (the dynamics' lateral stress near yield, where the
     // hardening is steepest); tolerance 8e-4.
     assert!(e_p < 8e-4, "pressure off by {e_p:e}");
-}
-
-/// The 11 × 11 × 10 block of copper struck around a vertical edge (as in tests/solid.rs).
-fn struck_block() -> Model {
-    let (n, nz, h) = (11, 10, 1e-3);
-    let mut m = hex_block(n, n, nz, h, "block", copper());
-    for (i, x) in m.coords.clone().iter().enumerate() {
-        if x[2] == 0.0 {
-            m.constraints.push((i, [true, true, true]));
-        }
-        let r = x[0].hypot(x[1]);
-        if x[2] > 0.0 && r < 6.0 * h {
-            let vz = -150.0 * (1.0 - r / (6.0 * h)) * x[2] / (nz as f64 * h);
-            m.initial_velocities.push((i, [0.0, 0.0, vz]));
-        }
-    }
-    m.analysis.end_time = 3e-6;
-    m.analysis.output_interval = 1e-7;
-    m
 }
 
 #[test]

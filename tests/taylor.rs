@@ -19,6 +19,8 @@
 //!   internal energy;
 //! - the same bits on one and two threads.
 
+mod common;
+use common::solid::on_threads;
 use weft::generate::metals::Metal;
 use weft::generate::taylor::{taylor, TaylorParams};
 use weft::model::Model;
@@ -202,13 +204,7 @@ fn the_aluminium_rod_converges_with_the_mesh() {
 #[test]
 fn a_taylor_rod_runs_the_same_on_one_and_two_threads() {
     let m = taylor(&TaylorParams::default()).unwrap();
-    let go = |threads: usize| {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap()
-            .install(|| run_in_memory(&m).unwrap())
-    };
+    let go = |threads: usize| on_threads(threads, || run_in_memory(&m).unwrap());
     let (s1, o1, st1) = go(1);
     let (s2, o2, st2) = go(2);
     assert!(o1.u == o2.u && o1.energy == o2.energy && st1.steps == st2.steps);

@@ -108,9 +108,14 @@ fn full_disk(q: &Disk) -> Disk {
 }
 
 pub fn check(p: &BulletParams) -> Result<()> {
-    for (name, v) in [("bullet-diameter", p.diameter), ("bullet-mass", p.mass)] {
+    // The generators set the diameter and mass from the projectile's flags.
+    for (what, v, unit) in [
+        ("diameter (2 × --projectile-radius)", p.diameter, "m"),
+        ("mass (--projectile-mass)", p.mass, "kg"),
+    ] {
         if !(v > 0.0 && v.is_finite()) {
-            return Err(WeftError::input(format!("--{name} = `{v}`")).expected("a value > 0"));
+            return Err(WeftError::input(format!("bullet {what} = `{v}`"))
+                .expected(format!("a value > 0 in {unit}")));
         }
     }
     if p.radial < 2 || p.radial % 2 != 0 {
@@ -200,7 +205,7 @@ pub fn mesh(p: &BulletParams, tip: [f64; 3], quarter: bool) -> Result<BulletMesh
             "at least the mass of its nose, {:.3} g",
             nose_mass / share * 1e3
         ))
-        .hint("raise --bullet-mass or lower --bullet-diameter"));
+        .hint("raise --projectile-mass or lower --projectile-radius"));
     }
     let h = r / p.radial as f64;
     let n_body = ((body / h).round() as usize).max(1);

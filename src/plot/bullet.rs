@@ -7,7 +7,7 @@
 use std::path::PathBuf;
 
 use super::chart::{label, Chart, Series, Style};
-use crate::analysis::series::read_series_of;
+use crate::analysis::series::read_nodes_of;
 use crate::error::{Result, WeftError};
 use crate::model::striker::BULLET_SET;
 
@@ -29,7 +29,8 @@ pub fn shape(model: &std::path::Path, history: &std::path::Path) -> Result<Vec<(
         ))
         .hint("weft-weave woven --projectile deformable")
     })?;
-    let s = read_series_of(model, history, BULLET_SET, &[0, 1, 2])?;
+    let nodes = m.bullet_nodes().unwrap_or_default();
+    let s = read_nodes_of(&m, history, nodes, "of set `bullet`", &[0, 1, 2])?;
     let along = |x: &[f64; 3]| x[0] * a[0] + x[1] * a[1] + x[2] * a[2];
     let tip = crate::model::striker::axis_point(&s.x0, a);
     Ok(s.t

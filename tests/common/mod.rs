@@ -5,6 +5,7 @@ use std::path::{Path, PathBuf};
 
 use weft::model::{Analysis, ElementKind, Load, Model, PartProps, TimeLaw};
 
+pub mod solid;
 pub mod woven;
 
 /// Node 0 fixed, node 1 a point mass `m` joined to it by a link (k, c along x) and free

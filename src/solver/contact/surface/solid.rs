@@ -44,18 +44,8 @@
 use super::kernels::Hit;
 use crate::model::{ElementKind, Model};
 use crate::solver::contact::closest::closest_on_quad;
+use crate::solver::solid::kernel::FACES as HEX_FACES;
 use crate::solver::vec3::{cross, dot, sub};
-
-/// The six faces of a hexahedron in LS-DYNA's node order (local indices), each
-/// counter-clockwise seen from outside for a positive Jacobian.
-const HEX_FACES: [[usize; 4]; 6] = [
-    [0, 3, 2, 1],
-    [4, 5, 6, 7],
-    [0, 1, 5, 4],
-    [1, 2, 6, 5],
-    [2, 3, 7, 6],
-    [3, 0, 4, 7],
-];
 
 /// The depth behind a face that is still caught, as a fraction of R (when above the
 /// contact distance c): see the module doc.
