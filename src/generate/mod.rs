@@ -8,6 +8,7 @@ pub mod grid;
 pub mod layers;
 pub mod metals;
 pub mod pulse;
+pub mod reduced_failure;
 pub mod rod;
 pub mod square;
 pub mod surround;

@@ -8,6 +8,9 @@
 use serde::Serialize;
 
 use crate::error::{Result, WeftError};
+use crate::generate::reduced_failure::{
+    check_membrane_strain, fail_membranes, fail_rods, tag_layer, ReducedFailure,
+};
 use crate::generate::surround::{
     centre_line_sets, coarse_membrane, graded_lines, hold_outer_edge, tie_to_hole, Coarse,
     MembraneProps,
@@ -35,6 +38,9 @@ pub struct SurroundParams {
     /// spacing (the thickness only sets ρ_m = ratio·(2ρA/p)/s: s ρ_m and s E_m are what
     /// the membrane's waves see).
     pub thickness: Option<f64>,
+    /// Failure strain of the membrane along both fibre directions (None: it cannot fail,
+    /// as in the paper's studies); see [`crate::generate::reduced_failure::fail_membranes`].
+    pub failure_strain: Option<f64>,
 }
 
 impl Default for SurroundParams {
@@ -53,6 +59,7 @@ impl SurroundParams {
             shear_ratio: 0.0042,
             poisson_ratio: 0.0,
             thickness: None,
+            failure_strain: None,
         }
     }
 }
@@ -168,6 +175,11 @@ pub struct WovenParams {
     /// `projectile_friction`; its faces and nodes in contact with the yarns' trusses, of
     /// contact thickness √(4A/π)): [`crate::generate::bullet`]. None: rigid.
     pub bullet: Option<crate::generate::bullet::BulletParams>,
+    /// The rods' failure (none by default, as in the paper's §5).
+    pub failure: ReducedFailure,
+    /// End the run at the projectile's outcome (analysis.parquet's `stop_on_outcome`: a
+    /// ballistic sweep's runs).
+    pub stop_on_outcome: bool,
 }
 
 impl Default for WovenParams {
@@ -218,6 +230,8 @@ impl WovenParams {
             output_interval: 1e-6,
             dt_safety: 0.9,
             bullet: None,
+            failure: ReducedFailure::default(),
+            stop_on_outcome: false,
         }
     }
 
@@ -289,6 +303,8 @@ impl WovenParams {
                 )));
             }
         }
+        self.failure.check()?;
+        check_membrane_strain(r.failure_strain)?;
         let nu = r.poisson_ratio;
         if !(nu > -1.0 && nu < 1.0) {
             return Err(WeftError::input(format!("--membrane-poisson = `{nu}`"))
@@ -348,8 +364,9 @@ pub fn woven_reduced(p: &WovenParams) -> Result<Model> {
     let mut m = Model::default();
     let yarns = add_yarn_nodes(&mut m, p, &layout);
     let parts = add_parts(&mut m, p);
-    add_yarns_and_links(&mut m, p, &layout, &yarns, &parts);
+    let yarn_of = add_yarns_and_links(&mut m, p, &layout, &yarns, &parts);
     let coarse = coarse_membrane(&mut m, &pos, p.quarter, layout.c, &membrane, 1_000_000);
+    tag_layer(&mut m, &yarn_of);
     if p.pretension_strain != 0.0 && p.pretension_start == PretensionStart::Balanced {
         prestress_membrane(&mut m, p, &membrane);
     }
@@ -365,11 +382,26 @@ pub fn woven_reduced(p: &WovenParams) -> Result<Model> {
         end_time: p.end_time,
         output_interval: p.output_interval,
         dt_safety: p.dt_safety,
+        stop_on_outcome: p.stop_on_outcome,
         ..Default::default()
     };
     m.validate()?;
     if p.pretension_strain != 0.0 && p.pretension_start == PretensionStart::Relaxed {
         relax_start(&mut m, p)?;
+    }
+    let delay = p
+        .failure
+        .delay_for(p.spacing, p.yarn_modulus, p.yarn_density);
+    if p.failure.strain > 0.0 {
+        fail_rods(
+            &mut m,
+            &[parts.yarn, parts.half_yarn],
+            p.failure.strain,
+            delay,
+        );
+    }
+    if let Some(e) = p.surround.failure_strain {
+        fail_membranes(&mut m, e, delay);
     }
     if let Some(b) = &p.bullet {
         add_bullet(&mut m, p, b, &parts)?;
@@ -652,15 +684,18 @@ fn scaled_link(f: f64, base: &PartProps) -> PartProps {
 }
 
 /// The yarns' trusses and the crossings' links, numbered crossing by crossing: the warp
-/// element leaving (i, j), the weft element, the link.
+/// element leaving (i, j), the weft element, the link. Returns each truss's yarn, its
+/// index within its part from 1: the warp on y = jp is j + 1, the weft on x = ip is
+/// n + 2 + i (a rod's part holds warp and weft alike).
 fn add_yarns_and_links(
     m: &mut Model,
     p: &WovenParams,
     l: &Layout,
     y: &YarnNodes,
     parts: &ReducedParts,
-) {
+) -> Vec<i64> {
     let (n, last) = (l.n, l.last());
+    let mut yarn_of = vec![];
     let mut eid = 1;
     for j in 0..=n {
         for i in 0..=n {
@@ -674,6 +709,7 @@ fn add_yarns_and_links(
                     },
                     &[y.warp_at(i, j), y.warp_at(i + 1, j)],
                 );
+                yarn_of.push(j as i64 + 1);
                 eid += 1;
             }
             if j < last {
@@ -686,12 +722,14 @@ fn add_yarns_and_links(
                     },
                     &[y.weft_at(i, j), y.weft_at(i, j + 1)],
                 );
+                yarn_of.push((n + 2 + i) as i64);
                 eid += 1;
             }
             add_link(m, p, l, y, eid, parts.link_at(p.quarter, i, j), (i, j));
             eid += 1;
         }
     }
+    yarn_of
 }
 
 /// The link `eid` of part `part` at the crossing (i, j), in the crossing's frame with
@@ -793,7 +831,7 @@ fn add_projectile(m: &mut Model, p: &WovenParams) {
         prescribed_velocity: false,
         contact_stiffness: None,
         friction: p.projectile_friction,
-        contact_damping: 0.0,
+        contact_damping: p.failure.contact_damping(),
         segment_contact: true,
     });
 }

@@ -254,7 +254,7 @@ impl NodalBound<'_> {
                         "the stable step is set once, from the undeformed model, and a crushed solid needs a smaller one: lower dt_safety (now {dt_safety}) to run on"
                     )
                 } else { format!(
-                    "the stable step is set once, from the undeformed model; strains this large are beyond what most materials bear (aramid yarns break near 3.6 %) and weft models no failure: shorten end_time, lower the load or the impact velocity, or lower dt_safety (now {}) to run on",
+                    "the stable step is set once, from the undeformed model; strains this large are beyond what most materials bear (aramid yarns break near 3.6 %; give the part a failure law, `failure_strain`, to remove such elements): shorten end_time, lower the load or the impact velocity, or lower dt_safety (now {}) to run on",
                     dt_safety
                 ) }),
             });

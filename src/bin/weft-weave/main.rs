@@ -202,6 +202,13 @@ struct WovenBandArgs {
     /// per unit width of both families).
     #[arg(long, requires = "membrane_length")]
     membrane_thickness: Option<f64>,
+    /// With --membrane-length: the membrane fails too, removed once the engineering strain
+    /// of either fibre direction (x or y) reaches this, after the yarns' failure delay
+    /// [default: it cannot fail]. The membrane is
+    /// the fabric homogenised: the yarns' --failure-strain is its natural value, for a
+    /// patch so small that the zone where yarns break reaches it.
+    #[arg(long, requires = "membrane_length")]
+    membrane_failure_strain: Option<f64>,
     /// Projectile nose shape.
     #[arg(long, value_enum, default_value_t = WovenBandParams::default().projectile_shape)]
     projectile_shape: ProjectileShape,
@@ -461,6 +468,31 @@ struct WovenArgs {
     /// step).
     #[arg(long, default_value_t = WovenParams::default().dt_safety)]
     dt_safety: f64,
+    /// Failure strain of the rods, their engineering axial strain (0: they never fail, as
+    /// in the paper's §5). A rod spans a crossing spacing and runs straight, so the strain
+    /// at which the reduced model perforates as the yarn-level patch does is fitted
+    /// (`weft-fit --objective projectile --param yarns.eps_f,half_yarns.eps_f:…`); the
+    /// yarn's own 0.036 is the trial value.
+    #[arg(long, default_value_t = 0.0)]
+    failure_strain: f64,
+    /// Delay τ of the rods' failure [s]: the strain is compared after a low-pass filter of
+    /// time τ [default: ten transits of a rod, p/√(E/ρ) each: 1.34 µs for the aramid at
+    /// 1 mm].
+    #[arg(long)]
+    failure_delay: Option<f64>,
+    /// The membrane surround fails too, removed once the engineering strain of either
+    /// fibre direction (x or y) reaches this, after the rods' delay [default: it cannot
+    /// fail].
+    #[arg(long)]
+    membrane_failure_strain: Option<f64>,
+    /// Viscous damping of the projectile's contact springs, a fraction of critical
+    /// [default: 0.5 when the rods can fail, 0 otherwise].
+    #[arg(long)]
+    projectile_contact_damping: Option<f64>,
+    /// End the run once the projectile is arrested or has perforated (for ballistic
+    /// sweeps: `weft-ballistic search`).
+    #[arg(long)]
+    stop_on_outcome: bool,
 }
 
 #[derive(clap::Args)]
@@ -821,6 +853,7 @@ impl WovenArgs {
                 shear_ratio: self.membrane_shear_ratio,
                 poisson_ratio: self.membrane_poisson,
                 thickness: self.membrane_thickness,
+                failure_strain: self.membrane_failure_strain,
             },
             length: self.length,
             growth: self.growth,
@@ -836,6 +869,12 @@ impl WovenArgs {
             dt_safety: self.dt_safety,
             // (Checked in `weave`, before the model is built.)
             bullet: self.bullet.params().ok().flatten(),
+            failure: weft::generate::reduced_failure::ReducedFailure {
+                strain: self.failure_strain,
+                delay: self.failure_delay,
+                contact_damping: self.projectile_contact_damping,
+            },
+            stop_on_outcome: self.stop_on_outcome,
         }
     }
 
@@ -897,6 +936,7 @@ impl WovenBandArgs {
                 modulus_ratio: self.membrane_modulus_ratio,
                 shear_ratio: self.membrane_shear_ratio,
                 thickness: self.membrane_thickness,
+                failure_strain: self.membrane_failure_strain,
             }),
             failure: YarnFailure {
                 strain: self.failure_strain,

@@ -39,7 +39,10 @@ mod params;
 mod section;
 mod yarns;
 
-pub use params::{Edge, StrengthPer, Surround, WovenBandParams, YarnFailure, YarnModel};
+pub use params::{
+    Edge, StrengthPer, Surround, WovenBandParams, YarnFailure, YarnModel, DELAY_TRANSITS,
+    FAILURE_CONTACT_DAMPING,
+};
 pub use section::{chain_touching_amplitude, Lenticular};
 use section::{crimp_amplitude, crimp_of, Section};
 use yarns::{add_layer, insert_sets, Built, Weave};
@@ -524,6 +527,10 @@ fn surround(m: &mut Model, p: &WovenBandParams, s: &Surround, info: &WovenInfo) 
     axis.extend(beyond);
     m.node_sets.insert("axis_x_all".into(), axis);
     m.node_sets.insert("interface".into(), tied);
+    crate::generate::reduced_failure::check_membrane_strain(s.failure_strain)?;
+    if let Some(e) = s.failure_strain {
+        crate::generate::reduced_failure::fail_membranes(m, e, p.failure_delay());
+    }
     m.analysis.history_sets.push("axis_x_all".into());
     Ok(())
 }

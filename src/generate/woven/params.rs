@@ -207,6 +207,9 @@ pub struct Surround {
     /// layer, the yarns' cross-section per unit width of both families, so that the
     /// membrane's stress is the yarns' at the same strain when E_m = E/2.
     pub thickness: Option<f64>,
+    /// Failure strain of the membrane along both fibre directions (None: it cannot fail);
+    /// see [`crate::generate::reduced_failure::fail_membranes`].
+    pub failure_strain: Option<f64>,
 }
 
 impl Default for Surround {
@@ -227,6 +230,7 @@ impl Surround {
             modulus_ratio: 0.3,
             shear_ratio: 0.0042,
             thickness: None,
+            failure_strain: None,
         }
     }
 }
