@@ -24,8 +24,9 @@ use weft::table::Provenance;
                   bootstrap intervals and the probability of perforation (V50, V10, V90; a \
                   bracket when the outcomes are separated).\n\n`search` runs the impacts of one \
                   model itself, in parallel, narrowing the bracket of the limit to a tolerance.\n\n\
-                  Both write ballistic_runs.parquet (one row per impact) and \
-                  ballistic_limit.parquet (one row per group) into --out (docs/tables.md).\n\n\
+                  Both write ballistic_runs.parquet (one row per impact, with what it cost: \
+                  steps, elements, wall time) and ballistic_limit.parquet (one row per group, \
+                  with what its impacts cost) into --out (docs/tables.md).\n\n\
                   Example:\n  weft-ballistic fit --runs runs/v300 runs/v350 runs/v400 --out runs/limit\n  \
                   weft-ballistic search --model runs/patch --lo 50 --hi 400 --tolerance 5 --out runs/search"
 )]
