@@ -1,12 +1,13 @@
 //! Perforation and the ballistic limit: the woven patch with failing yarns against the
-//! bullet, statistical strengths, the stopped run's tables, and the fits of
-//! `weft-ballistic`.
+//! bullet, statistical strengths, the stopped run's tables, the fits of
+//! `weft-ballistic`, and what its impacts cost.
 //!
 //! References: the impulse–momentum theorem (a perforating projectile loses the momentum
 //! its contact force's impulse takes); the Weibull law of the strengths
 //! (docs/theory.md, "Failure, perforation and the ballistic limit") checked by the
 //! Kolmogorov–Smirnov test and the moments of ln ε (Weibull 1951); the Lambert–Jonas law
-//! (BRL-R-1852, 1976) on synthetic data.
+//! (BRL-R-1852, 1976) on synthetic data; the cost columns against the runs' own
+//! summaries and weft-simulate runs of the same model (the same solver, the same steps).
 
 mod common;
 use common::woven::run_on;
@@ -331,6 +332,7 @@ fn bad_failure_input_is_named() {
         outcome: if perforated { "perforated" } else { "arrested" }.into(),
         energy_absorbed: f64::NAN,
         signature: vec![("layers", 2.0), ("nodes", nodes)],
+        cost: Default::default(),
     };
     let fit = |runs: Vec<weft::ballistic::runs::Run>| -> String {
         match weft::ballistic::runs::group(runs) {
@@ -358,5 +360,261 @@ fn bad_failure_input_is_named() {
             && mixed.contains("nodes = 1 and 2")
             && mixed.contains("runs/30"),
         "{mixed}"
+    );
+}
+
+// ---------------------------------------------------------------------------------------
+// What an impact costs: `ballistic_runs.parquet`'s steps, simulated time, elements,
+// element cycles and wall time, and `ballistic_limit.parquet`'s sums.
+
+const WEAVE: &str = env!("CARGO_BIN_EXE_weft-weave");
+const SIMULATE: &str = env!("CARGO_BIN_EXE_weft-simulate");
+const BALLISTIC: &str = env!("CARGO_BIN_EXE_weft-ballistic");
+
+/// A 4 × 4 chain patch (112 trusses) failing at 3.6 %, its runs ending at the outcome
+/// within 1 ms: at 40 and 80 m/s it stops, at 250 and 400 m/s it is perforated.
+fn small_patch(dir: &std::path::Path) -> std::path::PathBuf {
+    let m = dir.join("patch");
+    run_ok(
+        WEAVE,
+        &[
+            "woven",
+            "--yarns",
+            "4",
+            "--yarn-model",
+            "chain",
+            "--failure-strain",
+            "0.036",
+            "--stop-on-outcome",
+            "--end-time",
+            "1e-3",
+            "--out",
+            m.to_str().unwrap(),
+        ],
+    );
+    m
+}
+
+fn simulate(model: &std::path::Path, out: &std::path::Path, v: f64) {
+    run_ok(
+        SIMULATE,
+        &[
+            "--model",
+            model.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--projectile-velocity",
+            &format!("{v}"),
+            "--quiet",
+        ],
+    );
+}
+
+/// A column of a table as options (null: None); integers as i64, others as f64.
+fn opt_f(t: &weft::table::Table, c: &str) -> Vec<Option<f64>> {
+    t.f64_opt(c)
+        .unwrap()
+        .unwrap_or_else(|| panic!("no column {c}"))
+}
+fn opt_i(t: &weft::table::Table, c: &str) -> Vec<Option<i64>> {
+    t.i64_opt(c)
+        .unwrap()
+        .unwrap_or_else(|| panic!("no column {c}"))
+}
+
+/// The fit's cost columns are the summaries' own: steps, end time and elements as
+/// written, element cycles = steps × elements exactly, the wall time the sum of the five
+/// wall-time columns; each group's sums are the sums of its rows (in the rows' order:
+/// the same additions), the mean their sum over the impacts. A table of the same
+/// summaries without their wall-time columns (an older summary) and with `steps` as
+/// floats gives null wall times and null sums of them, the other columns as before.
+#[test]
+fn the_cost_columns_are_the_summaries_own() {
+    use weft::table::Table;
+    let dir = tempfile::tempdir().unwrap();
+    let m = small_patch(dir.path());
+    let speeds = [40.0, 80.0, 250.0, 400.0];
+    let runs: Vec<std::path::PathBuf> = speeds
+        .iter()
+        .map(|v| {
+            let r = dir.path().join(format!("v{v}"));
+            simulate(&m, &r, *v);
+            r
+        })
+        .collect();
+    let out = dir.path().join("fit");
+    let mut args = vec!["fit", "--bootstrap", "10", "--out", out.to_str().unwrap()];
+    args.push("--runs");
+    args.extend(runs.iter().map(|r| r.to_str().unwrap()));
+    run_ok(BALLISTIC, &args);
+    let t = Table::read(&out.join("ballistic_runs.parquet")).unwrap();
+    let (src, vs) = (
+        t.str("run", "").unwrap(),
+        t.f64("striking_velocity", "").unwrap(),
+    );
+    let (steps, sim, elements) = (
+        opt_i(&t, "steps"),
+        opt_f(&t, "simulated_time"),
+        opt_i(&t, "elements"),
+    );
+    let (cycles, wall) = (opt_i(&t, "element_cycles"), opt_f(&t, "wall_time"));
+    assert_eq!(vs, speeds, "the group's runs in the order of their speeds");
+    for i in 0..4 {
+        assert_eq!(src[i], runs[i].to_str().unwrap());
+        let s = Table::read(&runs[i].join("summary.parquet")).unwrap();
+        let one = |c: &str| s.f64(c, "").unwrap()[0];
+        let (n, e) = (
+            s.i64("steps", "").unwrap()[0],
+            s.i64("elements", "").unwrap()[0],
+        );
+        let w = one("wall_time_setup")
+            + one("wall_time_loads")
+            + one("wall_time_forces")
+            + one("wall_time_update")
+            + one("wall_time_output");
+        println!(
+            "{} m/s: {n} steps × {e} elements = {:?} cycles, {:?} s simulated, wall {:?} s",
+            vs[i], cycles[i], sim[i], wall[i]
+        );
+        assert_eq!((steps[i], elements[i]), (Some(n), Some(e)));
+        assert_eq!(cycles[i], Some(n * e));
+        assert_eq!(e, 112, "the patch's 112 trusses");
+        assert_eq!(sim[i], Some(one("end_time")));
+        assert_eq!(wall[i], Some(w));
+    }
+    let l = Table::read(&out.join("ballistic_limit.parquet")).unwrap();
+    let sum_cycles: i64 = cycles.iter().map(|c| c.unwrap()).sum();
+    let sum_wall: f64 = wall.iter().map(|w| w.unwrap()).sum();
+    assert_eq!(opt_i(&l, "impacts_element_cycles"), vec![Some(sum_cycles)]);
+    assert_eq!(opt_f(&l, "impacts_wall_time"), vec![Some(sum_wall)]);
+    assert_eq!(
+        opt_f(&l, "wall_time_per_impact"),
+        vec![Some(sum_wall / 4.0)]
+    );
+
+    // The same four summaries gathered into one table, without the wall-time columns,
+    // and with `steps` as floats (as pandas writes an integer column with nulls).
+    let batches: Vec<arrow_array::RecordBatch> = runs
+        .iter()
+        .map(|r| {
+            use arrow_schema::{DataType, Field, Schema};
+            let s = Table::read(&r.join("summary.parquet")).unwrap();
+            let (mut fields, mut cols) = (vec![], vec![]);
+            for (f, c) in s.batch.schema().fields().iter().zip(s.batch.columns()) {
+                if f.name().starts_with("wall_time") {
+                    continue;
+                }
+                if f.name() == "steps" {
+                    fields.push(Field::new("steps", DataType::Float64, false));
+                    cols.push(arrow_cast::cast(c, &DataType::Float64).unwrap());
+                } else {
+                    fields.push(f.as_ref().clone());
+                    cols.push(c.clone());
+                }
+            }
+            // Without the summary's provenance (schema metadata), as a gathered table.
+            arrow_array::RecordBatch::try_new(std::sync::Arc::new(Schema::new(fields)), cols)
+                .unwrap()
+        })
+        .collect();
+    let gathered = dir.path().join("gathered.parquet");
+    weft::table::write_table(
+        &gathered,
+        &arrow_select::concat::concat_batches(&batches[0].schema(), &batches).unwrap(),
+        &weft::table::Provenance::new("t", serde_json::json!({})),
+    )
+    .unwrap();
+    let old = dir.path().join("old");
+    run_ok(
+        BALLISTIC,
+        &[
+            "fit",
+            "--table",
+            gathered.to_str().unwrap(),
+            "--bootstrap",
+            "10",
+            "--out",
+            old.to_str().unwrap(),
+        ],
+    );
+    let t = Table::read(&old.join("ballistic_runs.parquet")).unwrap();
+    assert_eq!(opt_f(&t, "wall_time"), vec![None; 4]);
+    assert_eq!(opt_i(&t, "element_cycles"), cycles);
+    assert_eq!(opt_i(&t, "steps"), steps);
+    let l = Table::read(&old.join("ballistic_limit.parquet")).unwrap();
+    assert_eq!(opt_f(&l, "impacts_wall_time"), vec![None]);
+    assert_eq!(opt_f(&l, "wall_time_per_impact"), vec![None]);
+    assert_eq!(opt_i(&l, "impacts_element_cycles"), vec![Some(sum_cycles)]);
+}
+
+/// The search runs the solver weft-simulate runs: each of its impacts took the steps,
+/// the simulated time and the elements of a weft-simulate run of the model at the same
+/// speed, exactly; the elements are the model's trusses (elements_truss.parquet's rows).
+#[test]
+fn the_search_costs_what_weft_simulate_runs_cost() {
+    use weft::table::Table;
+    let dir = tempfile::tempdir().unwrap();
+    let m = small_patch(dir.path());
+    let out = dir.path().join("search");
+    run_ok(
+        BALLISTIC,
+        &[
+            "search",
+            "--model",
+            m.to_str().unwrap(),
+            "--lo",
+            "40",
+            "--hi",
+            "400",
+            "--tolerance",
+            "1000",
+            "--per-round",
+            "2",
+            "--max-rounds",
+            "1",
+            "--threads",
+            "1",
+            "--bootstrap",
+            "10",
+            "--out",
+            out.to_str().unwrap(),
+        ],
+    );
+    let t = Table::read(&out.join("ballistic_runs.parquet")).unwrap();
+    let vs = t.f64("striking_velocity", "").unwrap();
+    let (steps, sim, elements) = (
+        opt_i(&t, "steps"),
+        opt_f(&t, "simulated_time"),
+        opt_i(&t, "elements"),
+    );
+    let (cycles, wall) = (opt_i(&t, "element_cycles"), opt_f(&t, "wall_time"));
+    let trusses = Table::read(&m.join("elements_truss.parquet"))
+        .unwrap()
+        .num_rows() as i64;
+    assert_eq!(vs, vec![40.0, 400.0]);
+    for i in 0..vs.len() {
+        let r = dir.path().join(format!("v{}", vs[i]));
+        simulate(&m, &r, vs[i]);
+        let s = Table::read(&r.join("summary.parquet")).unwrap();
+        let (n, e) = (
+            s.i64("steps", "").unwrap()[0],
+            s.i64("elements", "").unwrap()[0],
+        );
+        let end = s.f64("end_time", "").unwrap()[0];
+        println!(
+            "{} m/s: search {:?} steps, {:?} s, {:?} elements; weft-simulate {n}, {end:e} s, {e}",
+            vs[i], steps[i], sim[i], elements[i]
+        );
+        assert_eq!(steps[i], Some(n));
+        assert_eq!(sim[i], Some(end));
+        assert_eq!(elements[i], Some(e));
+        assert_eq!(e, trusses);
+        assert_eq!(cycles[i], Some(n * e));
+        assert!(wall[i].is_some_and(|w| w.is_finite() && w >= 0.0));
+    }
+    let l = Table::read(&out.join("ballistic_limit.parquet")).unwrap();
+    assert_eq!(
+        opt_i(&l, "impacts_element_cycles"),
+        vec![Some(cycles.iter().map(|c| c.unwrap()).sum())]
     );
 }

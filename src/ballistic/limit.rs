@@ -1,7 +1,7 @@
 //! The ballistic limit of each group of impact runs: the Lambert–Jonas fit of residual
 //! against striking velocity, the probability of perforation, and the tables
 //! `ballistic_runs.parquet` (one row per impact) and `ballistic_limit.parquet` (one row
-//! per group) (docs/tables.md).
+//! per group) (docs/tables.md), each with what the impacts cost.
 
 use std::path::Path;
 
@@ -45,6 +45,35 @@ pub struct Limit {
     pub lambert_jonas: Option<lambert_jonas::Fit>,
     pub fastest_stop: f64,
     pub slowest_perforation: f64,
+    /// What the group's impacts cost together.
+    pub cost: GroupCost,
+}
+
+/// What a group's impacts cost: the cost of its limit. Each `None` when any impact's
+/// part is unknown.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct GroupCost {
+    /// The sum of the impacts' wall times [s].
+    pub wall_time: Option<f64>,
+    /// The sum of the impacts' steps × elements.
+    pub element_cycles: Option<i64>,
+    /// The mean wall time of an impact [s].
+    pub wall_time_per_impact: Option<f64>,
+}
+
+/// The sums over a group's impacts, in their order.
+pub fn group_cost(runs: &[Run]) -> GroupCost {
+    let wall_time: Option<f64> = runs.iter().map(|r| r.cost.wall_time).sum();
+    let element_cycles = runs
+        .iter()
+        .try_fold(0i64, |s, r| s.checked_add(r.cost.element_cycles()?));
+    GroupCost {
+        wall_time,
+        element_cycles,
+        wall_time_per_impact: wall_time
+            .filter(|_| !runs.is_empty())
+            .map(|w| w / runs.len() as f64),
+    }
 }
 
 /// Fits every group; a group whose velocities cannot bracket a limit is refused.
@@ -108,6 +137,7 @@ fn fit_group(group: &str, runs: &[Run], by: &str, o: &Options) -> Result<Limit> 
             .filter(|r| r.perforated)
             .map(|r| r.striking_velocity)
             .fold(f64::INFINITY, f64::min),
+        cost: group_cost(runs),
     })
 }
 
@@ -122,8 +152,10 @@ pub fn write_runs(
 ) -> Result<()> {
     let mut cols: (Vec<String>, Vec<String>, Vec<f64>, Vec<f64>, Vec<bool>) = Default::default();
     let (mut outcome, mut absorbed, mut fitted) = (vec![], vec![], vec![]);
+    let mut cost = vec![];
     for ((_, runs), l) in groups.iter().zip(limits) {
         for r in runs {
+            cost.push(r.cost);
             cols.0.push(r.source.clone());
             cols.1.push(r.group.clone());
             cols.2.push(r.striking_velocity);
@@ -145,6 +177,17 @@ pub fn write_runs(
             Col::Str("outcome", outcome),
             Col::OptF64("energy_absorbed", absorbed),
             Col::OptF64("residual_velocity_fit", fitted),
+            Col::OptI64("steps", cost.iter().map(|c| c.steps).collect()),
+            Col::OptF64(
+                "simulated_time",
+                cost.iter().map(|c| c.simulated_time).collect(),
+            ),
+            Col::OptI64("elements", cost.iter().map(|c| c.elements).collect()),
+            Col::OptI64(
+                "element_cycles",
+                cost.iter().map(|c| c.element_cycles()).collect(),
+            ),
+            Col::OptF64("wall_time", cost.iter().map(|c| c.wall_time).collect()),
         ]),
         prov,
     )
@@ -223,6 +266,18 @@ pub fn write_limits(path: &Path, limits: &[Limit], by: &str, prov: &Provenance) 
                     .iter()
                     .map(|l| l.lambert_jonas.as_ref().map(|f| f.replicates as i64))
                     .collect(),
+            ),
+            Col::OptF64(
+                "impacts_wall_time",
+                limits.iter().map(|l| l.cost.wall_time).collect(),
+            ),
+            Col::OptI64(
+                "impacts_element_cycles",
+                limits.iter().map(|l| l.cost.element_cycles).collect(),
+            ),
+            Col::OptF64(
+                "wall_time_per_impact",
+                limits.iter().map(|l| l.cost.wall_time_per_impact).collect(),
             ),
         ]),
         prov,

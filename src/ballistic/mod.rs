@@ -1,8 +1,8 @@
 //! Ballistic limits from impact runs: the runs gathered and grouped ([`runs`]), the
 //! Lambert–Jonas fit of residual against striking velocity ([`lambert_jonas`]), the
 //! probability of perforation ([`probability`]), the limit of each group and its tables
-//! ([`limit`]), and a search that runs the impacts itself, bracketing the limit
-//! ([`search`]).
+//! ([`limit`]), a search that runs the impacts itself, bracketing the limit
+//! ([`search`]), and the failed zone of impacts ([`zone`]).
 //! The physics and the practice behind them: docs/theory.md, "Failure, perforation and
 //! the ballistic limit".
 
@@ -11,3 +11,4 @@ pub mod limit;
 pub mod probability;
 pub mod runs;
 pub mod search;
+pub mod zone;

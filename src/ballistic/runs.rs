@@ -1,7 +1,8 @@
 //! Impact runs gathered for a ballistic limit: one [`Run`] per impact, read from the
 //! `summary.parquet` of each run folder (or from one table that gathers them, as
 //! `weft gather` writes), grouped by a column (`layers`, by default), each group checked
-//! to be one model.
+//! to be one model. Each run keeps what it cost ([`Cost`]: steps, simulated time, the
+//! model's elements, wall time), from the summary's columns where it has them.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -27,7 +28,41 @@ pub struct Run {
     /// What must agree within a group: layers, the projectile's mass and radius, and the
     /// model's nodes and elements.
     pub signature: Vec<(&'static str, f64)>,
+    /// What the impact cost (unknown parts `None`).
+    pub cost: Cost,
 }
+
+/// What one impact cost: its solver steps and simulated time to its outcome, the
+/// model's elements (the solver's count, point masses left out: the summary's
+/// `elements`), and the wall time of its run. `None` where unknown (a summary written
+/// before these columns).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Cost {
+    pub steps: Option<i64>,
+    /// [s]
+    pub simulated_time: Option<f64>,
+    pub elements: Option<i64>,
+    /// [s]: a measurement of the machine, not reproducible.
+    pub wall_time: Option<f64>,
+}
+
+impl Cost {
+    /// Steps × elements: the element updates the run took (`None` when either is
+    /// unknown, or the product overflows).
+    pub fn element_cycles(&self) -> Option<i64> {
+        self.steps?.checked_mul(self.elements?)
+    }
+}
+
+/// The summary's wall-time columns whose sum is a run's wall time (setup, external
+/// loads, forces, node update, output; the contact's time is within the forces').
+pub const WALL_TIME_COLUMNS: [&str; 5] = [
+    "wall_time_setup",
+    "wall_time_loads",
+    "wall_time_forces",
+    "wall_time_update",
+    "wall_time_output",
+];
 
 /// The summary columns a run must have.
 const REQUIRED: &str = "striking_velocity, outcome, perforated, residual_velocity, layers";
@@ -52,6 +87,7 @@ pub fn read_table(path: &Path, by: &str, label: &dyn Fn(usize) -> String) -> Res
     let residual = t.f64_opt("residual_velocity")?.unwrap_or(vec![None; n]);
     let absorbed = t.f64_opt("energy_absorbed")?.unwrap_or(vec![None; n]);
     let group = group_column(&t, by)?;
+    let cost = costs(&t)?;
     let sig: Vec<(&'static str, Vec<f64>)> = SIGNATURE
         .iter()
         .filter(|c| t.has(c))
@@ -72,9 +108,56 @@ pub fn read_table(path: &Path, by: &str, label: &dyn Fn(usize) -> String) -> Res
             outcome: outcome[row].clone(),
             energy_absorbed: absorbed[row].unwrap_or(f64::NAN),
             signature: sig.iter().map(|(c, v)| (*c, v[row])).collect(),
+            cost: cost[row],
         });
     }
     Ok(runs)
+}
+
+/// Each row's cost from a table of summaries: `steps`, `end_time`, `elements` and the
+/// sum of [`WALL_TIME_COLUMNS`], `None` where a column is absent or its cell null.
+fn costs(t: &Table) -> Result<Vec<Cost>> {
+    let n = t.num_rows();
+    let steps = count_column(t, "steps")?.unwrap_or(vec![None; n]);
+    let end = t.f64_opt("end_time")?.unwrap_or(vec![None; n]);
+    let elements = count_column(t, "elements")?.unwrap_or(vec![None; n]);
+    let mut wall: Vec<Option<f64>> = vec![Some(0.0); n];
+    for c in WALL_TIME_COLUMNS {
+        let v = t.f64_opt(c)?.unwrap_or(vec![None; n]);
+        for (w, x) in wall.iter_mut().zip(v) {
+            *w = w.zip(x).map(|(a, b)| a + b);
+        }
+    }
+    Ok((0..n)
+        .map(|row| Cost {
+            steps: steps[row],
+            simulated_time: end[row],
+            elements: elements[row],
+            wall_time: wall[row],
+        })
+        .collect())
+}
+
+/// A count column (`steps`, `elements`): integers, or the floats a table gathered by
+/// another tool may hold (pandas writes an integer column with nulls so), each a whole
+/// number; `None` when the column is absent.
+fn count_column(t: &Table, c: &str) -> Result<Option<Vec<Option<i64>>>> {
+    if let Ok(v) = t.i64_opt(c) {
+        return Ok(v);
+    }
+    let Some(v) = t.f64_opt(c)? else {
+        return Ok(None);
+    };
+    v.iter()
+        .enumerate()
+        .map(|(row, x)| match x {
+            Some(x) if x.fract() != 0.0 || x.abs() > 9e15 => {
+                Err(t.value_error(c, row, format!("`{c}` = {x} is not a count")))
+            }
+            x => Ok(x.map(|x| x as i64)),
+        })
+        .collect::<Result<Vec<_>>>()
+        .map(Some)
 }
 
 /// A numeric column as f64 (integers included).

@@ -1,9 +1,11 @@
 //! A ballistic limit searched by running the impacts: rounds of `per_round` impacts run
 //! in parallel at velocities spread over the bracket of the limit, each round narrowing
 //! the bracket (the fastest stop below the slowest perforation) by a factor
-//! `per_round + 1`, until it is narrower than the tolerance.
+//! `per_round + 1`, until it is narrower than the tolerance. Each impact keeps what it
+//! cost: its steps, simulated time and elements from the solver, and the wall time of
+//! its solver (set up and run) as measured.
 
-use super::runs::Run;
+use super::runs::{Cost, Run};
 use crate::error::{Result, WeftError};
 use crate::model::Model;
 use crate::solver::output::Sink;
@@ -54,10 +56,12 @@ pub fn impact(m: &Model, v: f64, label: &str) -> Result<(Run, u64, f64)> {
     let mut m = m.clone();
     m.set_striking_speed(v);
     m.analysis.stop_on_outcome = true;
+    let clock = std::time::Instant::now();
     let mut s = Solver::new(&m)?;
     let stats = s
         .run(&mut Discard, &mut |_| {})
         .map_err(|e| e.context(format!("the impact at {v} m/s stopped")))?;
+    let wall_time = clock.elapsed().as_secs_f64();
     let (perforated, residual, outcome) = match s.watch.outcome {
         Outcome::Perforated {
             residual_velocity, ..
@@ -80,6 +84,12 @@ pub fn impact(m: &Model, v: f64, label: &str) -> Result<(Run, u64, f64)> {
                 f64::NAN
             },
             signature: vec![],
+            cost: Cost {
+                steps: i64::try_from(stats.steps).ok(),
+                simulated_time: Some(stats.end_time),
+                elements: i64::try_from(stats.elements).ok(),
+                wall_time: Some(wall_time),
+            },
         },
         stats.steps,
         stats.end_time,

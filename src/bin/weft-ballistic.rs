@@ -1,5 +1,5 @@
 //! `weft-ballistic`: ballistic limits from impact runs (`fit`), or by running the impacts
-//! (`search`).
+//! (`search`), and the failed zone of impact runs (`zone`).
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -8,14 +8,14 @@ use clap::{Parser, Subcommand};
 use weft::ballistic::lambert_jonas::Bounds;
 use weft::ballistic::limit::{self, Options};
 use weft::ballistic::probability::Link;
-use weft::ballistic::{runs, search};
+use weft::ballistic::{runs, search, zone};
 use weft::table::Provenance;
 
 #[derive(Parser)]
 #[command(
     name = "weft-ballistic",
     version,
-    about = "Ballistic limits (V50, the Lambert–Jonas fit) from impact runs, or by running them",
+    about = "Ballistic limits (V50, the Lambert–Jonas fit) from impact runs, or by running them; the failed zone of impact runs",
     long_about = "The ballistic limit of a fabric from impacts at several striking velocities \
                   (docs/theory.md, \"Failure, perforation and the ballistic limit\").\n\n\
                   `fit` gathers impact runs (the weft-simulate output folders, or one table that \
@@ -24,10 +24,14 @@ use weft::table::Provenance;
                   bootstrap intervals and the probability of perforation (V50, V10, V90; a \
                   bracket when the outcomes are separated).\n\n`search` runs the impacts of one \
                   model itself, in parallel, narrowing the bracket of the limit to a tolerance.\n\n\
-                  Both write ballistic_runs.parquet (one row per impact) and \
-                  ballistic_limit.parquet (one row per group) into --out (docs/tables.md).\n\n\
+                  Both write ballistic_runs.parquet (one row per impact, with what it cost: \
+                  steps, elements, wall time) and ballistic_limit.parquet (one row per group, \
+                  with what its impacts cost) into --out (docs/tables.md).\n\n\
+                  `zone` measures where the elements of impact runs failed: the failed zone's \
+                  radius and diameter per run and layer (failure_zone.parquet).\n\n\
                   Example:\n  weft-ballistic fit --runs runs/v300 runs/v350 runs/v400 --out runs/limit\n  \
-                  weft-ballistic search --model runs/patch --lo 50 --hi 400 --tolerance 5 --out runs/search"
+                  weft-ballistic search --model runs/patch --lo 50 --hi 400 --tolerance 5 --out runs/search\n  \
+                  weft-ballistic zone --run runs/v400 --model runs/patch --out runs/zone"
 )]
 struct Cli {
     #[command(subcommand)]
@@ -46,6 +50,36 @@ enum Command {
         after_help = "Example:\n  weft-weave woven --yarns 10 --layers 2 --failure-strain 0.036 --out runs/two\n  weft-ballistic search --model runs/two --lo 40 --hi 200 --tolerance 5 --out runs/two-limit"
     )]
     Search(SearchArgs),
+    /// The failed zone of impact runs: how far from the projectile's axis elements failed.
+    #[command(
+        long_about = "The failed zone of impact runs: for each element that failed and left the \
+                      model (failures.parquet, `eroded`), its centroid in the model's initial \
+                      configuration and its distance r from the projectile's axis (the line \
+                      through the projectile's initial position along its initial velocity). \
+                      Per run and layer, failure_zone.parquet: the failed elements, the largest r \
+                      (radius_max), its 90th percentile (radius_p90, nearest rank), the first and \
+                      last failure times, and the diameter.\n\n\
+                      The diameter is 2 × radius_max: the failed zone's diameter on the full \
+                      fabric (a quarter model's zone is symmetric about the axis). A patch should \
+                      be at least twice as large as the zone where yarns fail: compare the \
+                      patch's width with 2 × diameter.",
+        after_help = "Example:\n  weft-weave woven --yarns 10 --failure-strain 0.036 --stop-on-outcome --out runs/patch\n  weft-simulate --model runs/patch --projectile-velocity 400 --out runs/v400\n  weft-ballistic zone --run runs/v400 --model runs/patch --out runs/zone"
+    )]
+    Zone(ZoneArgs),
+}
+
+#[derive(clap::Args)]
+struct ZoneArgs {
+    /// An impact run folder (weft-simulate --out) with its failures.parquet; repeat it for
+    /// several runs of the one model.
+    #[arg(long, required = true)]
+    run: Vec<PathBuf>,
+    /// The model folder the runs used (its nodes, elements and projectile).
+    #[arg(long)]
+    model: PathBuf,
+    /// Output folder for failure_zone.parquet.
+    #[arg(long)]
+    out: PathBuf,
 }
 
 #[derive(clap::Args)]
@@ -162,7 +196,36 @@ fn run_cli() -> anyhow::Result<ExitCode> {
     match cli.command {
         Command::Fit(a) => fit(a),
         Command::Search(a) => search_cmd(a),
+        Command::Zone(a) => zone_cmd(a),
     }
+}
+
+fn zone_cmd(a: ZoneArgs) -> anyhow::Result<ExitCode> {
+    let rows = zone::failure_zone(&a.run, &a.model)?;
+    std::fs::create_dir_all(&a.out).map_err(|e| weft::WeftError::io(&a.out, e))?;
+    let mut prov = Provenance::new(
+        "ballistic",
+        serde_json::json!({ "runs": a.run, "model": a.model }),
+    );
+    for r in &a.run {
+        prov = prov.with_input(&r.join("failures.parquet"))?;
+    }
+    let path = a.out.join("failure_zone.parquet");
+    zone::write_zone(&path, &rows, &prov)?;
+    for r in &rows {
+        let mm = |x: Option<f64>| x.map_or("–".to_string(), |x| format!("{:.2} mm", 1e3 * x));
+        eprintln!(
+            "{} layer {}: {} failed elements, radius {} (p90 {}), diameter {}",
+            r.run,
+            r.layer,
+            r.failed_elements,
+            mm(r.radius_max),
+            mm(r.radius_p90),
+            mm(r.diameter)
+        );
+    }
+    eprintln!("  wrote {}", path.display());
+    Ok(ExitCode::SUCCESS)
 }
 
 fn fit(a: FitArgs) -> anyhow::Result<ExitCode> {
