@@ -329,7 +329,9 @@ pub fn tables(root: &Path) -> Vec<PathBuf> {
 
 /// Timing columns of the weft tables: wall times and the throughput derived from them.
 pub fn timing(column: &str) -> bool {
-    column.starts_with("wall_time") || column == "element_updates_per_second"
+    column.starts_with("wall_time")
+        || column == "impacts_wall_time"
+        || column == "element_updates_per_second"
 }
 
 /// Whether two projects' `runs/` hold the same files: tables equal column by column,
