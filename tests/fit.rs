@@ -65,6 +65,7 @@ fn case(name: &str, reference: Series, model: Model) -> Case {
         reference,
         model,
         set: "reference".into(),
+        projectile: None,
     }
 }
 
@@ -109,6 +110,7 @@ fn fit_recovers_a_models_own_parameters() {
         matching: weft::analysis::Matching::Position,
         static_mode: false,
         objective: Objective::Displacement,
+        projectile_weight: 0.0,
     };
     for method in [Method::Cobyla, Method::Gradient] {
         let opts = Options {
@@ -183,6 +185,7 @@ fn section4_errors(cells: usize, static_mode: bool) -> (Vec<f64>, f64, usize) {
         matching: weft::analysis::Matching::Position,
         static_mode,
         objective: Objective::Displacement,
+        projectile_weight: 0.0,
     };
     // The dynamic T is multi-extremal in (G, s, ρ) (the paper's §6 warns of it): from
     // (2e9, 1e-3, 5000) COBYLA alone stops at T = 0.48. A multistart finds the basin.
@@ -270,6 +273,7 @@ fn multistart_is_reproducible_across_thread_counts() {
         matching: weft::analysis::Matching::Position,
         static_mode: false,
         objective: Objective::Displacement,
+        projectile_weight: 0.0,
     };
     let opts = Options {
         starts: 3,
@@ -486,6 +490,7 @@ fn arrival_time_objective_recovers_the_wave_speed() {
             }],
             slack: 0.0,
         },
+        projectile_weight: 0.0,
     };
     let mut problem = problem;
     problem.cases[0].set = "axis_x".into();
@@ -527,12 +532,14 @@ fn thickness_problem(cand: Model, set: &str, matching: weft::analysis::Matching)
             reference,
             model: cand,
             set: set.into(),
+            projectile: None,
         }],
         components: vec![0, 1],
         tolerance: 1e-9,
         matching,
         static_mode: true,
         objective: Objective::Displacement,
+        projectile_weight: 0.0,
     }
 }
 
@@ -649,6 +656,7 @@ fn displacement_and_arrival_objective_recovers_density_and_thickness() {
             slack: 0.0,
             weight: 1.0,
         },
+        projectile_weight: 0.0,
     };
     problem.cases[0].set = "axis_x".into();
     assert!(problem.objective(&[rho, s]).unwrap() < 1e-20);

@@ -29,6 +29,19 @@ use weft::fit::Method;
                   COMPONENT:LEVEL, or --arrival-component at --relative-level of each node's peak, as weft-wavespeed measures \
                   them; the mean over the terms), which matches the wave speeds: W = Σ(t_c − t_r)²/Σ(t_c² + t_r²). \
                   --objective both minimises T + --arrival-weight × W: displacements and wave speeds together.\n\n\
+                  --objective projectile matches the projectile's velocity history instead: P = Σ(v_c − v_r)²/Σ(v_c² + v_r²) \
+                  over the reference's output times, v the first projectile's velocity along its initial direction of \
+                  flight (positive into the target), the reference's from its run's projectile.parquet (beside \
+                  --reference-history, or --reference-projectile), the candidate's from its in-process run (a rigid \
+                  projectile, or a deformable bullet's momentum over its mass), interpolated at the reference's times and \
+                  held at its last value after a run that ended at its outcome (stop_on_outcome). Once yarns fail, the \
+                  displacements of a reduced model and the yarn-level reference cannot match node by node, but what a \
+                  ballistic limit depends on can: the deceleration while the fabric holds, the perforation time, the \
+                  residual velocity. Use it to fit a failure law (a failure strain, a Weibull scale) of a reduced model to \
+                  the reference's perforation, with several cases at striking speeds around the limit, each candidate \
+                  woven at its reference's --projectile-velocity, e.g. --param yarns.eps_f,half_yarns.eps_f:0.02:0.08 \
+                  --objective projectile. --projectile-weight W adds W × P to the displacement, arrival or both \
+                  objective instead (T before failure and the projectile's history after, in one objective).\n\n\
                   Methods: cobyla (derivative-free, bounded) and gradient (projected BFGS, finite-difference gradients \
                   evaluated in parallel); --starts K > 1 adds a multistart global search (Halton points), the local \
                   searches running in parallel.\n\n\
@@ -42,7 +55,8 @@ use weft::fit::Method;
                   --out runs/fit"
 )]
 struct Cli {
-    /// Reference model folder (repeat for several cases).
+    /// Reference model folder (repeat for several cases; not read with --objective
+    /// projectile, which compares no node set).
     #[arg(long, required = true)]
     reference_model: Vec<PathBuf>,
     /// history.parquet of the reference run (repeat, one per case).
@@ -77,7 +91,8 @@ struct Cli {
     matching: weft::analysis::Matching,
     /// What is matched: `displacement` (the paper's T over --components), `arrival` (the
     /// arrival times of waves along the ordered --set, hence their speeds: the mean W of
-    /// the --arrival terms) or `both` (T + --arrival-weight × that mean W).
+    /// the --arrival terms), `both` (T + --arrival-weight × that mean W) or `projectile`
+    /// (the projectile's velocity history, P; no node set compared).
     #[arg(long, value_enum, default_value_t = ObjectiveKind::Displacement)]
     objective: ObjectiveKind,
     /// An arrival term (repeat): COMPONENT:LEVEL, the first time the component reaches
@@ -99,6 +114,15 @@ struct Cli {
     /// --objective both: the weight of the arrival mismatch W beside T.
     #[arg(long, default_value_t = 1.0)]
     arrival_weight: f64,
+    /// The reference run's projectile.parquet (repeat, one per case), for --objective
+    /// projectile or --projectile-weight (default: the projectile.parquet beside each
+    /// --reference-history).
+    #[arg(long)]
+    reference_projectile: Vec<PathBuf>,
+    /// Adds W × P (the projectile's velocity-history mismatch, as --objective projectile)
+    /// to the displacement, arrival or both objective (≥ 0; 0: not compared).
+    #[arg(long, default_value_t = 0.0)]
+    projectile_weight: f64,
     /// Linear static solves; T compares the final displacements.
     #[arg(long = "static")]
     static_mode: bool,
@@ -157,6 +181,8 @@ fn run() -> anyhow::Result<ExitCode> {
         arrival: cli.arrival,
         arrival_slack: cli.arrival_slack,
         arrival_weight: cli.arrival_weight,
+        reference_projectile: cli.reference_projectile,
+        projectile_weight: cli.projectile_weight,
         static_mode: cli.static_mode,
         method: cli.method,
         starts: cli.starts,
@@ -200,6 +226,10 @@ fn run() -> anyhow::Result<ExitCode> {
         cfg.starts,
         r.wall_seconds
     );
+    let best = res.evaluations.iter().min_by(|a, b| a.t.total_cmp(&b.t));
+    if let Some(p) = best.and_then(|e| e.projectile) {
+        eprintln!("  projectile mismatch P at the fitted values {p:.4e}");
+    }
     for ((p, v), e) in r.problem.params.iter().zip(&res.x).zip(&r.expected) {
         let cmp = e
             .map(|e| format!(", expected {e:.4e}: {:+.2} %", 100.0 * (v - e) / e))

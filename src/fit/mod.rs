@@ -10,7 +10,10 @@
 //!   same way) the candidate is solved in-process (explicit, or the linear static solve) and
 //!   T is computed over a node set; the objective is the mean T over the cases. A run that
 //!   fails (instability, a parameter the solver refuses) scores [`FAILED_T`], above the
-//!   largest possible T (2), and its message goes into the trace.
+//!   largest possible T (2), and its message goes into the trace. Wave arrival times
+//!   ([`Objective::Arrival`]) or the projectile's velocity history ([`projectile`]: P, alone
+//!   with [`Objective::Projectile`] or weighted beside the others) may be matched instead
+//!   or as well.
 //! - **Methods:** COBYLA (derivative-free, bounded: Powell's linear-approximation trust
 //!   region, the `cobyla` crate's pure-Rust translation of NLopt's), and a projected BFGS
 //!   with central finite-difference gradients evaluated in parallel (the bounded
@@ -21,6 +24,9 @@
 //!   sequential, so the result and the trace (ordered by start, then evaluation) do not
 //!   depend on the thread count; only the wall times do.
 
+pub mod projectile;
+mod respond;
+mod search;
 pub mod stage;
 
 use std::sync::Mutex;
@@ -32,8 +38,10 @@ use serde::Serialize;
 use crate::analysis::{interpolation, mismatch_paired, pair, Matching, Pairing, Series};
 use crate::error::{Result, WeftError};
 use crate::model::{props, ElementKind, Model, PartProps};
-use crate::solver::output::MemorySink;
-use crate::solver::Solver;
+use projectile::VelocityHistory;
+pub use respond::{respond, respond_nodes, respond_with_projectile};
+use respond::{set_nodes, solve};
+use search::{cobyla_search, gradient_search};
 
 /// T scored by an evaluation whose solve failed: above any real T (which lies in [0, 2]).
 pub const FAILED_T: f64 = 4.0;
@@ -256,6 +264,9 @@ pub struct Case {
     pub model: Model,
     /// The candidate's node set compared with the reference's.
     pub set: String,
+    /// The reference's projectile velocity history, when the objective compares it
+    /// ([`Problem::projectile_weight`] > 0 or [`Objective::Projectile`]).
+    pub projectile: Option<VelocityHistory>,
 }
 
 /// What is minimised.
@@ -272,8 +283,12 @@ pub struct Problem {
     pub matching: Matching,
     /// Linear static solves, comparing final displacements.
     pub static_mode: bool,
-    /// What is compared: displacement histories (T), or wave arrival times.
+    /// What is compared: displacement histories (T), wave arrival times, or the
+    /// projectile's velocity history.
     pub objective: Objective,
+    /// The weight of the projectile mismatch P ([`projectile`]) added to a displacement
+    /// or arrival objective (0: P is not computed).
+    pub projectile_weight: f64,
 }
 
 /// One wave whose arrival times a fit matches: `component` (0..6 = ux … vz) reaching
@@ -304,13 +319,16 @@ pub enum Objective {
         slack: f64,
         weight: f64,
     },
+    /// The projectile's velocity history alone: P ([`projectile`]); no node set is
+    /// compared.
+    Projectile,
 }
 
 impl Objective {
     /// The arrival terms, if the objective has any.
     pub fn arrival_terms(&self) -> &[ArrivalTerm] {
         match self {
-            Objective::Displacement => &[],
+            Objective::Displacement | Objective::Projectile => &[],
             Objective::Arrival { terms, .. } | Objective::Both { terms, .. } => terms,
         }
     }
@@ -374,6 +392,11 @@ impl Problem {
             return Err(WeftError::input("no parameter to fit")
                 .expected("at least one --param PART.PROPERTY:LOWER:UPPER"));
         }
+        self.check_projectile()?;
+        if matches!(self.objective, Objective::Projectile) {
+            // No node set is compared.
+            return Ok(());
+        }
         for c in &self.cases {
             let set = c.model.node_sets.get(&c.set).ok_or_else(|| {
                 WeftError::input(format!(
@@ -413,6 +436,45 @@ impl Problem {
         Ok(())
     }
 
+    /// Whether the objective compares the projectile's velocity history (P).
+    pub fn compares_projectile(&self) -> bool {
+        matches!(self.objective, Objective::Projectile) || self.projectile_weight > 0.0
+    }
+
+    /// The projectile term's weight and each case's striker, speed and duration against
+    /// its reference's.
+    fn check_projectile(&self) -> Result<()> {
+        let w = self.projectile_weight;
+        if !(w >= 0.0 && w.is_finite()) {
+            return Err(WeftError::input(format!("--projectile-weight {w}"))
+                .expected("a finite weight ≥ 0 of the projectile mismatch P (0: not compared)"));
+        }
+        if matches!(self.objective, Objective::Projectile) && w > 0.0 {
+            return Err(WeftError::input(format!(
+                "--projectile-weight {w} with --objective projectile"
+            ))
+            .expected("--projectile-weight beside --objective displacement, arrival or both; --objective projectile minimises P alone"));
+        }
+        if !self.compares_projectile() {
+            return Ok(());
+        }
+        if self.static_mode {
+            return Err(WeftError::input("a projectile objective with --static")
+                .expected("an explicit (dynamic) fit: a static solve has no projectile history"));
+        }
+        for c in &self.cases {
+            let r = c.projectile.as_ref().ok_or_else(|| {
+                WeftError::input(format!(
+                    "case `{}`: no reference projectile history",
+                    c.name
+                ))
+                .expected("the reference run's projectile.parquet for every case")
+            })?;
+            projectile::check_case(&c.name, &c.model, r)?;
+        }
+        Ok(())
+    }
+
     /// The candidate model of case `k` at parameter values `x`.
     pub fn model_at(&self, k: usize, x: &[f64]) -> Model {
         let mut m = self.cases[k].model.clone();
@@ -420,10 +482,20 @@ impl Problem {
         m
     }
 
-    /// The candidate's response at `m` over the nodes the comparison needs, and the
-    /// pairing of the reference's nodes onto it (interpolation searches all of the
-    /// candidate's membrane, truss and beam elements).
-    fn candidate_response(&self, c: &Case, m: &Model) -> Result<(Series, Pairing)> {
+    /// The candidate's run at `m`: its response over the nodes the comparison needs and
+    /// the pairing of the reference's nodes onto it (interpolation searches all of the
+    /// candidate's membrane, truss and beam elements; none with the projectile alone), and
+    /// its projectile's velocity history when the objective compares it.
+    fn candidate_response(&self, c: &Case, m: &Model) -> Result<Candidate> {
+        let striker = self.compares_projectile();
+        if matches!(self.objective, Objective::Projectile) {
+            let r = solve(m, &[], false, true)?;
+            return Ok(Candidate {
+                series: r.series,
+                pairs: vec![],
+                projectile: r.projectile,
+            });
+        }
         if self.matching == Matching::Interpolate {
             let (nodes, pairs) = interpolation(
                 m,
@@ -432,17 +504,30 @@ impl Problem {
                 &c.reference.node_id,
                 self.tolerance,
             )?;
-            return Ok((respond_nodes(m, &nodes, self.static_mode)?, pairs));
+            let r = solve(m, &nodes, self.static_mode, striker)?;
+            return Ok(Candidate {
+                series: r.series,
+                pairs,
+                projectile: r.projectile,
+            });
         }
-        let cand = respond(m, &c.set, self.static_mode)?;
-        let pairs = pair(&c.reference, &cand, self.tolerance, self.matching)?;
-        Ok((cand, pairs))
+        let r = solve(m, &set_nodes(m, &c.set)?, self.static_mode, striker)?;
+        let pairs = pair(&c.reference, &r.series, self.tolerance, self.matching)?;
+        Ok(Candidate {
+            series: r.series,
+            pairs,
+            projectile: r.projectile,
+        })
     }
 
-    /// T of one case at `x` (physical values).
-    pub fn case_t(&self, k: usize, x: &[f64]) -> Result<f64> {
+    /// The objective of one case at `x` (physical values), and its P when compared.
+    pub fn case_score(&self, k: usize, x: &[f64]) -> Result<Score> {
         let c = &self.cases[k];
-        let (cand, pairs) = self.candidate_response(c, &self.model_at(k, x))?;
+        let Candidate {
+            series: cand,
+            pairs,
+            projectile: cand_projectile,
+        } = self.candidate_response(c, &self.model_at(k, x))?;
         let t = || -> Result<f64> {
             Ok(mismatch_paired(
                 &c.reference,
@@ -469,28 +554,66 @@ impl Problem {
             }
             Ok(sum / terms.len().max(1) as f64)
         };
-        match &self.objective {
-            Objective::Displacement => t(),
-            Objective::Arrival { terms, slack } => w(terms, *slack),
+        let p = match (&c.projectile, &cand_projectile) {
+            (Some(r), Some(v)) => Some(projectile::mismatch(r, v)),
+            _ => None,
+        };
+        let p_value = || {
+            p.ok_or_else(|| {
+                WeftError::input("no projectile velocity history to compare")
+                    .expected("a reference projectile history and a candidate with a projectile")
+            })
+        };
+        let value = match &self.objective {
+            Objective::Displacement => t()?,
+            Objective::Arrival { terms, slack } => w(terms, *slack)?,
             Objective::Both {
                 terms,
                 slack,
                 weight,
-            } => Ok(t()? + weight * w(terms, *slack)?),
+            } => t()? + weight * w(terms, *slack)?,
+            Objective::Projectile => p_value()?,
+        };
+        let value =
+            if self.projectile_weight > 0.0 && !matches!(self.objective, Objective::Projectile) {
+                value + self.projectile_weight * p_value()?
+            } else {
+                value
+            };
+        Ok(Score {
+            value,
+            projectile: p,
+        })
+    }
+
+    /// The objective (T, W, P or their weighted sum) of one case at `x` (physical values).
+    pub fn case_t(&self, k: usize, x: &[f64]) -> Result<f64> {
+        Ok(self.case_score(k, x)?.value)
+    }
+
+    /// The mean objective over the cases at `x` (physical values), and the mean P when
+    /// compared.
+    pub fn evaluate(&self, x: &[f64]) -> Result<Score> {
+        let mut sum = 0.0;
+        let mut p_sum = self.compares_projectile().then_some(0.0);
+        for k in 0..self.cases.len() {
+            let s = self
+                .case_score(k, x)
+                .map_err(|e| prefix(e, &self.cases[k].name))?;
+            sum += s.value;
+            p_sum = p_sum.zip(s.projectile).map(|(a, b)| a + b);
         }
+        let n = self.cases.len() as f64;
+        Ok(Score {
+            value: sum / n,
+            projectile: p_sum.map(|p| p / n),
+        })
     }
 
     /// Mean T over the cases at `x` (physical values).
     pub fn objective(&self, x: &[f64]) -> Result<f64> {
-        let mut sum = 0.0;
-        for k in 0..self.cases.len() {
-            sum += self
-                .case_t(k, x)
-                .map_err(|e| prefix(e, &self.cases[k].name))?;
-        }
-        Ok(sum / self.cases.len() as f64)
+        Ok(self.evaluate(x)?.value)
     }
-
     fn values(&self, z: &[f64]) -> Vec<f64> {
         self.params
             .iter()
@@ -498,6 +621,21 @@ impl Problem {
             .map(|(p, &z)| p.value(z))
             .collect()
     }
+}
+
+/// An objective's value at one point, and the projectile mismatch P in it (mean over the
+/// cases; `None` when P is not compared).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Score {
+    pub value: f64,
+    pub projectile: Option<f64>,
+}
+
+/// A candidate's run as a case compares it.
+struct Candidate {
+    series: Series,
+    pairs: Pairing,
+    projectile: Option<VelocityHistory>,
 }
 
 /// The candidate's values paired onto the reference's nodes: one entry per reference
@@ -532,77 +670,6 @@ pub fn aligned(candidate: &Series, pairs: &Pairing, reference: &Series) -> Serie
             })
             .collect(),
     }
-}
-
-/// Solve a model in-process (explicit, or the linear static solve) and return the
-/// response of node set `set` as a [`Series`] (one sample at t = 0 when static).
-pub fn respond(m: &Model, set: &str, static_mode: bool) -> Result<Series> {
-    let nodes = m
-        .node_sets
-        .get(set)
-        .ok_or_else(|| {
-            WeftError::input(format!("the model has no node set `{set}`")).expected(format!(
-                "one of {}",
-                m.node_sets.keys().cloned().collect::<Vec<_>>().join(", ")
-            ))
-        })?
-        .clone();
-    respond_nodes(m, &nodes, static_mode)
-}
-
-/// [`respond`] over model nodes `nodes` (indices, in that order).
-pub fn respond_nodes(m: &Model, nodes: &[usize], static_mode: bool) -> Result<Series> {
-    const SET: &str = "__weft_compared";
-    let mut m = m.clone();
-    m.node_sets.insert(SET.to_string(), nodes.to_vec());
-    let set = SET;
-    m.analysis.history_sets = vec![set.to_string()];
-    let solver = match Solver::new(&m) {
-        // A fixed step chosen for the generator's parameters may exceed the stable step of
-        // the candidate's: fall back to the stable step.
-        Err(_) if m.analysis.time_step.is_some() => {
-            m.analysis.time_step = None;
-            Solver::new(&m)?
-        }
-        r => r?,
-    };
-    let (t, values) = if static_mode {
-        let r = solver.solve_static(&m)?;
-        let v: Vec<[f64; 6]> = nodes
-            .iter()
-            .map(|&i| [r.u[i][0], r.u[i][1], r.u[i][2], 0.0, 0.0, 0.0])
-            .collect();
-        (vec![0.0], vec![v])
-    } else {
-        let mut solver = solver;
-        let mut sink = MemorySink::default();
-        solver.run(&mut sink, &mut |_| {})?;
-        let pos: std::collections::HashMap<usize, usize> = sink
-            .nodes
-            .iter()
-            .enumerate()
-            .map(|(j, &i)| (i, j))
-            .collect();
-        let values = (0..sink.t.len())
-            .map(|k| {
-                nodes
-                    .iter()
-                    .map(|i| {
-                        let j = pos[i];
-                        let (u, v) = (sink.u[k][j], sink.v[k][j]);
-                        [u[0], u[1], u[2], v[0], v[1], v[2]]
-                    })
-                    .collect()
-            })
-            .collect();
-        (sink.t.clone(), values)
-    };
-    Ok(Series {
-        t,
-        node_id: nodes.iter().map(|&i| m.node_id[i]).collect(),
-        x0: nodes.iter().map(|&i| m.coords[i]).collect(),
-        values,
-    })
 }
 
 fn prefix(e: WeftError, case: &str) -> WeftError {
@@ -673,6 +740,9 @@ pub struct Evaluation {
     /// Parameter values (physical units).
     pub x: Vec<f64>,
     pub t: f64,
+    /// The projectile mismatch P in it, mean over the cases (`None`: not compared, or
+    /// the solve failed).
+    pub projectile: Option<f64>,
     pub seconds: f64,
     pub error: Option<String>,
 }
@@ -727,30 +797,32 @@ struct Evaluator<'a> {
 impl Evaluator<'_> {
     /// T at unit-box points, evaluated in parallel, logged in the given order.
     fn eval_many(&self, zs: &[Vec<f64>]) -> Vec<f64> {
-        let out: Vec<(Vec<f64>, f64, f64, Option<String>)> = zs
+        let out: Vec<Evaluation> = zs
             .par_iter()
             .map(|z| {
                 let x = self.problem.values(z);
                 let t0 = Instant::now();
-                let (t, err) = match self.problem.objective(&x) {
-                    Ok(t) if t.is_finite() => (t, None),
-                    Ok(t) => (FAILED_T, Some(format!("T = {t}"))),
-                    Err(e) => (FAILED_T, Some(e.to_string())),
+                let (t, projectile, error) = match self.problem.evaluate(&x) {
+                    Ok(s) if s.value.is_finite() => (s.value, s.projectile, None),
+                    Ok(s) => (FAILED_T, None, Some(format!("T = {}", s.value))),
+                    Err(e) => (FAILED_T, None, Some(e.to_string())),
                 };
-                (x, t, t0.elapsed().as_secs_f64(), err)
+                Evaluation {
+                    start: self.start,
+                    index: 0,
+                    x,
+                    t,
+                    projectile,
+                    seconds: t0.elapsed().as_secs_f64(),
+                    error,
+                }
             })
             .collect();
         let mut log = self.log.lock().expect("log");
         out.into_iter()
-            .map(|(x, t, seconds, error)| {
-                let e = Evaluation {
-                    start: self.start,
-                    index: log.len(),
-                    x,
-                    t,
-                    seconds,
-                    error,
-                };
+            .map(|mut e| {
+                e.index = log.len();
+                let t = e.t;
                 (self.on_eval)(&e);
                 log.push(e);
                 t
@@ -830,143 +902,4 @@ pub fn fit(
         starts: starts_out,
         evaluations,
     })
-}
-
-fn cobyla_search(ev: &Evaluator, z0: &[f64], opts: &Options) -> (Vec<f64>, f64, String) {
-    let n = z0.len();
-    let f = |z: &[f64], _: &mut ()| ev.eval(z);
-    let cons: Vec<&dyn cobyla::Func<()>> = vec![];
-    let stop = cobyla::StopTols {
-        ftol_rel: opts.ftol,
-        xtol_abs: vec![opts.xtol; n],
-        ..Default::default()
-    };
-    // Stop on the target T through COBYLA's own `stopval`-like check: the crate has none,
-    // so the evaluation budget and tolerances end the search.
-    match cobyla::minimize(
-        f,
-        z0,
-        &vec![(0.0, 1.0); n],
-        &cons,
-        (),
-        opts.max_evaluations,
-        cobyla::RhoBeg::All(opts.initial_step),
-        Some(stop),
-    ) {
-        Ok((status, z, t)) => (z, t, format!("{status:?}")),
-        Err((status, z, t)) => (z, t, format!("{status:?}")),
-    }
-}
-
-/// Projected BFGS on the unit box with central-difference gradients (one-sided at a
-/// bound), the 2n gradient evaluations in parallel; Armijo backtracking along the
-/// projected path.
-fn gradient_search(ev: &Evaluator, z0: &[f64], opts: &Options) -> (Vec<f64>, f64, String) {
-    let n = z0.len();
-    let h = 1e-5;
-    let grad = |z: &[f64], f: f64| -> Vec<f64> {
-        let mut pts = vec![];
-        for i in 0..n {
-            let (mut zp, mut zm) = (z.to_vec(), z.to_vec());
-            zp[i] = (z[i] + h).min(1.0);
-            zm[i] = (z[i] - h).max(0.0);
-            pts.push(zp);
-            pts.push(zm);
-        }
-        let fs = ev.eval_many(&pts);
-        (0..n)
-            .map(|i| {
-                let (zp, zm) = (pts[2 * i][i], pts[2 * i + 1][i]);
-                // The centre value stands in for a side clipped to the bound.
-                let fp = if zp > z[i] { fs[2 * i] } else { f };
-                let fm = if zm < z[i] { fs[2 * i + 1] } else { f };
-                (fp - fm) / (zp.max(z[i]) - zm.min(z[i]))
-            })
-            .collect()
-    };
-    let project = |z: &mut [f64]| z.iter_mut().for_each(|v| *v = v.clamp(0.0, 1.0));
-    let mut z = z0.to_vec();
-    let mut f = ev.eval(&z);
-    let mut g = grad(&z, f);
-    let mut hinv = nalgebra::DMatrix::<f64>::identity(n, n);
-    let status = loop {
-        if ev.count() >= opts.max_evaluations {
-            break "MaxEvalReached".to_string();
-        }
-        if f <= opts.target {
-            break "StopValReached".to_string();
-        }
-        // Variables held at a bound by the gradient are out of the step.
-        let free: Vec<bool> = (0..n)
-            .map(|i| !((z[i] <= 0.0 && g[i] > 0.0) || (z[i] >= 1.0 && g[i] < 0.0)))
-            .collect();
-        let pg: f64 = (0..n)
-            .filter(|&i| free[i])
-            .map(|i| g[i].abs())
-            .fold(0.0, f64::max);
-        if pg < 1e-12 {
-            break "GradientSmall".to_string();
-        }
-        let gv =
-            nalgebra::DVector::from_iterator(n, (0..n).map(|i| if free[i] { g[i] } else { 0.0 }));
-        let mut d: Vec<f64> = (-(&hinv * &gv)).iter().copied().collect();
-        for i in 0..n {
-            if !free[i] {
-                d[i] = 0.0;
-            }
-        }
-        if d.iter().zip(&g).map(|(a, b)| a * b).sum::<f64>() >= 0.0 {
-            hinv = nalgebra::DMatrix::identity(n, n);
-            d = (0..n).map(|i| if free[i] { -g[i] } else { 0.0 }).collect();
-        }
-        // Keep a first step within the box's scale.
-        let dmax = d.iter().map(|v| v.abs()).fold(0.0, f64::max);
-        let mut alpha = if dmax > 0.5 { 0.5 / dmax } else { 1.0 };
-        let mut accepted = None;
-        for _ in 0..30 {
-            let mut zn: Vec<f64> = z.iter().zip(&d).map(|(a, b)| a + alpha * b).collect();
-            project(&mut zn);
-            let dz: Vec<f64> = zn.iter().zip(&z).map(|(a, b)| a - b).collect();
-            let decrease: f64 = dz.iter().zip(&g).map(|(a, b)| a * b).sum();
-            if dz.iter().all(|v| v.abs() < opts.xtol * 1e-3) {
-                break;
-            }
-            let fn_ = ev.eval(&zn);
-            if fn_ <= f + 1e-4 * decrease {
-                accepted = Some((zn, fn_));
-                break;
-            }
-            alpha *= 0.5;
-        }
-        let Some((zn, fnew)) = accepted else {
-            break "LineSearchStalled".to_string();
-        };
-        let step: f64 = zn
-            .iter()
-            .zip(&z)
-            .map(|(a, b)| (a - b).abs())
-            .fold(0.0, f64::max);
-        let df = (f - fnew).abs();
-        let gn = grad(&zn, fnew);
-        let s = nalgebra::DVector::from_iterator(n, zn.iter().zip(&z).map(|(a, b)| a - b));
-        let y = nalgebra::DVector::from_iterator(n, gn.iter().zip(&g).map(|(a, b)| a - b));
-        let sy = s.dot(&y);
-        if sy > 1e-14 * s.norm() * y.norm() && sy > 0.0 {
-            let rho = 1.0 / sy;
-            let i = nalgebra::DMatrix::<f64>::identity(n, n);
-            let a = &i - rho * &s * y.transpose();
-            let b = &i - rho * &y * s.transpose();
-            hinv = &a * &hinv * &b + rho * &s * s.transpose();
-        }
-        z = zn;
-        f = fnew;
-        g = gn;
-        if step < opts.xtol {
-            break "XtolReached".to_string();
-        }
-        if df <= opts.ftol * f.abs().max(1e-300) {
-            break "FtolReached".to_string();
-        }
-    };
-    (z, f, status)
 }

@@ -8,10 +8,10 @@ use arrow_array::RecordBatch;
 use serde::Serialize;
 
 use super::{
-    fit, parse_param, ArrivalTerm, Case, Evaluation, FitResult, Method, Objective, Options,
-    Parameter, Problem,
+    fit, parse_param, projectile, ArrivalTerm, Case, Evaluation, FitResult, Method, Objective,
+    Options, Parameter, Problem,
 };
-use crate::analysis::{components, read_series_of, Level};
+use crate::analysis::{components, read_series_of, Level, Series};
 use crate::error::{Result, WeftError};
 use crate::model::io::{read_model, write_model};
 use crate::table::{batch, write_table, Col, Provenance};
@@ -27,6 +27,8 @@ pub enum ObjectiveKind {
     Arrival,
     // T plus the arrival-time mismatch.
     Both,
+    // The projectile's velocity history alone (P).
+    Projectile,
 }
 
 /// Settings of one fit, as `weft-fit`'s flags give them (and as its tables' provenance
@@ -57,6 +59,12 @@ pub struct Config {
     pub arrival_slack: f64,
     /// `both`: the arrival mismatch's weight beside T.
     pub arrival_weight: f64,
+    /// Each case's reference projectile table (empty: the `projectile.parquet` beside its
+    /// reference history).
+    pub reference_projectile: Vec<PathBuf>,
+    /// The weight of the projectile mismatch P added to a displacement or arrival
+    /// objective (0: not compared).
+    pub projectile_weight: f64,
     pub static_mode: bool,
     pub method: Method,
     pub starts: usize,
@@ -160,6 +168,7 @@ pub fn run(c: &Config, on_eval: &(dyn Fn(&Evaluation) + Sync)) -> Result<Report>
         matching: c.matching,
         static_mode: c.static_mode,
         objective,
+        projectile_weight: c.projectile_weight,
     };
     let (result, wall_seconds) = minimise(c, &problem, on_eval)?;
     let mut prov = Provenance::new("fit", serde_json::to_value(c).expect("config serialises"));
@@ -189,6 +198,13 @@ fn check_counts(c: &Config) -> Result<()> {
             c.reference_model.len(),
             c.reference_history.len(),
             n
+        ),
+    )?;
+    check(
+        c.reference_projectile.is_empty() || c.reference_projectile.len() == n,
+        format!(
+            "{} --reference-projectile for {n} cases; expected none (each case's projectile.parquet beside its --reference-history) or one per case",
+            c.reference_projectile.len()
         ),
     )?;
     check(
@@ -229,6 +245,13 @@ fn check_settings(c: &Config) -> Result<()> {
         format!(
             "--arrival-weight {}: expected a finite weight > 0",
             c.arrival_weight
+        ),
+    )?;
+    check(
+        c.projectile_weight >= 0.0 && c.projectile_weight.is_finite(),
+        format!(
+            "--projectile-weight {}: expected a finite weight ≥ 0 of the projectile mismatch P (0: not compared)",
+            c.projectile_weight
         ),
     )?;
     check(
@@ -280,6 +303,23 @@ fn objective(c: &Config) -> Result<Objective> {
             )?;
             Objective::Displacement
         }
+        ObjectiveKind::Projectile => {
+            check(
+                c.arrival.is_empty(),
+                format!(
+                    "--arrival {} with --objective projectile; expected --objective arrival or both",
+                    c.arrival.join(" --arrival ")
+                ),
+            )?;
+            check(
+                c.projectile_weight == 0.0,
+                format!(
+                    "--projectile-weight {} with --objective projectile; expected it beside --objective displacement, arrival or both (projectile minimises P alone)",
+                    c.projectile_weight
+                ),
+            )?;
+            Objective::Projectile
+        }
         ObjectiveKind::Arrival | ObjectiveKind::Both => {
             let terms = arrival_terms(c)?;
             if c.objective == ObjectiveKind::Arrival {
@@ -301,13 +341,24 @@ fn objective(c: &Config) -> Result<Objective> {
 /// The cases as read, and the files the provenance records as the fit's inputs.
 struct ReadCases {
     cases: Vec<Case>,
-    /// Each case's reference history, then its candidate model's tables.
+    /// Each case's reference history (unless the projectile alone is compared), its
+    /// reference projectile table (when compared), then its candidate model's tables.
     inputs: Vec<PathBuf>,
 }
 
 /// Read each case: the reference's series of the components the objective needs (the
-/// compared ones, then the arrival terms' others) and the candidate model.
+/// compared ones, then the arrival terms' others; none with the projectile alone), its
+/// projectile's velocity history when compared, and the candidate model.
 fn read_cases(c: &Config, comps: &[usize], objective: &Objective) -> Result<ReadCases> {
+    let projectile_only = matches!(objective, Objective::Projectile);
+    let compares_projectile = projectile_only || c.projectile_weight > 0.0;
+    if let (false, Some(p)) = (compares_projectile, c.reference_projectile.first()) {
+        return Err(WeftError::input(format!(
+            "--reference-projectile {} without a projectile objective",
+            p.display()
+        ))
+        .expected("--objective projectile or --projectile-weight > 0"));
+    }
     let mut cases = vec![];
     let mut prov_inputs: Vec<PathBuf> = vec![];
     for k in 0..c.model.len() {
@@ -317,22 +368,44 @@ fn read_cases(c: &Config, comps: &[usize], objective: &Objective) -> Result<Read
                 needed.push(a.component);
             }
         }
-        let reference = read_series_of(
-            &c.reference_model[k],
-            &c.reference_history[k],
-            &c.set,
-            &needed,
-        )
-        .map_err(|e| e.context(format!("reference of case {}", k + 1)))?;
+        let reference = if projectile_only {
+            Series {
+                t: vec![],
+                node_id: vec![],
+                x0: vec![],
+                values: vec![],
+            }
+        } else {
+            prov_inputs.push(c.reference_history[k].clone());
+            read_series_of(
+                &c.reference_model[k],
+                &c.reference_history[k],
+                &c.set,
+                &needed,
+            )
+            .map_err(|e| e.context(format!("reference of case {}", k + 1)))?
+        };
+        let projectile = if compares_projectile {
+            let path = projectile::reference_path(
+                &c.reference_history[k],
+                c.reference_projectile.get(k).map(|p| p.as_path()),
+            );
+            let h = projectile::read_reference(&path)
+                .map_err(|e| e.context(format!("reference projectile of case {}", k + 1)))?;
+            prov_inputs.push(path);
+            Some(h)
+        } else {
+            None
+        };
         let model = read_model(&c.model[k])
             .map_err(|e| e.context(format!("candidate model of case {}", k + 1)))?;
-        prov_inputs.push(c.reference_history[k].clone());
         prov_inputs.extend(parquet_files(&c.model[k])?);
         cases.push(Case {
             name: case_name(c, k),
             reference,
             model,
             set: c.candidate_set.clone().unwrap_or_else(|| c.set.clone()),
+            projectile,
         });
     }
     Ok(ReadCases {
@@ -463,7 +536,8 @@ fn case_name(c: &Config, k: usize) -> String {
 
 /// `fit_trace.parquet`: one row per evaluation, ordered by start, then evaluation:
 /// `evaluation`, `start`, `start_evaluation`, one column per parameter (its name),
-/// `T`, `best_T` (the running minimum), `wall_seconds`, `error` (null when it ran).
+/// `T`, `best_T` (the running minimum), `projectile_mismatch` (P, mean over the cases;
+/// null when not compared or the solve failed), `wall_seconds`, `error` (null when it ran).
 pub fn trace_table(r: &Report) -> RecordBatch {
     let ev = &r.result.evaluations;
     let mut running = f64::INFINITY;
@@ -490,6 +564,10 @@ pub fn trace_table(r: &Report) -> RecordBatch {
                 running
             })
             .collect(),
+    ));
+    cols.push(Col::OptF64(
+        "projectile_mismatch",
+        ev.iter().map(|e| e.projectile).collect(),
     ));
     cols.push(Col::F64(
         "wall_seconds",
