@@ -115,19 +115,21 @@ pub fn read_table(path: &Path, by: &str, label: &dyn Fn(usize) -> String) -> Res
 }
 
 /// Each row's cost from a table of summaries: `steps`, `end_time`, `elements` and the
-/// sum of [`WALL_TIME_COLUMNS`], `None` where a column is absent or its cell null.
+/// sum of [`WALL_TIME_COLUMNS`], `None` where a column is absent or its cell null. A
+/// table of `ballistic_runs.parquet` rows (searches gathered by `weft gather`, fitted
+/// again by group) carries its own `simulated_time` and `wall_time`, read as they are.
 fn costs(t: &Table) -> Result<Vec<Cost>> {
     let n = t.num_rows();
     let steps = count_column(t, "steps")?.unwrap_or(vec![None; n]);
-    let end = t.f64_opt("end_time")?.unwrap_or(vec![None; n]);
+    let end = match t.f64_opt("simulated_time")? {
+        Some(v) => v,
+        None => t.f64_opt("end_time")?.unwrap_or(vec![None; n]),
+    };
     let elements = count_column(t, "elements")?.unwrap_or(vec![None; n]);
-    let mut wall: Vec<Option<f64>> = vec![Some(0.0); n];
-    for c in WALL_TIME_COLUMNS {
-        let v = t.f64_opt(c)?.unwrap_or(vec![None; n]);
-        for (w, x) in wall.iter_mut().zip(v) {
-            *w = w.zip(x).map(|(a, b)| a + b);
-        }
-    }
+    let wall = match t.f64_opt("wall_time")? {
+        Some(v) => v,
+        None => summed_wall_time(t)?,
+    };
     Ok((0..n)
         .map(|row| Cost {
             steps: steps[row],
@@ -136,6 +138,19 @@ fn costs(t: &Table) -> Result<Vec<Cost>> {
             wall_time: wall[row],
         })
         .collect())
+}
+
+/// The sum of a summary's [`WALL_TIME_COLUMNS`] per row (`None` where one is missing).
+fn summed_wall_time(t: &Table) -> Result<Vec<Option<f64>>> {
+    let n = t.num_rows();
+    let mut wall: Vec<Option<f64>> = vec![Some(0.0); n];
+    for c in WALL_TIME_COLUMNS {
+        let v = t.f64_opt(c)?.unwrap_or(vec![None; n]);
+        for (w, x) in wall.iter_mut().zip(v) {
+            *w = w.zip(x).map(|(a, b)| a + b);
+        }
+    }
+    Ok(wall)
 }
 
 /// A count column (`steps`, `elements`): integers, or the floats a table gathered by
