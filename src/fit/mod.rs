@@ -41,7 +41,8 @@ use crate::model::{props, ElementKind, Model, PartProps};
 use projectile::VelocityHistory;
 pub use respond::{respond, respond_nodes, respond_with_projectile};
 use respond::{set_nodes, solve};
-use search::{cobyla_search, gradient_search};
+use search::{cobyla_search, gradient_search, Unit};
+pub use search::{Method, Options};
 
 /// T scored by an evaluation whose solve failed: above any real T (which lies in [0, 2]).
 pub const FAILED_T: f64 = 4.0;
@@ -689,48 +690,6 @@ fn prefix(e: WeftError, case: &str) -> WeftError {
     }
 }
 
-/// Local method.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, clap::ValueEnum)]
-#[serde(rename_all = "lowercase")]
-pub enum Method {
-    /// COBYLA: derivative-free, bounded (Powell 1994).
-    Cobyla,
-    /// Projected BFGS with central finite-difference gradients.
-    Gradient,
-}
-
-/// Stopping rules and the global search.
-#[derive(Debug, Clone, Serialize)]
-pub struct Options {
-    pub method: Method,
-    /// Local searches: 1 = local only; more = multistart.
-    pub starts: usize,
-    /// Objective evaluations per local search, at most.
-    pub max_evaluations: usize,
-    /// Stop when steps on the unit box are below this.
-    pub xtol: f64,
-    /// Stop when T changes by less than this, relatively.
-    pub ftol: f64,
-    /// Stop a search when T falls below this.
-    pub target: f64,
-    /// Initial step on the unit box (COBYLA's ρ_beg).
-    pub initial_step: f64,
-}
-
-impl Default for Options {
-    fn default() -> Self {
-        Options {
-            method: Method::Cobyla,
-            starts: 1,
-            max_evaluations: 200,
-            xtol: 1e-6,
-            ftol: 1e-10,
-            target: 0.0,
-            initial_step: 0.1,
-        }
-    }
-}
-
 /// One objective evaluation.
 #[derive(Debug, Clone)]
 pub struct Evaluation {
@@ -794,7 +753,7 @@ struct Evaluator<'a> {
     on_eval: &'a (dyn Fn(&Evaluation) + Sync),
 }
 
-impl Evaluator<'_> {
+impl Unit for Evaluator<'_> {
     /// T at unit-box points, evaluated in parallel, logged in the given order.
     fn eval_many(&self, zs: &[Vec<f64>]) -> Vec<f64> {
         let out: Vec<Evaluation> = zs

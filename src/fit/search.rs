@@ -2,9 +2,60 @@
 //! (derivative-free, bounded) and a projected BFGS with central finite-difference
 //! gradients evaluated in parallel.
 
-use super::{Evaluator, Options};
+use serde::Serialize;
 
-pub(super) fn cobyla_search(ev: &Evaluator, z0: &[f64], opts: &Options) -> (Vec<f64>, f64, String) {
+/// What a local search minimises: the objective at points of the unit parameter box,
+/// evaluated together (in parallel by the caller's implementation), and how many
+/// evaluations it has taken so far.
+pub(super) trait Unit {
+    fn eval_many(&self, zs: &[Vec<f64>]) -> Vec<f64>;
+    fn eval(&self, z: &[f64]) -> f64;
+    fn count(&self) -> usize;
+}
+
+/// Local method.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum Method {
+    /// COBYLA: derivative-free, bounded (Powell 1994).
+    Cobyla,
+    /// Projected BFGS with central finite-difference gradients.
+    Gradient,
+}
+
+/// Stopping rules and the global search.
+#[derive(Debug, Clone, Serialize)]
+pub struct Options {
+    pub method: Method,
+    /// Local searches: 1 = local only; more = multistart.
+    pub starts: usize,
+    /// Objective evaluations per local search, at most.
+    pub max_evaluations: usize,
+    /// Stop when steps on the unit box are below this.
+    pub xtol: f64,
+    /// Stop when T changes by less than this, relatively.
+    pub ftol: f64,
+    /// Stop a search when T falls below this.
+    pub target: f64,
+    /// Initial step on the unit box (COBYLA's ρ_beg).
+    pub initial_step: f64,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Options {
+            method: Method::Cobyla,
+            starts: 1,
+            max_evaluations: 200,
+            xtol: 1e-6,
+            ftol: 1e-10,
+            target: 0.0,
+            initial_step: 0.1,
+        }
+    }
+}
+
+pub(super) fn cobyla_search(ev: &impl Unit, z0: &[f64], opts: &Options) -> (Vec<f64>, f64, String) {
     let n = z0.len();
     let f = |z: &[f64], _: &mut ()| ev.eval(z);
     let cons: Vec<&dyn cobyla::Func<()>> = vec![];
@@ -34,7 +85,7 @@ pub(super) fn cobyla_search(ev: &Evaluator, z0: &[f64], opts: &Options) -> (Vec<
 /// bound), the 2n gradient evaluations in parallel; Armijo backtracking along the
 /// projected path.
 pub(super) fn gradient_search(
-    ev: &Evaluator,
+    ev: &impl Unit,
     z0: &[f64],
     opts: &Options,
 ) -> (Vec<f64>, f64, String) {
