@@ -43,19 +43,17 @@ fn shrink(root: &Path, pipeline: &str, edits: &[(&str, &str)]) {
     std::fs::write(&p, s).unwrap();
 }
 
-/// Per group of a ballistic_limit.parquet: (V50, fastest stop, slowest perforation).
+/// Per group (a string column) of a ballistic_limit.parquet: (V50, fastest stop, slowest
+/// perforation).
 fn limits(path: &Path, by: &str) -> BTreeMap<String, (f64, f64, f64)> {
     let t = Table::read(path).unwrap();
-    let groups: Vec<String> = match t.i64_opt(by).unwrap() {
-        Some(v) => v.into_iter().map(|x| x.unwrap().to_string()).collect(),
-        None => t
-            .str_opt(by)
-            .unwrap()
-            .unwrap()
-            .into_iter()
-            .map(|x| x.unwrap())
-            .collect(),
-    };
+    let groups: Vec<String> = t
+        .str_opt(by)
+        .unwrap()
+        .unwrap()
+        .into_iter()
+        .map(|x| x.unwrap())
+        .collect();
     let col = |c: &str| -> Vec<f64> {
         t.f64_opt(c)
             .unwrap()
