@@ -22,8 +22,9 @@ pub struct Energies {
     pub hourglass: f64,
     /// Contact energy: stored penalty energy and friction work in contact.
     pub contact: f64,
-    /// Strain energy taken out of the model by failed elements (docs/theory.md,
-    /// "Failure, perforation and the ballistic limit").
+    /// Strain energy taken out of the model by failed elements, with the contact energy
+    /// their faces held when they left (docs/theory.md, "Failure, perforation and the
+    /// ballistic limit"; `contact::SurfaceContact::eroded`).
     pub eroded: f64,
     pub external_work: f64,
     /// kinetic + internal + damping + friction + hourglass + contact + eroded − initial −
@@ -66,7 +67,7 @@ pub struct ElementEnergies {
     /// Dissipated by link sliders so far.
     pub friction: f64,
     pub hourglass: f64,
-    /// Taken by failed elements so far.
+    /// Taken by failed elements so far (with the contact energy their faces held).
     pub eroded: f64,
 }
 

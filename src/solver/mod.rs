@@ -530,8 +530,9 @@ impl Solver {
             damping: sums.total(1),
             friction: sums.total(2),
             hourglass: sums.total(3),
+            // With what the contact on the eroded faces held (`SurfaceContact::eroded`).
             eroded: if self.failures.active {
-                self.op.el.eroded_energy()
+                self.op.el.eroded_energy() + self.op.surfaces.eroded
             } else {
                 0.0
             },

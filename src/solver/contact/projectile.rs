@@ -10,6 +10,7 @@
 //! to a, side ρ = R); `round` (round-nosed cylinder: hemisphere of centre P − R a, then
 //! the cylinder ρ = R behind it); `wall` (the plane through P normal to a, unbounded:
 //! every point with s < 0 is inside, pushed out along a; the Taylor test's rigid wall).
+//! The cylinders end at s = −L_c, a flat back face whose outward normal is −a.
 //!
 //! Force on the node f = k g n − friction, on the projectile the opposite (momentum is
 //! exchanged exactly). Friction: f_t = −μ k g t̂ min(1, |v_t|/v_reg), t̂ along the
@@ -139,8 +140,8 @@ impl Projectile {
                 [0.0; 3]
             }
         };
-        match self.shape {
-            ProjectileShape::Sphere => sphere(r),
+        let inside = match self.shape {
+            ProjectileShape::Sphere => return sphere(r),
             ProjectileShape::Flat => {
                 if rho >= r || s < -self.length {
                     return None;
@@ -161,7 +162,16 @@ impl Projectile {
                     None
                 }
             }
-            ProjectileShape::Wall => Some((-s, *a)),
+            ProjectileShape::Wall => return Some((-s, *a)),
+        };
+        // A cylinder's back face: a node nearer to it than to the other surfaces is pushed
+        // out backwards. Without it, a node that came in from behind (a broken yarn end
+        // whipping past a perforating nose) went from no penetration to r − ρ in one
+        // step, millimetres: measured, 0.054 J out of nothing on a chain patch.
+        let back = s + self.length;
+        match inside {
+            Some((g, _)) if back >= 0.0 && back < g => Some((back, [-a[0], -a[1], -a[2]])),
+            other => other,
         }
     }
 }

@@ -64,6 +64,15 @@
 //! - **initial penetration**: a slave inside at t = 0 (g > 0 with g₀ = 0) is recorded with
 //!   its depth g₀ (the force acts only beyond it, and g₀ shrinks as the node leaves), or
 //!   stops the run when the definition says `error`.
+//! - **erosion** (docs/theory.md, "Failure, perforation and the ballistic limit"): the
+//!   faces of a failed element leave the surface at the force evaluation of the step it
+//!   fails; the pairs on them held ½ k g² and would have done a half step of work, which
+//!   a second narrow phase with the faces still in measures and the ledger books as
+//!   eroded energy (as `failure::taken_energy` does for the element itself). From the
+//!   first failure on, each slave's contact is its deepest face's alone, the exact
+//!   gradient of the ½ k g² booked: the shared normal and reaction above are not, and
+//!   broken yarn ends that slide through the crossings at hundreds of m/s gained energy
+//!   by them (`Side::deepest_only`).
 //! - **determinism**: slaves are processed in parallel fixed chunks, each writing only its
 //!   own result slot and its chunk's list of reaction shares; the results are gathered
 //!   onto the nodes in chunk order (the slaves, then their reactions), so 1 and N threads
@@ -245,6 +254,10 @@ pub struct SurfaceContact {
     pub node_friction: Option<Vec<f64>>,
     /// Stored energy at the last force evaluation [J].
     pub stored: f64,
+    /// Energy the faces of failed elements took with them when they left [J]: what the
+    /// pairs on them held, and the half step of work their forces would have done
+    /// ([`Side::pair_energy`]); the ledger books it with the elements' eroded energy.
+    pub eroded: f64,
     pub initial: Vec<InitialPen>,
 }
 
@@ -293,6 +306,7 @@ impl SurfaceContact {
             builds: 0,
             dissipated: 0.0,
             stored: 0.0,
+            eroded: 0.0,
             initial: vec![],
             ..Default::default()
         }
@@ -309,10 +323,53 @@ impl SurfaceContact {
     }
 
     /// Element `e` of kind `kind` has failed: its faces (or segments) leave every side
-    /// whose master surface they belong to.
+    /// whose master surface they belong to, at the next force evaluation (which books
+    /// what they held into `eroded`); from now on every slave's contact is its deepest
+    /// face's alone (see [`Side::deepest_only`]).
     pub fn erode(&mut self, kind: ElementKind, e: usize) {
-        for s in self.sides.iter_mut().filter(|s| s.master_kind == kind) {
-            s.erode(e);
+        for s in self.sides.iter_mut() {
+            s.deepest_only = true;
+            if s.master_kind == kind {
+                s.erode(e);
+            }
+        }
+    }
+
+    /// The faces pending erosion at x^n leave their sides, and what they held is booked
+    /// into `eroded`: per side with such faces, a narrow phase with them (its slaves'
+    /// states restored after it) against the step's own without them
+    /// ([`Side::pair_energy`]; the other slaves give the same terms in both). Returns
+    /// the first phase's energy per side (NaN where there was nothing pending), for
+    /// [`SurfaceContact::book_erosion`] once the step's narrow phase is done.
+    fn probe_erosion(
+        &mut self,
+        x: &[[f64; 3]],
+        v: &[[f64; 3]],
+        dt: f64,
+        dt_prev: f64,
+        spread: Option<&[f64]>,
+    ) -> Vec<f64> {
+        let mut with = vec![f64::NAN; self.sides.len()];
+        for (k, s) in self.sides.iter_mut().enumerate() {
+            if s.pending.is_empty() {
+                continue;
+            }
+            let kept = (s.state.clone(), s.held.clone(), s.out.clone());
+            s.narrow(x, v, dt, dt_prev, false, spread);
+            with[k] = s.pair_energy(v, dt_prev);
+            (s.state, s.held, s.out) = kept;
+            s.drop_pending();
+        }
+        with
+    }
+
+    /// Books the energy the eroded faces took: per side probed, its energy with them
+    /// (`with`) less the step's without them.
+    fn book_erosion(&mut self, with: &[f64], v: &[[f64; 3]], dt_prev: f64) {
+        for (s, w) in self.sides.iter().zip(with) {
+            if !w.is_nan() {
+                self.eroded += w - s.pair_energy(v, dt_prev);
+            }
         }
     }
 
@@ -454,6 +511,12 @@ impl SurfaceContact {
         let t1 = std::time::Instant::now();
         self.build_time += t1 - t0;
         let mut stored = 0.0;
+        let probed = if self.sides.iter().any(|s| !s.pending.is_empty()) {
+            let sp = self.skip_far.then(|| self.motion.spread().to_vec());
+            Some(self.probe_erosion(x, v, dt, dt_prev, sp.as_deref()))
+        } else {
+            None
+        };
         let spread = self.skip_far.then(|| self.motion.spread());
         for s in &mut self.sides {
             s.narrow(x, v, dt, dt_prev, false, spread);
@@ -475,6 +538,9 @@ impl SurfaceContact {
                     }
                 }
             }
+        }
+        if let Some(with) = probed {
+            self.book_erosion(&with, v, dt_prev);
         }
         let t_narrow = std::time::Instant::now();
         let ph = &mut self.phases;

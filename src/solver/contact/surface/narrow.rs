@@ -130,6 +130,10 @@ fn filter_block<const NF: usize>(
 struct Found {
     /// The candidate of largest raw penetration: (face, g, normal).
     best: Option<(u32, f64, [f64; 3])>,
+    /// Its foot's weights, and its thickness gradient (zero for a slave on its
+    /// mid-surface, which adds nothing to the sums below either).
+    best_w: [f64; 4],
+    best_tg: [f64; 3],
     /// Σ g n over the faces the node penetrates (off their mid-surface), and how many: in
     /// a concave crease (a node under a tent of two faces) both feet are valid and the
     /// nearer one's normal flips as the node crosses the bisector; the
@@ -159,6 +163,8 @@ impl Found {
     fn new() -> Found {
         Found {
             best: None,
+            best_w: [0.0; 4],
+            best_tg: [0.0; 3],
             n_sum: [0.0; 3],
             n_count: 0,
             tg_sum: [0.0; 3],
@@ -208,6 +214,30 @@ impl Found {
                 flat
             };
             self.best = Some((fi, g, n));
+            self.best_w = w;
+            self.best_tg = if dist > 0.0 { tg } else { [0.0; 3] };
+        }
+    }
+
+    /// The deepest face alone (the law after a failure, see [`Side::deepest_only`]): its
+    /// share the whole reaction, its normal and thickness gradient the sums', so that the
+    /// force is −∂(½kg²)/∂x of its penetration g.
+    fn deepest(&self, pen: &mut Shares) -> Found {
+        let (fi, g, n) = self.best.expect("a penetrated face");
+        pen[0] = (fi, self.best_w, g);
+        Found {
+            best: self.best,
+            best_w: self.best_w,
+            best_tg: self.best_tg,
+            n_sum: [g * n[0], g * n[1], g * n[2]],
+            n_count: 1,
+            tg_sum: [
+                g * self.best_tg[0],
+                g * self.best_tg[1],
+                g * self.best_tg[2],
+            ],
+            g_sum: g,
+            n_pen: 1,
         }
     }
 }
@@ -247,6 +277,8 @@ struct Narrow<'a> {
     eta: f64,
     /// A solid's faces: their contact thickness t_F (see [`super::solid`]; 0 otherwise).
     solid_t: f64,
+    /// The deepest face alone takes the contact (see [`Side::deepest_only`]).
+    deepest_only: bool,
 }
 
 /// One fixed chunk of slaves as the narrow phase writes it: (chunk index, ((((results,
@@ -323,6 +355,7 @@ impl Side {
             keep: self.on_initial == InitialPenetration::Keep,
             eta: self.box_margin,
             solid_t: self.solid.unwrap_or(0.0),
+            deepest_only: self.deepest_only,
         };
         let nchunks = self.slaves.len().div_ceil(SLAVE_CHUNK);
         self.chunk_active.resize_with(nchunks, Vec::new);
@@ -403,7 +436,7 @@ impl Narrow<'_> {
                 continue;
             }
             let s = self.slaves[si] as usize;
-            let found = self.search::<NF, SOLID>(si, &self.x[s], &mut near, &mut pen, sums);
+            let mut found = self.search::<NF, SOLID>(si, &self.x[s], &mut near, &mut pen, sums);
             let mut out = PairOut {
                 face: u32::MAX,
                 ..Default::default()
@@ -430,6 +463,9 @@ impl Narrow<'_> {
             let g = g_raw - st.g0;
             match found.best {
                 Some((fi, _, n)) if g > 0.0 => {
+                    if self.deepest_only {
+                        found = found.deepest(&mut pen);
+                    }
                     // Shares λ_F = g_F/Σg of the penetrated faces.
                     let pen = &pen[..found.n_pen];
                     let g_pen: f64 = pen.iter().map(|e| e.2).sum();
