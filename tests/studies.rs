@@ -1,34 +1,11 @@
 //! The study pipelines shipped in `pipelines/` run end to end through `weft run` in a
 //! fresh project, give the physics they are about, and a second run finds them fresh.
 
-use std::path::Path;
+mod common;
+use common::{project_with, weft_run};
 use std::process::Command;
 
 use weft::table::Table;
-
-fn project_with(pipeline: &str) -> tempfile::TempDir {
-    let dir = tempfile::tempdir().unwrap();
-    std::fs::create_dir_all(dir.path().join("pipelines")).unwrap();
-    std::fs::copy(
-        Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("pipelines")
-            .join(pipeline),
-        dir.path().join("pipelines").join(pipeline),
-    )
-    .unwrap();
-    dir
-}
-
-fn weft_run(root: &Path, pipeline: &str) -> String {
-    let o = Command::new(env!("CARGO_BIN_EXE_weft"))
-        .args(["run", &format!("pipelines/{pipeline}")])
-        .current_dir(root)
-        .output()
-        .unwrap();
-    let err = String::from_utf8_lossy(&o.stderr).to_string();
-    assert!(o.status.success(), "weft run {pipeline} failed:\n{err}");
-    err
-}
 
 /// The paper's §4 study: the fitted membrane matches the closed forms of a rigid-jointed
 /// square lattice (docs/theory.md, "Closed forms used as oracles"; Gibson & Ashby, Cellular Solids, §4.3) within 5 % at

@@ -2,35 +2,12 @@
 //! §5 girder's V50 with a fitted failure strain (`pipelines/woven_reduced_ballistic.toml`),
 //! run end to end through `weft run` in a fresh project.
 
+mod common;
+use common::{project_with, weft_run};
 use std::collections::BTreeMap;
 use std::path::Path;
-use std::process::Command;
 
 use weft::table::Table;
-
-fn project_with(pipeline: &str) -> tempfile::TempDir {
-    let dir = tempfile::tempdir().unwrap();
-    std::fs::create_dir_all(dir.path().join("pipelines")).unwrap();
-    std::fs::copy(
-        Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("pipelines")
-            .join(pipeline),
-        dir.path().join("pipelines").join(pipeline),
-    )
-    .unwrap();
-    dir
-}
-
-fn weft_run(root: &Path, pipeline: &str) -> String {
-    let o = Command::new(env!("CARGO_BIN_EXE_weft"))
-        .args(["run", &format!("pipelines/{pipeline}")])
-        .current_dir(root)
-        .output()
-        .unwrap();
-    let err = String::from_utf8_lossy(&o.stderr).to_string();
-    assert!(o.status.success(), "weft run {pipeline} failed:\n{err}");
-    err
-}
 
 /// Rewrites the pipeline's text by (from, to) pairs, each of which must occur.
 fn shrink(root: &Path, pipeline: &str, edits: &[(&str, &str)]) {

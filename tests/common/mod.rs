@@ -366,3 +366,29 @@ pub fn same_outputs(a: &Path, b: &Path) -> Result<usize, String> {
     Ok(ta.len())
 }
 pub mod optional;
+
+/// A fresh project (a temporary folder) holding a copy of `pipelines/<pipeline>`.
+pub fn project_with(pipeline: &str) -> tempfile::TempDir {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::create_dir_all(dir.path().join("pipelines")).unwrap();
+    std::fs::copy(
+        Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("pipelines")
+            .join(pipeline),
+        dir.path().join("pipelines").join(pipeline),
+    )
+    .unwrap();
+    dir
+}
+
+/// `weft run pipelines/<pipeline>` in `root`; its stderr (it must succeed).
+pub fn weft_run(root: &Path, pipeline: &str) -> String {
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_weft"))
+        .args(["run", &format!("pipelines/{pipeline}")])
+        .current_dir(root)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr).to_string();
+    assert!(o.status.success(), "weft run {pipeline} failed:\n{err}");
+    err
+}
