@@ -118,6 +118,9 @@ pub enum Criterion {
     Force,
     /// A link's opening.
     Opening,
+    /// A membrane's own stable step, at its current shape, below half the run's step
+    /// ([`super::collapse`]): the value is that step, the limit half the run's [s].
+    TimeStep,
 }
 
 impl Criterion {
@@ -129,6 +132,7 @@ impl Criterion {
             Criterion::Direction2 => "strain_2",
             Criterion::Force => "force",
             Criterion::Opening => "opening",
+            Criterion::TimeStep => "time_step",
         }
     }
 }
@@ -141,7 +145,8 @@ pub struct Failure {
     /// Index of the element in its family.
     pub element: usize,
     pub criterion: Criterion,
-    /// The strain (or force [N], or opening [m]) that reached the limit.
+    /// The strain (or force [N], or opening [m], or a membrane's stable step [s]) that
+    /// reached the limit.
     pub value: f64,
     /// The limit it reached (with the rate law applied).
     pub limit: f64,

@@ -449,6 +449,7 @@ pub fn max_stiffness<const N: usize>(
 // ---------------------------------------------------------------------------------------
 // The membrane families (triangles and quads).
 
+use super::collapse::{limit as limit_step, CollapseRef};
 use super::failure::{fibre_strain, taken_energy, Criterion, Erosion, Failure, FailureLaw, Fate};
 use super::family::{
     chunk_partials, for_chunks, Build, EnergyGroup, EnergyPartial, Family, ForceCtx, StiffCtx,
@@ -533,6 +534,10 @@ pub struct MembraneGroup<const N: usize> {
     /// directions' laws (`erosion.law` holds direction 1's, to say who can fail).
     pub erosion: Erosion,
     pub failure: Vec<MembraneFailure>,
+    /// Per element, what the collapse criterion keeps ([`super::collapse`]): empty until
+    /// the explicit solver sets it ([`MembraneGroup::set_collapse_steps`]), and then
+    /// only for a group whose elements can fail.
+    pub collapse: Vec<CollapseRef>,
     partials: Vec<EnergyPartial>,
 }
 
@@ -573,6 +578,31 @@ impl<const N: usize> MembraneGroup<N> {
     }
 }
 
+impl<const N: usize> MembraneGroup<N> {
+    /// Sets up the collapse criterion ([`super::collapse`]) of a group whose elements can
+    /// fail, from the reference positions `x_ref` and the run's nodal masses (with what
+    /// ties and mass scaling added); a node fully fixed (`fixed` = 0b111) does not count.
+    /// An element that cannot fail is never removed by it.
+    pub fn set_collapse_steps(&mut self, x_ref: &[[f64; 3]], mass: &[f64], fixed: &[u8]) {
+        if !self.erosion.active() {
+            return;
+        }
+        self.collapse = (0..self.nodes.len())
+            .map(|e| {
+                let ns = &self.nodes[e];
+                let xe: [[f64; 3]; N] = std::array::from_fn(|a| x_ref[ns[a] as usize]);
+                let can_fail = self.failure[e].dir.iter().any(FailureLaw::can_fail);
+                let k = if can_fail { self.k_max[e] } else { 0.0 };
+                let free = ns
+                    .iter()
+                    .map(|&n| n as usize)
+                    .filter(|&n| fixed[n] != 0b111);
+                CollapseRef::new(&xe, k, free.map(|n| mass[n]))
+            })
+            .collect();
+    }
+}
+
 impl<const N: usize> Family for MembraneGroup<N> {
     const KIND: ElementKind = if N == 3 {
         ElementKind::Tri
@@ -595,6 +625,7 @@ impl<const N: usize> Family for MembraneGroup<N> {
             mass: vec![],
             erosion: Erosion::default(),
             failure: vec![],
+            collapse: vec![],
             partials: vec![],
         };
         let Some(b) = m.block(kind) else { return Ok(g) };
@@ -837,16 +868,18 @@ impl<const N: usize> MembraneGroup<N> {
             k_hg,
             erosion,
             failure,
+            collapse,
             ..
         } = self;
         let Erosion { fate, any, .. } = erosion;
-        let (nodes, reference, material, thickness, k_hg, failure, any) = (
+        let (nodes, reference, material, thickness, k_hg, failure, collapse, any) = (
             &*nodes,
             &*reference,
             &*material,
             &*thickness,
             &*k_hg,
             &*failure,
+            &*collapse,
             &*any,
         );
         let body = |(ci, (out, fates)): (usize, (&mut [[f64; 3]], &mut [Fate]))| {
@@ -871,17 +904,20 @@ impl<const N: usize> MembraneGroup<N> {
                     lw.dir[i].filter(eps[i], ctx.dt_prev, &mut fate.filtered[i])
                 });
                 let (now, limit) = failing(lw, eps, rate, fate.dirs);
+                // Collapsed: its own stable step below half the run's
+                // ([`super::collapse`]).
+                let collapsed = collapse.get(e).and_then(|c| c.below(&xe, ctx.dt_prev));
                 let before = fate.dirs;
                 let mat_before = if before == 0 {
                     material[e]
                 } else {
                     material[e].with_failed(before)
                 };
-                if now != 0 {
+                if now != 0 || collapsed.is_some() {
                     let (w0, h0) = energy(&xe, &reference[e], &mat_before, thickness[e], k_hg[e]);
                     let dirs = before | now;
                     let can = (lw.dir[0].can_fail() as u8) | ((lw.dir[1].can_fail() as u8) << 1);
-                    let eroded = !lw.all_directions || dirs & can == can;
+                    let eroded = collapsed.is_some() || !lw.all_directions || dirs & can == can;
                     // The energy and the forces that leave: all of them, or what the
                     // failed direction carried (see `failure::taken_energy`).
                     let f0 = forces(&xe, &reference[e], &mat_before, thickness[e], k_hg[e]);
@@ -896,21 +932,22 @@ impl<const N: usize> MembraneGroup<N> {
                             std::array::from_fn(|a| std::array::from_fn(|c| f0[a][c] - f1[a][c]));
                         taken_energy(w0 - w1, ctx.dt_prev, &vn, &df)
                     };
-                    // The first direction that failed now names the criterion.
-                    let i = if now & 1 != 0 { 0 } else { 1 };
+                    // The first direction that failed now names the criterion, else the
+                    // collapse: the element's step against the run's.
+                    let (criterion, value, limit) = match (now, collapsed) {
+                        (0, Some(step)) => (Criterion::TimeStep, step, limit_step(ctx.dt_prev)),
+                        _ if now & 1 != 0 => (Criterion::Direction1, eps[0], limit[0]),
+                        _ => (Criterion::Direction2, eps[1], limit[1]),
+                    };
                     fate.dirs = dirs;
                     fate.eroded = eroded;
                     fate.energy += taken;
                     fate.fresh = Some(Failure {
                         kind: Self::KIND,
                         element: e,
-                        criterion: if i == 0 {
-                            Criterion::Direction1
-                        } else {
-                            Criterion::Direction2
-                        },
-                        value: eps[i],
-                        limit: limit[i],
+                        criterion,
+                        value,
+                        limit,
                         eroded,
                         energy: taken,
                     });

@@ -16,7 +16,8 @@
 //!   [`contact`]) the rigid projectiles;
 //! - [`stable`]: the stable step (nodal Gershgorin bound) and mass scaling;
 //! - [`ties`], [`contact`]: tied interfaces, projectile and surface contact;
-//! - [`failure`]: the failure laws; [`erosion`]: what failures leave (the log, the
+//! - [`failure`]: the failure laws, and [`collapse`], the membranes' removal when their
+//!   own step falls below the run's; [`erosion`]: what failures leave (the log, the
 //!   contact surfaces' erosion) and the per-layer [`watch`] of an impact;
 //! - [`energy`]: the energies and the ledger; [`output`]: the sampling onto the output
 //!   grid and the sinks;
@@ -32,6 +33,7 @@
 //! of threads. Buffers are allocated once at setup; the step allocates nothing.
 
 pub mod beam;
+pub mod collapse;
 pub mod contact;
 pub mod energy;
 pub mod erosion;
@@ -313,6 +315,11 @@ impl Solver {
         s.failures = FailureLog::new(&s.op.el, nn);
         let kappa = contact::surface::guard_kappa(m);
         s.set_time_step(kappa)?;
+        // The membranes' collapse criterion reads the masses as the step was set with.
+        s.op.el.tri.set_collapse_steps(&m.coords, &s.mass, &s.fixed);
+        s.op.el
+            .quad
+            .set_collapse_steps(&m.coords, &s.mass, &s.fixed);
         s.ledger.floor = energy_floor(&s.x0, &s.mass, s.stable.dt);
         s.op.projectiles.set_step(&s.mass, s.stable.dt);
         if !m.contacts.is_empty() {
