@@ -269,6 +269,54 @@ fn sample_penalty(p: &Projectile, sp: &SamplePoint, dt2: f64) -> f64 {
     SEGMENT_FACTOR * p.stiffness.unwrap_or(PENALTY_FACTOR * sp.mass / dt2)
 }
 
+/// A dissipative contact force of one force pass (the dashpot's and the friction's), on a
+/// point of the fabric (a node, or a face point with its nodes' weights) against one
+/// projectile.
+///
+/// The work a force f^n does over its step of the central difference is f^n·Δx, the point
+/// moving from t^{n−½} to t^{n+½} by (Δt^{n−½} v^{n−½} + Δt^{n+½} v^{n+½})/2 relative to
+/// the projectile: the midpoint rule, the one under which the ledger's kinetic energy
+/// ½ M v^{n−½}·v^{n+½} balances exactly. The first half is booked with the force, the
+/// second at the next pass, when v^{n+½} is known. Booking the whole step with v^{n−½}
+/// alone over-counts what a stiff dashpot or a chattering friction force dissipates (the
+/// dashpot changes the node's approach speed by 2ζ√κ ≈ 32 % a step at ζ = 0.5; a Coulomb
+/// force that reverses the slip each step does almost no work while v^{n−½}·f books its
+/// full |f||v|): measured on a slow perforation of a patch in a membrane, 8.1 % of the
+/// impact energy by 2.4 ms, against 1.1 % with the projectile's friction and damping off.
+#[derive(Debug, Clone, Copy)]
+struct Pending {
+    projectile: u32,
+    /// How many of `nodes` and `w` count.
+    n: u8,
+    nodes: [u32; 4],
+    w: [f64; 4],
+    damping: [f64; 3],
+    friction: [f64; 3],
+}
+
+impl Pending {
+    fn at_node(projectile: usize, node: usize, damping: [f64; 3], friction: [f64; 3]) -> Self {
+        Pending {
+            projectile: projectile as u32,
+            n: 1,
+            nodes: [node as u32, 0, 0, 0],
+            w: [1.0, 0.0, 0.0, 0.0],
+            damping,
+            friction,
+        }
+    }
+
+    /// The point's velocity relative to the projectile's `vp`.
+    fn relative_velocity(&self, v: &[[f64; 3]], vp: &[f64; 3]) -> [f64; 3] {
+        std::array::from_fn(|d| {
+            (0..self.n as usize)
+                .map(|a| self.w[a] * v[self.nodes[a] as usize][d])
+                .sum::<f64>()
+                - vp[d]
+        })
+    }
+}
+
 /// Every projectile of a model and what it can touch.
 #[derive(Debug, Clone, Default)]
 pub struct ProjectileContact {
@@ -292,6 +340,9 @@ pub struct ProjectileContact {
     pub friction_work: f64,
     /// Work dissipated by the contact springs' dashpots [J].
     pub damping_work: f64,
+    /// The dissipative forces of the last force pass, whose work over the second half of
+    /// their step is booked at the next pass, once v^{n+½} is known ([`Pending`]).
+    pending: Vec<Pending>,
     /// When asked, the friction work so far by node [J] (a face contact's shared by the
     /// face's nodes with the contact point's weights), for the energy absorbed per layer.
     pub node_friction: Option<Vec<f64>>,
@@ -392,6 +443,7 @@ impl ProjectileContact {
             k_node: vec![],
             friction_work: 0.0,
             damping_work: 0.0,
+            pending: vec![],
             node_friction: None,
             prescribed_work: 0.0,
             fixed: std::array::from_fn(|d| m.symmetry.iter().any(|sp| sp.normal == d)),
@@ -457,9 +509,12 @@ impl ProjectileContact {
         touched: &mut Vec<usize>,
     ) {
         self.update_near(x);
+        self.book_pending(v, dt_prev);
         let kc = &self.k_node;
         let dt2 = dt * dt;
+        let half = 0.5 * dt_prev;
         for (k, p) in self.projectiles.iter_mut().enumerate() {
+            let pk = k;
             let mut ftot = [0.0; 3];
             // The nodes inside, found in parallel and applied in node order (the same
             // sums whatever the threads).
@@ -477,25 +532,33 @@ impl ProjectileContact {
             for (i, g, n) in inside {
                 let k = p.stiffness.unwrap_or(kc[i]);
                 let mut fnorm = k * g;
+                let mut fdamp = [0.0; 3];
                 if p.damping > 0.0 {
                     // A dashpot on the approach speed, never pulling the node back
-                    // (LS-DYNA's VDC); its work on the node (over the last half step) is
-                    // dissipated.
+                    // (LS-DYNA's VDC); its work on the node is dissipated (booked by
+                    // the midpoint rule: this half step now, the next with the next
+                    // pass, see `Pending`).
                     let vr = [v[i][0] - p.v[0], v[i][1] - p.v[1], v[i][2] - p.v[2]];
                     let vn = vr[0] * n[0] + vr[1] * n[1] + vr[2] * n[2];
                     let fd = (-2.0 * p.damping * (k * mass[i]).sqrt() * vn).max(-fnorm);
                     fnorm += fd;
-                    self.damping_work -= fd * vn * dt_prev;
+                    self.damping_work -= fd * vn * half;
+                    fdamp = [n[0] * fd, n[1] * fd, n[2] * fd];
                 }
                 let mut f = [n[0] * fnorm, n[1] * fnorm, n[2] * fnorm];
+                let mut ffric = [0.0; 3];
                 if p.friction > 0.0 {
                     let vr = [v[i][0] - p.v[0], v[i][1] - p.v[1], v[i][2] - p.v[2]];
                     let (ft, power) = friction(&n, fnorm, &vr, p.friction);
                     f = [f[0] + ft[0], f[1] + ft[1], f[2] + ft[2]];
-                    self.friction_work += power * dt_prev;
+                    self.friction_work += power * half;
                     if let Some(nf) = self.node_friction.as_mut() {
-                        nf[i] += power * dt_prev;
+                        nf[i] += power * half;
                     }
+                    ffric = ft;
+                }
+                if p.damping > 0.0 || p.friction > 0.0 {
+                    self.pending.push(Pending::at_node(pk, i, fdamp, ffric));
                 }
                 add(&mut fcon[i], &f);
                 ftot = [ftot[0] - f[0], ftot[1] - f[1], ftot[2] - f[2]];
@@ -532,12 +595,20 @@ impl ProjectileContact {
                         let vr = [vq[0] - p.v[0], vq[1] - p.v[1], vq[2] - p.v[2]];
                         let (ft, power) = friction(&n, fnorm, &vr, p.friction);
                         f = [f[0] + ft[0], f[1] + ft[1], f[2] + ft[2]];
-                        self.friction_work += power * dt_prev;
+                        self.friction_work += power * half;
                         if let Some(nf) = self.node_friction.as_mut() {
                             for a in 0..3 {
-                                nf[t.nodes[a] as usize] += w[a] * power * dt_prev;
+                                nf[t.nodes[a] as usize] += w[a] * power * half;
                             }
                         }
+                        self.pending.push(Pending {
+                            projectile: pk as u32,
+                            n: 3,
+                            nodes: [t.nodes[0], t.nodes[1], t.nodes[2], 0],
+                            w: [w[0], w[1], w[2], 0.0],
+                            damping: [0.0; 3],
+                            friction: ft,
+                        });
                     }
                     for a in 0..3 {
                         let i = t.nodes[a] as usize;
@@ -567,12 +638,20 @@ impl ProjectileContact {
                         let vr = [vp[0] - p.v[0], vp[1] - p.v[1], vp[2] - p.v[2]];
                         let (ft, power) = friction(&n, fnorm, &vr, p.friction);
                         f = [f[0] + ft[0], f[1] + ft[1], f[2] + ft[2]];
-                        self.friction_work += power * dt_prev;
+                        self.friction_work += power * half;
                         if let Some(nf) = self.node_friction.as_mut() {
                             for a in 0..sp.n {
-                                nf[nodes[a] as usize] += sp.w[a] * power * dt_prev;
+                                nf[nodes[a] as usize] += sp.w[a] * power * half;
                             }
                         }
+                        self.pending.push(Pending {
+                            projectile: pk as u32,
+                            n: sp.n as u8,
+                            nodes: std::array::from_fn(|a| if a < sp.n { nodes[a] } else { 0 }),
+                            w: std::array::from_fn(|a| if a < sp.n { sp.w[a] } else { 0.0 }),
+                            damping: [0.0; 3],
+                            friction: ft,
+                        });
                     }
                     for a in 0..sp.n {
                         let i = nodes[a] as usize;
@@ -586,6 +665,24 @@ impl ProjectileContact {
                 }
             }
             p.force = ftot;
+        }
+    }
+
+    /// The second half of the last pass's dissipative work ([`Pending`]): its forces
+    /// against the velocities v^{n+½} of this pass over the step just taken, `dt_prev`.
+    fn book_pending(&mut self, v: &[[f64; 3]], dt_prev: f64) {
+        let half = 0.5 * dt_prev;
+        for q in self.pending.drain(..) {
+            let vp = &self.projectiles[q.projectile as usize].v;
+            let vr = q.relative_velocity(v, vp);
+            self.damping_work -= dot(&q.damping, &vr) * half;
+            let w = -dot(&q.friction, &vr) * half;
+            self.friction_work += w;
+            if let Some(nf) = self.node_friction.as_mut() {
+                for a in 0..q.n as usize {
+                    nf[q.nodes[a] as usize] += q.w[a] * w;
+                }
+            }
         }
     }
 
