@@ -343,8 +343,9 @@ pub struct ProjectileContact {
     /// The dissipative forces of the last force pass, whose work over the second half of
     /// their step is booked at the next pass, once v^{n+½} is known ([`Pending`]).
     pending: Vec<Pending>,
-    /// When asked, the friction work so far by node [J] (a face contact's shared by the
-    /// face's nodes with the contact point's weights), for the energy absorbed per layer.
+    /// When asked, the friction and dashpot work so far by node [J] (a face contact's
+    /// shared by the face's nodes with the contact point's weights), for the energy
+    /// absorbed per layer.
     pub node_friction: Option<Vec<f64>>,
     /// Work done by projectiles with prescribed velocity [J].
     pub prescribed_work: f64,
@@ -543,6 +544,9 @@ impl ProjectileContact {
                     let fd = (-2.0 * p.damping * (k * mass[i]).sqrt() * vn).max(-fnorm);
                     fnorm += fd;
                     self.damping_work -= fd * vn * half;
+                    if let Some(nf) = self.node_friction.as_mut() {
+                        nf[i] -= fd * vn * half;
+                    }
                     fdamp = [n[0] * fd, n[1] * fd, n[2] * fd];
                 }
                 let mut f = [n[0] * fnorm, n[1] * fnorm, n[2] * fnorm];
@@ -675,12 +679,13 @@ impl ProjectileContact {
         for q in self.pending.drain(..) {
             let vp = &self.projectiles[q.projectile as usize].v;
             let vr = q.relative_velocity(v, vp);
-            self.damping_work -= dot(&q.damping, &vr) * half;
+            let wd = -dot(&q.damping, &vr) * half;
             let w = -dot(&q.friction, &vr) * half;
+            self.damping_work += wd;
             self.friction_work += w;
             if let Some(nf) = self.node_friction.as_mut() {
                 for a in 0..q.n as usize {
-                    nf[q.nodes[a] as usize] += q.w[a] * w;
+                    nf[q.nodes[a] as usize] += q.w[a] * (w + wd);
                 }
             }
         }
