@@ -306,6 +306,29 @@ impl Pending {
         }
     }
 
+    /// A face point's friction force `ft` (nodes and weights, at most four).
+    fn at_point(projectile: usize, nodes: &[u32], w: &[f64], ft: [f64; 3]) -> Self {
+        Pending {
+            projectile: projectile as u32,
+            n: nodes.len() as u8,
+            nodes: std::array::from_fn(|a| nodes.get(a).copied().unwrap_or(0)),
+            w: std::array::from_fn(|a| w.get(a).copied().unwrap_or(0.0)),
+            damping: [0.0; 3],
+            friction: ft,
+        }
+    }
+
+    /// Shares the work `work` of the first half step among the point's nodes (when the
+    /// per-node account is kept) and returns it.
+    fn book_first_half(&self, node_friction: &mut Option<Vec<f64>>, work: f64) -> f64 {
+        if let Some(nf) = node_friction.as_mut() {
+            for a in 0..self.n as usize {
+                nf[self.nodes[a] as usize] += self.w[a] * work;
+            }
+        }
+        work
+    }
+
     /// The point's velocity relative to the projectile's `vp`.
     fn relative_velocity(&self, v: &[[f64; 3]], vp: &[f64; 3]) -> [f64; 3] {
         std::array::from_fn(|d| {
@@ -515,7 +538,6 @@ impl ProjectileContact {
         let dt2 = dt * dt;
         let half = 0.5 * dt_prev;
         for (k, p) in self.projectiles.iter_mut().enumerate() {
-            let pk = k;
             let mut ftot = [0.0; 3];
             // The nodes inside, found in parallel and applied in node order (the same
             // sums whatever the threads).
@@ -531,38 +553,31 @@ impl ProjectileContact {
                 })
                 .collect();
             for (i, g, n) in inside {
-                let k = p.stiffness.unwrap_or(kc[i]);
-                let mut fnorm = k * g;
-                let mut fdamp = [0.0; 3];
+                let kn = p.stiffness.unwrap_or(kc[i]);
+                let mut fnorm = kn * g;
+                let vr = [v[i][0] - p.v[0], v[i][1] - p.v[1], v[i][2] - p.v[2]];
+                // (fdamp, its work over this half step), (ffric, its work): booked by the
+                // midpoint rule, this half step now, the next with the next pass (`Pending`).
+                let (mut fdamp, mut wd, mut ffric, mut wf) = ([0.0; 3], 0.0, [0.0; 3], 0.0);
                 if p.damping > 0.0 {
                     // A dashpot on the approach speed, never pulling the node back
-                    // (LS-DYNA's VDC); its work on the node is dissipated (booked by
-                    // the midpoint rule: this half step now, the next with the next
-                    // pass, see `Pending`).
-                    let vr = [v[i][0] - p.v[0], v[i][1] - p.v[1], v[i][2] - p.v[2]];
+                    // (LS-DYNA's VDC); its work on the node is dissipated.
                     let vn = vr[0] * n[0] + vr[1] * n[1] + vr[2] * n[2];
-                    let fd = (-2.0 * p.damping * (k * mass[i]).sqrt() * vn).max(-fnorm);
+                    let fd = (-2.0 * p.damping * (kn * mass[i]).sqrt() * vn).max(-fnorm);
                     fnorm += fd;
-                    self.damping_work -= fd * vn * half;
-                    if let Some(nf) = self.node_friction.as_mut() {
-                        nf[i] -= fd * vn * half;
-                    }
-                    fdamp = [n[0] * fd, n[1] * fd, n[2] * fd];
+                    (fdamp, wd) = ([n[0] * fd, n[1] * fd, n[2] * fd], -fd * vn * half);
                 }
                 let mut f = [n[0] * fnorm, n[1] * fnorm, n[2] * fnorm];
-                let mut ffric = [0.0; 3];
                 if p.friction > 0.0 {
-                    let vr = [v[i][0] - p.v[0], v[i][1] - p.v[1], v[i][2] - p.v[2]];
                     let (ft, power) = friction(&n, fnorm, &vr, p.friction);
                     f = [f[0] + ft[0], f[1] + ft[1], f[2] + ft[2]];
-                    self.friction_work += power * half;
-                    if let Some(nf) = self.node_friction.as_mut() {
-                        nf[i] += power * half;
-                    }
-                    ffric = ft;
+                    (ffric, wf) = (ft, power * half);
                 }
                 if p.damping > 0.0 || p.friction > 0.0 {
-                    self.pending.push(Pending::at_node(pk, i, fdamp, ffric));
+                    let q = Pending::at_node(k, i, fdamp, ffric);
+                    self.damping_work += q.book_first_half(&mut self.node_friction, wd);
+                    self.friction_work += q.book_first_half(&mut self.node_friction, wf);
+                    self.pending.push(q);
                 }
                 add(&mut fcon[i], &f);
                 ftot = [ftot[0] - f[0], ftot[1] - f[1], ftot[2] - f[2]];
@@ -599,20 +614,10 @@ impl ProjectileContact {
                         let vr = [vq[0] - p.v[0], vq[1] - p.v[1], vq[2] - p.v[2]];
                         let (ft, power) = friction(&n, fnorm, &vr, p.friction);
                         f = [f[0] + ft[0], f[1] + ft[1], f[2] + ft[2]];
-                        self.friction_work += power * half;
-                        if let Some(nf) = self.node_friction.as_mut() {
-                            for a in 0..3 {
-                                nf[t.nodes[a] as usize] += w[a] * power * half;
-                            }
-                        }
-                        self.pending.push(Pending {
-                            projectile: pk as u32,
-                            n: 3,
-                            nodes: [t.nodes[0], t.nodes[1], t.nodes[2], 0],
-                            w: [w[0], w[1], w[2], 0.0],
-                            damping: [0.0; 3],
-                            friction: ft,
-                        });
+                        let q = Pending::at_point(k, &t.nodes, &w, ft);
+                        self.friction_work +=
+                            q.book_first_half(&mut self.node_friction, power * half);
+                        self.pending.push(q);
                     }
                     for a in 0..3 {
                         let i = t.nodes[a] as usize;
@@ -642,20 +647,10 @@ impl ProjectileContact {
                         let vr = [vp[0] - p.v[0], vp[1] - p.v[1], vp[2] - p.v[2]];
                         let (ft, power) = friction(&n, fnorm, &vr, p.friction);
                         f = [f[0] + ft[0], f[1] + ft[1], f[2] + ft[2]];
-                        self.friction_work += power * half;
-                        if let Some(nf) = self.node_friction.as_mut() {
-                            for a in 0..sp.n {
-                                nf[nodes[a] as usize] += sp.w[a] * power * half;
-                            }
-                        }
-                        self.pending.push(Pending {
-                            projectile: pk as u32,
-                            n: sp.n as u8,
-                            nodes: std::array::from_fn(|a| if a < sp.n { nodes[a] } else { 0 }),
-                            w: std::array::from_fn(|a| if a < sp.n { sp.w[a] } else { 0.0 }),
-                            damping: [0.0; 3],
-                            friction: ft,
-                        });
+                        let q = Pending::at_point(k, nodes, &sp.w[..sp.n], ft);
+                        self.friction_work +=
+                            q.book_first_half(&mut self.node_friction, power * half);
+                        self.pending.push(q);
                     }
                     for a in 0..sp.n {
                         let i = nodes[a] as usize;
