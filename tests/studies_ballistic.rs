@@ -20,6 +20,16 @@ fn shrink(root: &Path, pipeline: &str, edits: &[(&str, &str)]) {
     std::fs::write(&p, s).unwrap();
 }
 
+/// Every value of a float column that has no nulls.
+fn f64s(t: &Table, c: &str) -> Vec<f64> {
+    t.f64_opt(c)
+        .unwrap()
+        .unwrap_or_else(|| panic!("no column {c}"))
+        .into_iter()
+        .map(|x| x.unwrap())
+        .collect()
+}
+
 /// Per group (a string column) of a ballistic_limit.parquet: (V50, fastest stop, slowest
 /// perforation).
 fn limits(path: &Path, by: &str) -> BTreeMap<String, (f64, f64, f64)> {
@@ -31,15 +41,11 @@ fn limits(path: &Path, by: &str) -> BTreeMap<String, (f64, f64, f64)> {
         .into_iter()
         .map(|x| x.unwrap())
         .collect();
-    let col = |c: &str| -> Vec<f64> {
-        t.f64_opt(c)
-            .unwrap()
-            .unwrap()
-            .into_iter()
-            .map(|x| x.unwrap())
-            .collect()
-    };
-    let (v50, lo, hi) = (col("v50"), col("fastest_stop"), col("slowest_perforation"));
+    let (v50, lo, hi) = (
+        f64s(&t, "v50"),
+        f64s(&t, "fastest_stop"),
+        f64s(&t, "slowest_perforation"),
+    );
     groups
         .into_iter()
         .enumerate()
@@ -79,13 +85,7 @@ fn fitted_girder_v50_is_nearer_the_reference_than_the_trial_girder() {
         "fitted {f} is not nearer the reference {r} than the trial {t}"
     );
     let trace = Table::read(&out.join("fit/fit_trace.parquet")).unwrap();
-    let obj: Vec<f64> = trace
-        .f64_opt("T")
-        .unwrap()
-        .unwrap()
-        .into_iter()
-        .map(|x| x.unwrap())
-        .collect();
+    let obj = f64s(&trace, "T");
     let best = obj.iter().cloned().fold(f64::INFINITY, f64::min);
     eprintln!("projectile mismatch: start {:.3e}, best {best:.3e}", obj[0]);
     assert!(best < obj[0]);
@@ -96,10 +96,9 @@ fn fitted_girder_v50_is_nearer_the_reference_than_the_trial_girder() {
 fn v50_by_patch(path: &Path) -> BTreeMap<i64, f64> {
     let t = Table::read(path).unwrap();
     let n = t.i64_opt("patch").unwrap().unwrap();
-    let v = t.f64_opt("v50").unwrap().unwrap();
     n.into_iter()
-        .zip(v)
-        .map(|(n, v)| (n.unwrap(), v.unwrap()))
+        .map(|n| n.unwrap())
+        .zip(f64s(&t, "v50"))
         .collect()
 }
 
