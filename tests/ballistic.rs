@@ -620,3 +620,44 @@ fn the_search_costs_what_weft_simulate_runs_cost() {
         vec![Some(cycles.iter().map(|c| c.unwrap()).sum())]
     );
 }
+
+/// A search names its group by the model folder, as text whatever the name reads like:
+/// a search over `models/6` and one over `models/reference` gather into one table
+/// (`weft gather` refuses instances whose columns differ in type), so `model` is a string
+/// column holding "6", not an integer.
+#[test]
+fn a_search_names_its_model_as_text() {
+    use weft::table::Table;
+    let dir = tempfile::tempdir().unwrap();
+    let m = dir.path().join("6");
+    std::fs::rename(small_patch(dir.path()), &m).unwrap();
+    let out = dir.path().join("search");
+    run_ok(
+        BALLISTIC,
+        &[
+            "search",
+            "--model",
+            m.to_str().unwrap(),
+            "--lo",
+            "40",
+            "--hi",
+            "400",
+            "--tolerance",
+            "1000",
+            "--max-rounds",
+            "1",
+            "--threads",
+            "1",
+            "--bootstrap",
+            "10",
+            "--out",
+            out.to_str().unwrap(),
+        ],
+    );
+    for table in ["ballistic_runs.parquet", "ballistic_limit.parquet"] {
+        let t = Table::read(&out.join(table)).unwrap();
+        let model = t.str_opt("model").unwrap();
+        assert!(model.is_some(), "{table}: `model` is not a string column");
+        assert!(model.unwrap().iter().all(|m| m.as_deref() == Some("6")));
+    }
+}

@@ -7,7 +7,7 @@ use std::path::Path;
 
 use super::lambert_jonas::{self, Bounds, Shot};
 use super::probability::{self, Link};
-use super::runs::Run;
+use super::runs::{group_col, GroupBy, Run};
 use crate::error::{Result, WeftError};
 use crate::table::{batch, write_table, Col, Provenance};
 
@@ -147,7 +147,7 @@ pub fn write_runs(
     path: &Path,
     groups: &[(String, Vec<Run>)],
     limits: &[Limit],
-    by: &str,
+    by: GroupBy,
     prov: &Provenance,
 ) -> Result<()> {
     let mut cols: (Vec<String>, Vec<String>, Vec<f64>, Vec<f64>, Vec<bool>) = Default::default();
@@ -170,7 +170,7 @@ pub fn write_runs(
         path,
         &batch(vec![
             Col::Str("run", cols.0),
-            super::runs::group_col(by, cols.1),
+            group_col(by, cols.1),
             Col::F64("striking_velocity", cols.2),
             Col::F64("residual_velocity", cols.3),
             Col::Bool("perforated", cols.4),
@@ -194,7 +194,7 @@ pub fn write_runs(
 }
 
 /// `ballistic_limit.parquet`: one row per group.
-pub fn write_limits(path: &Path, limits: &[Limit], by: &str, prov: &Provenance) -> Result<()> {
+pub fn write_limits(path: &Path, limits: &[Limit], by: GroupBy, prov: &Provenance) -> Result<()> {
     let lj = |f: fn(&lambert_jonas::Fit) -> f64| {
         limits
             .iter()
@@ -210,7 +210,7 @@ pub fn write_limits(path: &Path, limits: &[Limit], by: &str, prov: &Provenance) 
     write_table(
         path,
         &batch(vec![
-            super::runs::group_col(by, limits.iter().map(|l| l.group.clone()).collect()),
+            group_col(by, limits.iter().map(|l| l.group.clone()).collect()),
             Col::I64("runs", limits.iter().map(|l| l.runs as i64).collect()),
             Col::I64(
                 "perforated_runs",

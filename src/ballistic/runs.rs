@@ -274,11 +274,33 @@ fn check_one_model(group: &str, runs: &[Run]) -> Result<()> {
     Ok(())
 }
 
-/// The grouping column to write: integers when every value is one as written (`layers`),
-/// numbers when every value is one, text otherwise, so that a table read back in pandas
-/// or polars sorts and plots its groups as the source table did.
-pub fn group_col(by: &str, groups: Vec<String>) -> crate::table::Col {
+/// How the grouping column is typed when written.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum GroupType {
+    /// As the values read: integers, numbers or text (`fit --by layers`).
+    Inferred,
+    /// Always text: a model folder's name (`search`), so that searches over folders named
+    /// `6` and `reference` gather into one table.
+    Text,
+}
+
+/// The grouping column of the tables written: its name and how it is typed.
+#[derive(Clone, Copy, Debug)]
+pub struct GroupBy<'a> {
+    pub column: &'a str,
+    pub kind: GroupType,
+}
+
+/// The grouping column to write: with [`GroupType::Inferred`], integers when every value
+/// is one as written (`layers`), numbers when every value is one, text otherwise, so that
+/// a table read back in pandas or polars sorts and plots its groups as the source table
+/// did; with [`GroupType::Text`], text.
+pub fn group_col(by: GroupBy, groups: Vec<String>) -> crate::table::Col {
     use crate::table::Col;
+    let GroupBy { column: by, kind } = by;
+    if kind == GroupType::Text {
+        return Col::StrNamed(by.to_string(), groups);
+    }
     let ints: Option<Vec<i64>> = groups
         .iter()
         .map(|g| g.parse::<i64>().ok().filter(|i| i.to_string() == *g))

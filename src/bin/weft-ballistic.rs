@@ -8,6 +8,7 @@ use clap::{Parser, Subcommand};
 use weft::ballistic::lambert_jonas::Bounds;
 use weft::ballistic::limit::{self, Options};
 use weft::ballistic::probability::Link;
+use weft::ballistic::runs::{GroupBy, GroupType};
 use weft::ballistic::{runs, search, zone};
 use weft::table::Provenance;
 
@@ -240,7 +241,11 @@ fn fit(a: FitArgs) -> anyhow::Result<ExitCode> {
         "runs": a.runs, "table": a.table, "by": a.by, "bootstrap": o.replicates, "seed": o.seed,
         "a_bounds": o.bounds.a, "p_bounds": o.bounds.p, "link": o.link.name(),
     });
-    write(&a.out, &groups, &limits, &a.by, params)?;
+    let by = GroupBy {
+        column: &a.by,
+        kind: GroupType::Inferred,
+    };
+    write(&a.out, &groups, &limits, by, params)?;
     Ok(ExitCode::SUCCESS)
 }
 
@@ -282,7 +287,13 @@ fn search_cmd(a: SearchArgs) -> anyhow::Result<ExitCode> {
         "per_round": per_round, "max_rounds": a.max_rounds, "bootstrap": o.replicates, "seed": o.seed,
         "a_bounds": o.bounds.a, "p_bounds": o.bounds.p, "link": o.link.name(),
     });
-    write(&a.out, &groups, &limits, "model", params)?;
+    // The model folder's name, as text whatever it reads like, so that every search's
+    // table gathers into one (`weft gather`).
+    let by = GroupBy {
+        column: "model",
+        kind: GroupType::Text,
+    };
+    write(&a.out, &groups, &limits, by, params)?;
     Ok(ExitCode::SUCCESS)
 }
 
@@ -291,7 +302,7 @@ fn write(
     out: &std::path::Path,
     groups: &[(String, Vec<runs::Run>)],
     limits: &[limit::Limit],
-    by: &str,
+    by: GroupBy,
     params: serde_json::Value,
 ) -> anyhow::Result<()> {
     std::fs::create_dir_all(out).map_err(|e| weft::WeftError::io(out, e))?;
@@ -304,6 +315,7 @@ fn write(
         &prov,
     )?;
     limit::write_limits(&out.join("ballistic_limit.parquet"), limits, by, &prov)?;
+    let col = by.column;
     for l in limits {
         let p = &l.probability;
         let lj = l.lambert_jonas.map_or(
@@ -316,7 +328,7 @@ fn write(
             },
         );
         eprintln!(
-            "{by} {}: {} runs, {} perforated; V50 {:.1} m/s ({:.1}–{:.1}, {}); {lj}",
+            "{col} {}: {} runs, {} perforated; V50 {:.1} m/s ({:.1}–{:.1}, {}); {lj}",
             l.group, l.runs, l.perforations, p.v50, p.v50_interval.0, p.v50_interval.1, p.method
         );
     }
