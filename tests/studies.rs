@@ -322,11 +322,13 @@ fn woven_reduced_study_fits_the_girder_to_the_yarn_level_patch() {
     let out = root.join("runs/woven_reduced");
     // Energy conservation (the explicit scheme's, contact and friction work counted):
     // each run's worst relative balance error held near what it measures today (the
-    // users' promise is 1 %, issue 13). Measured: formed 1.35e-4, trial 1.30e-5, paper
-    // 4.1e-6, extended 1.50e-4, sliding 1.75e-5; tolerances 3–3.7× above.
+    // users' promise is 1 %, issue 13). Measured: formed 1.23e-4, trial 3.4e-6, soft
+    // (the paper fit with k_z/100) 2.1e-6, paper 4.5e-6, extended 1.48e-4, sliding
+    // 2.24e-5; tolerances 2.7–3.4× above.
     for (run, tol) in [
         ("formed", 4e-4),
-        ("trial", 4e-5),
+        ("trial", 1e-5),
+        ("soft", 6e-6),
         ("paper", 1.5e-5),
         ("extended", 5e-4),
         ("sliding", 6e-5),
