@@ -108,7 +108,7 @@ pub fn pair_force(
             trial[d] -= k * vt[d] * dt_prev;
         }
         let vtm = dot(vt, vt).sqrt();
-        let mu = fr.mu_d + (fr.mu_s - fr.mu_d) * (-fr.decay * vtm).exp();
+        let mu = friction_coefficient(fr, vtm);
         let limit = mu * fnorm;
         let tm = dot(&trial, &trial).sqrt();
         if tm > limit {
@@ -131,6 +131,22 @@ pub fn pair_force(
         stored,
         diss,
     )
+}
+
+/// μ = μ_d + (μ_s − μ_d) e^{−d_c|v_t|} at the tangential speed `vtm`. Without a static
+/// excess (μ_s − μ_d = ±0, which holds only for equal finite coefficients, or zeros of
+/// either sign) and with d_c|v_t| ≥ 0 (not NaN), e^{−d_c|v_t|} lies in [0, 1], so the
+/// product is the excess itself (a zero of its sign) and the sum μ_d + (μ_s − μ_d) is the
+/// formula bit for bit: the exponential is skipped (any other case, NaN and infinities
+/// included, takes the formula).
+#[inline]
+fn friction_coefficient(fr: &Friction, vtm: f64) -> f64 {
+    let excess = fr.mu_s - fr.mu_d;
+    if excess == 0.0 && fr.decay * vtm >= 0.0 {
+        fr.mu_d + excess
+    } else {
+        fr.mu_d + excess * (-fr.decay * vtm).exp()
+    }
 }
 
 /// A slave opens: its stick spring is released, and what it stored is dissipated (the
@@ -388,6 +404,52 @@ mod tests {
             (beyond - expected).abs() < 1e-7 && beyond > 0.0,
             "{beyond} {expected}"
         );
+    }
+
+    /// The friction coefficient without its exponential (μ_s = μ_d) is bit for bit the
+    /// formula μ_d + (μ_s − μ_d) e^{−d_c|v_t|}, over equal and unequal coefficients, decay
+    /// coefficients and speeds including 0, negatives, infinities and NaN (the oracle: the
+    /// formula itself, evaluated here).
+    #[test]
+    fn friction_coefficient_is_the_formula_bit_for_bit() {
+        let specials = [
+            0.0,
+            -0.0,
+            1e-300,
+            0.15,
+            0.2,
+            1.0,
+            3.5e2,
+            1e308,
+            -0.15,
+            -1e3,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::NAN,
+        ];
+        let mut checked = 0;
+        let mut skipped = 0;
+        for &mu_s in &specials {
+            for &mu_d in &specials {
+                for &decay in &specials {
+                    for &vtm in &specials {
+                        let fr = super::Friction { mu_s, mu_d, decay };
+                        let formula = fr.mu_d + (fr.mu_s - fr.mu_d) * (-fr.decay * vtm).exp();
+                        let got = super::friction_coefficient(&fr, vtm);
+                        assert_eq!(
+                            got.to_bits(),
+                            formula.to_bits(),
+                            "mu_s {mu_s}, mu_d {mu_d}, decay {decay}, |v_t| {vtm}"
+                        );
+                        checked += 1;
+                        skipped += usize::from(mu_s - mu_d == 0.0 && decay * vtm >= 0.0);
+                    }
+                }
+            }
+        }
+        // 13⁴ cases, of which the equal finite pairs (11 of 169) with d_c|v_t| ≥ 0 skip.
+        assert_eq!(checked, 28561);
+        assert!(skipped > 500, "{skipped} cases skipped the exponential");
     }
 
     /// A pair with no penalty (all its nodes massless: tie slaves) gives no force and
