@@ -83,9 +83,10 @@
 //! [`super::closest`]'s), [`solid`] (a hexahedron part's boundary faces and nodes, and
 //! its faces' one-sided kernel), [`side`] (a definition's side and its per-step data), [`grid`]
 //! (the broad phase), [`narrow`] (the narrow phase), and this module: the driver
-//! ([`SurfaceContact`]: setup, the step's phases in order, the gather onto the nodes, the
-//! report).
+//! ([`SurfaceContact`]: setup, the step's phases in order, the report), and `gather` (the
+//! forces onto the nodes in a canonical order, in parallel).
 
+mod gather;
 pub mod grid;
 pub mod kernels;
 pub mod narrow;
@@ -100,7 +101,6 @@ use super::staleness::Staleness;
 use crate::error::{Result, WeftError};
 use crate::model::contacts::{InitialPenetration, Slave};
 use crate::model::{ElementKind, Model};
-use crate::solver::vec3::add;
 pub use kernels::{pair_force, thickness_gradient, Friction, SlaveState, MAX_THICKNESS_GRADIENT};
 use side::{part_nodes, ChunkSums};
 pub use side::{PairOut, Reaction, Side};
@@ -625,54 +625,9 @@ impl SurfaceContact {
         ph.staleness += (t_stale - t_boxes).as_secs_f64();
         ph.builds += (t1 - t_stale).as_secs_f64();
         ph.narrow += (t_narrow - t1).as_secs_f64();
-        // Gather onto the nodes: the nodes are split into one block per thread, and each
-        // block takes the contributions to its nodes in the canonical order (side, chunk,
-        // the chunk's slaves, then their reactions' face nodes), so every node's sum is the
-        // same whatever the split: bit-identical for any thread count, and parallel. `fcon`
-        // must be zero at the slaves' and faces' nodes before (the operator clears it).
-        let sides = &self.sides;
-        let active: usize = sides
-            .iter()
-            .map(|s| s.chunk_active.iter().map(|a| a.len()).sum::<usize>())
-            .sum();
-        // Small jobs stay on one thread (same sums, no scheduling cost).
-        let blocks = if active < 2048 {
-            1
-        } else {
-            rayon::current_num_threads().max(1)
-        };
-        let bs = fcon.len().div_ceil(blocks).max(1);
-        let gather = |(b, block): (usize, &mut [[f64; 3]])| {
-            let (lo, hi) = (b * bs, b * bs + block.len());
-            for s in sides {
-                for (active, reactions) in s.chunk_active.iter().zip(&s.chunk_reactions) {
-                    for &si in active {
-                        let sl = s.slaves[si as usize] as usize;
-                        if (lo..hi).contains(&sl) {
-                            add(&mut block[sl - lo], &s.out[si as usize].f);
-                        }
-                    }
-                    for r in reactions {
-                        let f = &s.out[r.slave as usize].f;
-                        let face = &s.faces[r.face as usize];
-                        for a in 0..s.nf {
-                            let n = face[a] as usize;
-                            if (lo..hi).contains(&n) {
-                                add(
-                                    &mut block[n - lo],
-                                    &[-r.w[a] * f[0], -r.w[a] * f[1], -r.w[a] * f[2]],
-                                );
-                            }
-                        }
-                    }
-                }
-            }
-        };
-        if blocks == 1 {
-            gather((0, fcon));
-        } else {
-            fcon.par_chunks_mut(bs).enumerate().for_each(gather);
-        }
+        // Gather onto the nodes in the canonical order (side, chunk, the chunk's slaves,
+        // then their reactions' face nodes): bit-identical for any thread count.
+        gather::gather(&self.sides, fcon);
         self.stored = stored;
         self.phases.scatter += t_narrow.elapsed().as_secs_f64();
         self.narrow_time += t1.elapsed();

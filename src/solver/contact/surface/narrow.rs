@@ -5,6 +5,7 @@
 
 use rayon::prelude::*;
 
+use super::gather::{block_size, ChunkContribs, ChunkParts};
 use super::kernels::{
     box_distance2, fmax, pair_force, release, thickness_gradient, Friction, Hit, SlaveState,
 };
@@ -361,8 +362,42 @@ impl Side {
         self.chunk_active.resize_with(nchunks, Vec::new);
         self.chunk_reactions.resize_with(nchunks, Vec::new);
         self.chunk_sums.resize(nchunks, ChunkSums::default());
-        let body = |c: Chunk| nar.chunk::<NF, SOLID>(c);
+        // On more than one thread, each chunk also sorts its forces on the nodes by node
+        // block for the parallel gather, while its results are in cache.
+        let lists = rayon::current_num_threads() > 1;
+        self.chunk_contribs
+            .resize_with(if lists { nchunks } else { 0 }, Default::default);
+        let (slaves, faces, nf) = (&self.slaves, &self.faces, self.nf);
+        let bs = block_size(x.len());
+        let body = |(c, contribs): (Chunk, Option<&mut ChunkContribs>)| {
+            let (ci, ((((outs, (sts, held)), active), reactions), sums)) = c;
+            nar.chunk::<NF, SOLID>((
+                ci,
+                (
+                    (((&mut *outs, (sts, held)), &mut *active), &mut *reactions),
+                    sums,
+                ),
+            ));
+            if let Some(cc) = contribs {
+                let p = ChunkParts {
+                    slaves,
+                    faces,
+                    nf,
+                    first: ci * SLAVE_CHUNK,
+                    outs,
+                    active,
+                    reactions,
+                };
+                cc.fill(&p, bs);
+            }
+        };
+        let mut no_lists: Vec<Option<&mut ChunkContribs>> = Vec::new();
         if self.slaves.len() <= SLAVE_CHUNK {
+            let contribs: Box<dyn Iterator<Item = Option<&mut ChunkContribs>>> = if lists {
+                Box::new(self.chunk_contribs.iter_mut().map(Some))
+            } else {
+                Box::new(std::iter::repeat_with(|| None))
+            };
             self.out
                 .chunks_mut(SLAVE_CHUNK)
                 .zip(
@@ -374,8 +409,15 @@ impl Side {
                 .zip(self.chunk_reactions.iter_mut())
                 .zip(self.chunk_sums.iter_mut())
                 .enumerate()
+                .zip(contribs)
                 .for_each(body);
         } else {
+            let contribs: Vec<Option<&mut ChunkContribs>> = if lists {
+                self.chunk_contribs.iter_mut().map(Some).collect()
+            } else {
+                no_lists.resize_with(nchunks, || None);
+                no_lists
+            };
             self.out
                 .par_chunks_mut(SLAVE_CHUNK)
                 .zip(
@@ -387,6 +429,7 @@ impl Side {
                 .zip(self.chunk_reactions.par_iter_mut())
                 .zip(self.chunk_sums.par_iter_mut())
                 .enumerate()
+                .zip(contribs)
                 // A task per few chunks: the slaves in contact cluster under the nose, and
                 // rayon's default split leaves quarters of the range that a second thread
                 // cannot steal from (measured by thread in perf: the narrow phase's

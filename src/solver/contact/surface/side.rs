@@ -5,6 +5,7 @@
 
 use rayon::prelude::*;
 
+use super::gather::ChunkContribs;
 use super::kernels::{bbox, envelope_directions, thickness_box, Friction, SlaveState};
 use super::solid::{boundary_faces, boundary_nodes};
 use crate::model::contacts::{ContactDef, InitialPenetration, Slave};
@@ -151,8 +152,11 @@ pub struct Side {
     pub(super) chunk_active: Vec<Vec<u32>>,
     /// ... the shares of their reactions over the faces they penetrate, in slave order ...
     pub(super) chunk_reactions: Vec<Vec<Reaction>>,
-    /// ... and the chunk's energies and counts, summed in chunk order.
+    /// ... the chunk's energies and counts, summed in chunk order ...
     pub(super) chunk_sums: Vec<ChunkSums>,
+    /// ... and, on more than one thread, its forces on the nodes by node block, for the
+    /// parallel gather (`super::gather`).
+    pub(super) chunk_contribs: Vec<ChunkContribs>,
 }
 
 /// What one chunk of slaves adds up in a narrow phase: the stored energy and the friction
@@ -426,6 +430,7 @@ impl Side {
             chunk_active: vec![],
             chunk_reactions: vec![],
             chunk_sums: vec![],
+            chunk_contribs: vec![],
         }
     }
 
