@@ -19,7 +19,7 @@
 
 use rayon::prelude::*;
 
-use super::side::{PairOut, Reaction, Side};
+use super::side::{ChunkContribs, Contrib, PairOut, Reaction, Side};
 use crate::solver::vec3::add;
 
 /// Node blocks of the parallel gather: fixed, so that the split does not depend on the
@@ -29,21 +29,6 @@ pub(super) const NODE_BLOCKS: usize = 64;
 /// Slaves in contact below which the gather stays on one thread (same sums, no
 /// scheduling cost).
 const PARALLEL_ACTIVE: usize = 2048;
-
-/// One contribution: a node and the force added to it [N].
-#[derive(Debug, Clone, Copy, Default)]
-struct Contrib {
-    node: u32,
-    f: [f64; 3],
-}
-
-/// One chunk's contributions sorted by node block, in the chunk's order within each.
-#[derive(Debug, Clone, Default)]
-pub(super) struct ChunkContribs {
-    /// Block b's contributions are `items[ptr[b]..ptr[b + 1]]`.
-    ptr: Vec<u32>,
-    items: Vec<Contrib>,
-}
 
 /// What the contributions of a side's chunk are made of: its slaves' nodes, its faces'
 /// nodes (`nf` each), and the slaves' results from slave `first` on.

@@ -5,11 +5,11 @@
 
 use rayon::prelude::*;
 
-use super::gather::{block_size, ChunkContribs, ChunkParts};
+use super::gather::{block_size, ChunkParts};
 use super::kernels::{
     box_distance2, fmax, pair_force, release, thickness_gradient, Friction, Hit, SlaveState,
 };
-use super::side::{ChunkSums, PairOut, Reaction, Side, SLAVE_CHUNK};
+use super::side::{ChunkContribs, ChunkSums, PairOut, Reaction, Side, SLAVE_CHUNK};
 use super::solid::evaluate_solid;
 use crate::model::contacts::InitialPenetration;
 use crate::solver::contact::closest::closest_on_face;

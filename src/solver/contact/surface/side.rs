@@ -5,7 +5,6 @@
 
 use rayon::prelude::*;
 
-use super::gather::ChunkContribs;
 use super::kernels::{bbox, envelope_directions, thickness_box, Friction, SlaveState};
 use super::solid::{boundary_faces, boundary_nodes};
 use crate::model::contacts::{ContactDef, InitialPenetration, Slave};
@@ -551,4 +550,21 @@ impl Side {
                 }
             });
     }
+}
+
+/// One contribution to the parallel gather (`super::gather`): a node and the force added
+/// to it [N].
+#[derive(Debug, Clone, Copy, Default)]
+pub(super) struct Contrib {
+    pub(super) node: u32,
+    pub(super) f: [f64; 3],
+}
+
+/// One chunk's contributions sorted by node block, in the chunk's order within each
+/// (filled by `super::gather`'s `ChunkContribs::fill`).
+#[derive(Debug, Clone, Default)]
+pub(super) struct ChunkContribs {
+    /// Block b's contributions are `items[ptr[b]..ptr[b + 1]]`.
+    pub(super) ptr: Vec<u32>,
+    pub(super) items: Vec<Contrib>,
 }
