@@ -27,8 +27,14 @@
 //! Nodes moving together (a rigid translation of a region of size ~3h) keep their lists
 //! until they have moved U, instead of skin/2. The per-cell minima and maxima are exact
 //! (no sums), so the test gives the same answer on any thread count.
+//!
+//! This is the special case of one tile over all cells of [`super::tiles`] (whose docs
+//! state the general lemma and theorem), with the cells sized as there
+//! ([`CellGrid::covering`]).
 
 use rayon::prelude::*;
+
+use super::tiles::CellGrid;
 
 /// The absolute bound U as a multiple of the skin: larger U means larger cells, so
 /// larger neighbourhoods whose spread reaches the skin sooner. Measured on the 60 × 60
@@ -36,10 +42,6 @@ use rayon::prelude::*;
 /// times): U = 0.5, 1, 2, 4 skins build 746, 510, 510, 516 times (at 0.5 and 1 mostly
 /// for a node past U, at 2 and 4 never: the spread under the nose's rim decides).
 pub const ABSOLUTE_PER_SKIN: f64 = 2.0;
-
-/// Most cells per node (past it, the cells grow: a patch far apart in one direction would
-/// otherwise ask for a huge, empty grid).
-const CELLS_PER_NODE: usize = 4;
 
 /// Cells per parallel chunk of the per-cell ranges.
 const CELL_CHUNK: usize = 256;
@@ -53,9 +55,7 @@ pub struct Staleness {
     /// Positions at the build of the nodes in `cell_nodes`, in the same (cell) order.
     x_ref: Vec<[f64; 3]>,
     /// Cells: origin, size h, counts per axis.
-    origin: [f64; 3],
-    h: f64,
-    dims: [usize; 3],
+    grid: CellGrid,
     /// Nodes (indices into the positions) per cell (CSR).
     cell_ptr: Vec<u32>,
     cell_nodes: Vec<u32>,
@@ -112,36 +112,17 @@ impl Staleness {
                 std::array::from_fn(|d| p.1[d].max(q.1[d])),
             )
         };
-        let (mut lo, hi) = nodes
+        let (lo, hi) = nodes
             .par_iter()
             .fold(
                 || none,
                 |acc, &n| merge(acc, (x[n as usize], x[n as usize])),
             )
             .reduce(|| none, merge);
-        let mut h = rho_w + 4.0 * self.u_max;
-        if nodes.is_empty() || !(h > 0.0) || !(0..3).all(|d| lo[d].is_finite() && hi[d].is_finite())
-        {
-            // Nothing to bin (or a non-finite position, which stops the run elsewhere):
-            // one cell, so that every pair is in one neighbourhood.
-            lo = [0.0; 3];
-            h = f64::INFINITY;
-        }
-        let cap = CELLS_PER_NODE * nodes.len() + 64;
-        let mut dims = [1usize; 3];
-        if h.is_finite() {
-            loop {
-                for d in 0..3 {
-                    dims[d] = ((hi[d] - lo[d]) / h).floor() as usize + 1;
-                }
-                if dims[0].saturating_mul(dims[1]).saturating_mul(dims[2]) <= cap {
-                    break;
-                }
-                h *= 1.5;
-            }
-        }
-        let ncell = dims[0] * dims[1] * dims[2];
-        (self.origin, self.h, self.dims) = (lo, h, dims);
+        // (Nothing to bin, or a non-finite position, which stops the run elsewhere: one
+        // cell, so that every pair is in one neighbourhood.)
+        self.grid = CellGrid::covering(lo, hi, rho_w + 4.0 * self.u_max, nodes.len());
+        let ncell = self.grid.cells();
         // Nodes by cell: a counting sort; the nodes' indices and build positions are kept
         // in cell order, so that the test reads them in sequence.
         let cells: Vec<u32> = nodes
@@ -174,14 +155,8 @@ impl Staleness {
 
     /// The cell of a build position.
     pub fn cell(&self, p: &[f64; 3]) -> usize {
-        if !self.h.is_finite() {
-            return 0;
-        }
-        let c: [usize; 3] = std::array::from_fn(|d| {
-            // Truncation is the floor: every build position is ≥ the origin.
-            (((p[d] - self.origin[d]) / self.h).max(0.0) as usize).min(self.dims[d] - 1)
-        });
-        (c[2] * self.dims[1] + c[1]) * self.dims[0] + c[0]
+        // (Truncation is the floor: every build position is ≥ the origin.)
+        self.grid.cell(p)
     }
 
     /// Whether the lists built at `reset` may miss a pair at the positions `x` (of every
@@ -253,7 +228,7 @@ impl Staleness {
     /// cells' own ranges in `range`: a window of three along each axis in turn (range →
     /// scratch → range → scratch), the result in `scratch`.
     fn neighbourhood_ranges(&mut self) {
-        let dims = self.dims;
+        let dims = self.grid.dims();
         let stride = [1, dims[0], dims[0] * dims[1]];
         for axis in 0..3 {
             let (src, dst) = if axis == 1 {
@@ -306,7 +281,7 @@ impl Staleness {
             *oc = (0..3).all(|d| r[d + 3] >= r[d]);
             *o |= *oc && (0..3).any(|d| r[d + 3] - r[d] > self.skin);
         }
-        tile_marks(self.dims, &over, &occupied)
+        tile_marks(self.grid.dims(), &over, &occupied)
     }
 
     /// Whether the last [`Staleness::stale`] found a node past U.
@@ -316,7 +291,7 @@ impl Staleness {
 
     /// The cell counts per axis.
     pub fn dims(&self) -> [usize; 3] {
-        self.dims
+        self.grid.dims()
     }
 
     /// Per cell, the norm |S| of its neighbourhood's spreads of the displacements since

@@ -90,7 +90,8 @@
 
 use rayon::prelude::*;
 
-/// Most cells per node, as in [`super::staleness`] (past it, the cells grow).
+/// Most cells per node (past it, the cells grow: a patch far apart in one direction
+/// would otherwise ask for a huge, empty grid).
 const CELLS_PER_NODE: usize = 4;
 
 /// Nodes per parallel chunk of [`Binning::rebin`].
@@ -132,7 +133,7 @@ impl Reach {
 }
 
 /// Fixed cells over the contact nodes: origin, size h, counts per axis; indices clamped.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, Default, PartialEq)]
 pub struct CellGrid {
     origin: [f64; 3],
     h: f64,
@@ -141,9 +142,9 @@ pub struct CellGrid {
 
 impl CellGrid {
     /// Cells of size at least `h_min` from `lo` covering up to `hi` (the nodes' bounds),
-    /// grown by 1.5 until there are at most 4 per node (+64): the sizing rule of
-    /// [`super::staleness::Staleness::reset`], so that the same bounds and size give the
-    /// same cells. Without nodes, or with a non-finite bound or size: one cell.
+    /// grown by 1.5 until there are at most 4 per node (+64), as
+    /// [`super::staleness::Staleness::reset`] sizes its cells (with these). Without nodes,
+    /// or with a non-finite bound or size: one cell.
     pub fn covering(lo: [f64; 3], hi: [f64; 3], h_min: f64, nodes: usize) -> CellGrid {
         let mut h = h_min;
         let mut origin = lo;
@@ -184,7 +185,7 @@ impl CellGrid {
         CellGrid::covering(lo, hi, reach.cell_size(x_abs), nodes.len())
     }
 
-    /// The cell of a position (the same expression as `Staleness::cell`).
+    /// The cell of a position (also `Staleness::cell`).
     pub fn cell(&self, p: &[f64; 3]) -> usize {
         if !self.h.is_finite() {
             return 0;
