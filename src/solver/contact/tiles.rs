@@ -72,11 +72,16 @@
 //!
 //! **Consequences.** At a build the lemma with R = r puts every face within r of a slave
 //! of T in FaceSet(T), so the build loses nothing by looking only there. A slave re-binned
-//! out of T marks T and its new tile stale. Marking on a re-bin that keeps the cell is not
-//! needed by the proof (membership is all a tile depends on); it is kept so that one tile
-//! is exactly today's test (below), and costs little: re-bins need a node to move U = 2
-//! skins relative to its bin position, which on the 60 × 60 woven quarter never triggered
-//! today's builds (see [`super::staleness::ABSOLUTE_PER_SKIN`]).
+//! out of T marks T and its new tile stale. A tile holding both the old and the new cell
+//! is marked too: its test groups V_T by the cells at its build, and step 4 needs the
+//! current ones. Marking on a re-bin that keeps the cell is not needed by the proof (the
+//! cells are all a tile depends on); it is kept so that one tile is exactly today's test
+//! (below). Re-bins happen wherever nodes travel U from their bin positions, also in a
+//! region that moves as a whole (x̂ is not reset at a tile's build, unlike today's x^b at a
+//! global build), each node at its own step: in the brute-force test's drifting sheet
+//! (tests/contact_tiles.rs) re-bin marks caused 854 of 992 tile rebuilds; re-bins into
+//! another cell alone would have marked 768 of them. Step 3 should measure this on the
+//! woven runs: under the nose it, not the test, may decide how often tiles rebuild.
 //!
 //! **[`super::staleness`] is the special case of one tile** over all cells: V_T holds
 //! every node, FaceSet(T) every face, x̂ = y^T = x^b (every re-bin marks the one tile, as
