@@ -395,6 +395,35 @@ fn small_patch(dir: &std::path::Path) -> std::path::PathBuf {
     m
 }
 
+/// One round of `weft-ballistic search` on `model`, its two impacts at 40 and 400 m/s
+/// (the bracket's ends, --per-round 2), into `out`.
+fn search_once(model: &std::path::Path, out: &std::path::Path) {
+    run_ok(
+        BALLISTIC,
+        &[
+            "search",
+            "--model",
+            model.to_str().unwrap(),
+            "--lo",
+            "40",
+            "--hi",
+            "400",
+            "--tolerance",
+            "1000",
+            "--per-round",
+            "2",
+            "--max-rounds",
+            "1",
+            "--threads",
+            "1",
+            "--bootstrap",
+            "10",
+            "--out",
+            out.to_str().unwrap(),
+        ],
+    );
+}
+
 fn simulate(model: &std::path::Path, out: &std::path::Path, v: f64) {
     run_ok(
         SIMULATE,
@@ -558,30 +587,7 @@ fn the_search_costs_what_weft_simulate_runs_cost() {
     let dir = tempfile::tempdir().unwrap();
     let m = small_patch(dir.path());
     let out = dir.path().join("search");
-    run_ok(
-        BALLISTIC,
-        &[
-            "search",
-            "--model",
-            m.to_str().unwrap(),
-            "--lo",
-            "40",
-            "--hi",
-            "400",
-            "--tolerance",
-            "1000",
-            "--per-round",
-            "2",
-            "--max-rounds",
-            "1",
-            "--threads",
-            "1",
-            "--bootstrap",
-            "10",
-            "--out",
-            out.to_str().unwrap(),
-        ],
-    );
+    search_once(&m, &out);
     let t = Table::read(&out.join("ballistic_runs.parquet")).unwrap();
     let vs = t.f64("striking_velocity", "").unwrap();
     let (steps, sim, elements) = (
@@ -632,28 +638,7 @@ fn a_search_names_its_model_as_text() {
     let m = dir.path().join("6");
     std::fs::rename(small_patch(dir.path()), &m).unwrap();
     let out = dir.path().join("search");
-    run_ok(
-        BALLISTIC,
-        &[
-            "search",
-            "--model",
-            m.to_str().unwrap(),
-            "--lo",
-            "40",
-            "--hi",
-            "400",
-            "--tolerance",
-            "1000",
-            "--max-rounds",
-            "1",
-            "--threads",
-            "1",
-            "--bootstrap",
-            "10",
-            "--out",
-            out.to_str().unwrap(),
-        ],
-    );
+    search_once(&m, &out);
     for table in ["ballistic_runs.parquet", "ballistic_limit.parquet"] {
         let t = Table::read(&out.join(table)).unwrap();
         let model = t.str_opt("model").unwrap();

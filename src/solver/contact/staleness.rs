@@ -34,7 +34,7 @@
 
 use rayon::prelude::*;
 
-use super::tiles::CellGrid;
+use super::tiles::{CellGrid, EMPTY_RANGE};
 
 /// The absolute bound U as a multiple of the skin: larger U means larger cells, so
 /// larger neighbourhoods whose spread reaches the skin sooner. Measured on the 60 × 60
@@ -176,14 +176,7 @@ impl Staleness {
                 let mut far = false;
                 for (j, r) in rs.iter_mut().enumerate() {
                     let c = k * CELL_CHUNK + j;
-                    *r = [
-                        f64::INFINITY,
-                        f64::INFINITY,
-                        f64::INFINITY,
-                        f64::NEG_INFINITY,
-                        f64::NEG_INFINITY,
-                        f64::NEG_INFINITY,
-                    ];
+                    *r = EMPTY_RANGE;
                     for i in cell_ptr[c] as usize..cell_ptr[c + 1] as usize {
                         let (p, q) = (&x[cell_nodes[i] as usize], &x_ref[i]);
                         for d in 0..3 {

@@ -137,6 +137,35 @@ impl Reach {
     }
 }
 
+/// A cell's empty range of displacements: min Δ (3) at +∞, max Δ (3) at −∞, ready for
+/// min/max folds.
+pub const EMPTY_RANGE: [f64; 6] = [
+    f64::INFINITY,
+    f64::INFINITY,
+    f64::INFINITY,
+    f64::NEG_INFINITY,
+    f64::NEG_INFINITY,
+    f64::NEG_INFINITY,
+];
+
+/// The cells per axis over (lo, hi) at the cell size `h` (finite, > 0), and the cell size:
+/// h grown by 1.5 until there are at most `cap` cells (a set far apart in one direction
+/// would otherwise ask for a huge, empty grid). Shared by the tiles, the staleness test
+/// and the surface contact's face grid.
+pub fn cell_counts(lo: &[f64; 3], hi: &[f64; 3], mut h: f64, cap: usize) -> ([usize; 3], f64) {
+    let mut dims = [1usize; 3];
+    loop {
+        for d in 0..3 {
+            dims[d] = ((hi[d] - lo[d]) / h).floor() as usize + 1;
+        }
+        if dims[0].saturating_mul(dims[1]).saturating_mul(dims[2]) <= cap {
+            break;
+        }
+        h *= 1.5;
+    }
+    (dims, h)
+}
+
 /// Fixed cells over the contact nodes: origin, size h, counts per axis; indices clamped.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct CellGrid {
@@ -157,18 +186,9 @@ impl CellGrid {
             origin = [0.0; 3];
             h = f64::INFINITY;
         }
-        let cap = CELLS_PER_NODE * nodes + 64;
         let mut dims = [1usize; 3];
         if h.is_finite() {
-            loop {
-                for d in 0..3 {
-                    dims[d] = ((hi[d] - lo[d]) / h).floor() as usize + 1;
-                }
-                if dims[0].saturating_mul(dims[1]).saturating_mul(dims[2]) <= cap {
-                    break;
-                }
-                h *= 1.5;
-            }
+            (dims, h) = cell_counts(&lo, &hi, h, CELLS_PER_NODE * nodes + 64);
         }
         CellGrid { origin, h, dims }
     }
@@ -569,17 +589,7 @@ impl Tile {
     /// marked stale or has never been built.
     pub fn test(&self, x: &[[f64; 3]], skin: f64) -> TileTest {
         // Per cell of N(T): min Δ (3), max Δ (3); and the largest |x|, |y|.
-        let mut range = vec![
-            [
-                f64::INFINITY,
-                f64::INFINITY,
-                f64::INFINITY,
-                f64::NEG_INFINITY,
-                f64::NEG_INFINITY,
-                f64::NEG_INFINITY,
-            ];
-            self.near_cells.len()
-        ];
+        let mut range = vec![EMPTY_RANGE; self.near_cells.len()];
         let mut big = 0.0f64;
         for (c, r) in range.iter_mut().enumerate() {
             for i in self.cell_ptr[c] as usize..self.cell_ptr[c + 1] as usize {

@@ -6,6 +6,7 @@ use rayon::prelude::*;
 
 use super::kernels::{excess, fmin};
 use super::side::{Side, SLAVE_CHUNK};
+use crate::solver::contact::tiles::cell_counts;
 
 /// Most cells a broad-phase grid may have per face box (past it, the cells grow).
 const GRID_CELLS_PER_BOX: usize = 8;
@@ -44,7 +45,9 @@ impl Grid {
                 items: vec![],
             };
         }
-        let (dims, h) = cell_counts(&lo, &hi, h, boxes.len());
+        // (At most a few cells per box: a patch whose faces are far apart in one
+        // direction would otherwise ask for a huge, empty grid.)
+        let (dims, h) = cell_counts(&lo, &hi, h, GRID_CELLS_PER_BOX * boxes.len() + 64);
         // Truncation is the floor here: every coordinate is ≥ the origin.
         let cell = |p: &[f64; 3]| -> [u32; 3] {
             std::array::from_fn(|d| {
@@ -109,24 +112,6 @@ fn extent(boxes: &[([f64; 3], [f64; 3])]) -> ([f64; 3], [f64; 3], f64) {
         .reduce(|| none, merge);
     h *= GRID_CELL_FRACTION;
     (lo, hi, h)
-}
-
-/// The cells per axis over (lo, hi) at the cell size `h`, and the cell size: grown until
-/// there are a few cells per box at most (a patch whose faces are far apart in one
-/// direction would otherwise ask for a huge, empty grid).
-fn cell_counts(lo: &[f64; 3], hi: &[f64; 3], mut h: f64, n_boxes: usize) -> ([usize; 3], f64) {
-    let cap = GRID_CELLS_PER_BOX * n_boxes + 64;
-    let mut dims = [1usize; 3];
-    loop {
-        for d in 0..3 {
-            dims[d] = ((hi[d] - lo[d]) / h).floor() as usize + 1;
-        }
-        if dims[0].saturating_mul(dims[1]).saturating_mul(dims[2]) <= cap {
-            break;
-        }
-        h *= 1.5;
-    }
-    (dims, h)
 }
 
 /// The row (the cells of one (j, k)) of the grid's cell indices j, k.
