@@ -1,7 +1,6 @@
 //! Tiles of the surface contact's broad phase, each with its own build epoch and its own
-//! reference positions, so that a stale region rebuilds its candidate lists alone
-//! (issue 39, design step 2: the search's data and its proof; the narrow phase does not
-//! use it yet).
+//! reference positions, so that a stale region rebuilds its candidate lists alone: the
+//! data and the proof of the tiled search ([`super::surface::tiled`], which uses them).
 //!
 //! Glossary (as in [`super::staleness`]): s a slave node, F a master face, t_a the nodal
 //! contact thickness; a face's thickness box is the bounding box of the balls of radius
@@ -32,7 +31,9 @@
 //!
 //! **Invariants**, restored every step before a narrow phase:
 //! - (B) binning: |x_i,d − x̂_i,d| ≤ U for every node and every component of more than
-//!   one cell ([`Binning::rebin`]);
+//!   one cell ([`Binning::rebin`]); with hysteresis ([`Binning::with_hysteresis`], the
+//!   solver's), (B') instead: x_i,d lies within U of κ(i)'s cell, [o_d + k_d h − U,
+//!   o_d + (k_d + 1) h + U] with k = κ(i)'s indices (unbounded past a border cell);
 //! - (W) width: every live face's thickness box is at most W_cap wide in each component
 //!   ([`WidthMonitor`]; past the cap, a re-grid with a larger h);
 //! - (M) membership: no node has entered or left N(T) since b_T (a tile marked stale by a
@@ -50,6 +51,11 @@
 //! so the floors of (x̂_d − o_d)/h differ by at most one (for the rounded quotients too:
 //! see the allowance in [`Reach::cell_size`]). Clamping to [0, dims_d − 1] is monotone and
 //! does not widen a difference; a component of one cell gives equal indices. ∎
+//! *With (B').* If κ(a)_d ≥ κ(s)_d + 2, then x_a,d ≥ o_d + (κ(s)_d + 2) h − U and
+//! x_s,d ≤ o_d + (κ(s)_d + 1) h + U, so |x_a,d − x_s,d| ≥ h − 2U ≥ R + W_cap, against
+//! the first line (the windows' rounding, a few units in the last place of |x|, is far
+//! inside the allowance of [`Reach::cell_size`]; a border cell's window is unbounded only
+//! outward, where no other cell lies). The same cell size serves both.
 //!
 //! **Theorem.** If (B), (W), (M) hold at step n and T passes the test, then every face F
 //! that the narrow phase can evaluate for a slave s with κ(s) ∈ T (e_d(s, F) ≤ t_s/2 + η
@@ -80,8 +86,16 @@
 //! region that moves as a whole (x̂ is not reset at a tile's build, unlike today's x^b at a
 //! global build), each node at its own step: in the brute-force test's drifting sheet
 //! (tests/contact_tiles.rs) re-bin marks caused 854 of 992 tile rebuilds; re-bins into
-//! another cell alone would have marked 768 of them. Step 3 should measure this on the
-//! woven runs: under the nose it, not the test, may decide how often tiles rebuild.
+//! another cell alone would have marked 768 of them.
+//!
+//! **Hysteresis.** A node re-binned by (B) lands at x̂ = x, possibly next to a cell face,
+//! and then changes cell at every small excursion across it. With (B') a node changes
+//! cell only once it is U past its cell, and every re-bin is a change of cell; only those
+//! mark tiles ([`Rebin::crossing_tiles`]). In the drifting sheet: 384 re-bins against
+//! 4 208 (911 into another cell). On the woven impacts (60 × 60 quarter to 60 µs) the
+//! changes of cell still asked for most tile builds (93 % of them at U = 4 skins): the
+//! yarns are drawn in toward the impact along their length, and carry every node across
+//! the fixed cells in turn (see [`super::surface::tiled::TILE_CELLS`]).
 //!
 //! **[`super::staleness`] is the special case of one tile** over all cells: V_T holds
 //! every node, FaceSet(T) every face, x̂ = y^T = x^b (every re-bin marks the one tile, as
@@ -240,6 +254,10 @@ impl CellGrid {
         self.h
     }
 
+    pub fn origin(&self) -> [f64; 3] {
+        self.origin
+    }
+
     pub fn cells(&self) -> usize {
         self.dims[0] * self.dims[1] * self.dims[2]
     }
@@ -261,6 +279,9 @@ pub struct Rebin {
     pub moved: Vec<Moved>,
     /// The tiles whose N(T) holds a moved node's old or new cell, ascending.
     pub stale_tiles: Vec<u32>,
+    /// The tiles whose N(T) holds the old or new cell of a node that changed cell,
+    /// ascending: all the proof needs marked (module docs, "Consequences").
+    pub crossing_tiles: Vec<u32>,
     /// The largest |x_i,d| over the contact nodes (to check the grid's round-off
     /// allowance, [`Reach::cell_size`]).
     pub x_abs: f64,
@@ -280,9 +301,52 @@ pub struct Binning {
     cell_nodes: Vec<u32>,
     /// The absolute bound U [m].
     u: f64,
+    /// With hysteresis ([`Binning::with_hysteresis`]): per node, the window of its cell
+    /// widened by U on each side (lo 3, hi 3; infinite past a border cell and in a
+    /// component of one cell); without, unused.
+    hysteresis: bool,
+    window: Vec<[f64; 6]>,
+}
+
+impl CellGrid {
+    /// The window of cell `c` widened by `delta` on each side (lo, hi per component),
+    /// infinite past the border cells and in a component of one cell.
+    pub fn window(&self, c: usize, delta: f64) -> [f64; 6] {
+        let i = self.index(c);
+        let mut w = [
+            f64::NEG_INFINITY,
+            f64::NEG_INFINITY,
+            f64::NEG_INFINITY,
+            f64::INFINITY,
+            f64::INFINITY,
+            f64::INFINITY,
+        ];
+        for d in 0..3 {
+            if i[d] > 0 {
+                w[d] = (self.origin[d] + i[d] as f64 * self.h) - delta;
+            }
+            if i[d] + 1 < self.dims[d] {
+                w[d + 3] = (self.origin[d] + (i[d] + 1) as f64 * self.h) + delta;
+            }
+        }
+        w
+    }
 }
 
 impl Binning {
+    /// [`Binning::new`] with hysteresis: a node keeps its cell while it lies in the cell
+    /// widened by `u` on each side, and is re-binned (x̂ := x, the cell of x) only when it
+    /// leaves that window, so that every re-bin changes its cell and a node that
+    /// oscillates about a cell's face by less than `u` never does. Invariant (B) then
+    /// reads: x_i,d lies within u of κ(i)'s cell (module docs, "Hysteresis"), and the
+    /// lemma holds with the same cell size.
+    pub fn with_hysteresis(grid: &CellGrid, nodes: &[u32], x: &[[f64; 3]], u: f64) -> Binning {
+        let mut b = Binning::new(grid, nodes, x, u);
+        b.hysteresis = true;
+        b.window = b.cell.iter().map(|&c| grid.window(c as usize, u)).collect();
+        b
+    }
+
     /// Every node of `nodes` binned at its position in `x` (indexed by model node).
     pub fn new(grid: &CellGrid, nodes: &[u32], x: &[[f64; 3]], u: f64) -> Binning {
         let n_model = nodes.iter().map(|&n| n as usize + 1).max().unwrap_or(0);
@@ -300,6 +364,8 @@ impl Binning {
             cell_ptr: Vec::new(),
             cell_nodes: Vec::new(),
             u,
+            hysteresis: false,
+            window: vec![[0.0; 6]; nodes.len()],
         };
         b.sort_cells(grid.cells());
         b
@@ -333,12 +399,14 @@ impl Binning {
         let multi: [bool; 3] = std::array::from_fn(|d| grid.dims[d] > 1);
         let (nodes, u) = (&self.nodes, self.u);
         // Per chunk: the moves, in node order, and the largest coordinate.
+        let hysteresis = self.hysteresis;
         let parts: Vec<(Vec<Moved>, f64)> = self
             .x_bin
             .par_chunks_mut(NODE_CHUNK)
             .zip(self.cell.par_chunks_mut(NODE_CHUNK))
+            .zip(self.window.par_chunks_mut(NODE_CHUNK))
             .enumerate()
-            .map(|(k, (xb, cs))| {
+            .map(|(k, ((xb, cs), ws))| {
                 let mut moved = Vec::new();
                 let mut x_abs = 0.0f64;
                 for (j, (b, c)) in xb.iter_mut().zip(cs.iter_mut()).enumerate() {
@@ -347,7 +415,13 @@ impl Binning {
                     for d in 0..3 {
                         x_abs = x_abs.max(p[d].abs());
                     }
-                    if (0..3).any(|d| multi[d] && (p[d] - b[d]).abs() > u) {
+                    let leaves = if hysteresis {
+                        // (A NaN coordinate is outside every window.)
+                        !(0..3).all(|d| p[d] >= ws[j][d] && p[d] <= ws[j][d + 3])
+                    } else {
+                        (0..3).any(|d| multi[d] && (p[d] - b[d]).abs() > u)
+                    };
+                    if leaves {
                         let to = grid.cell(p) as u32;
                         moved.push(Moved {
                             node: i as u32,
@@ -355,6 +429,9 @@ impl Binning {
                             to,
                         });
                         (*b, *c) = (*p, to);
+                        if hysteresis {
+                            ws[j] = grid.window(to as usize, u);
+                        }
                     }
                 }
                 (moved, x_abs)
@@ -363,9 +440,13 @@ impl Binning {
         let x_abs = parts.iter().map(|p| p.1).fold(0.0, f64::max);
         let moved: Vec<Moved> = parts.into_iter().flat_map(|p| p.0).collect();
         let mut marked = vec![false; tiling.tiles.len()];
+        let mut crossing = vec![false; tiling.tiles.len()];
         for m in &moved {
             for c in [m.from, m.to] {
-                tiling.for_tiles_holding(c as usize, |t| marked[t] = true);
+                tiling.for_tiles_holding(c as usize, |t| {
+                    marked[t] = true;
+                    crossing[t] |= m.from != m.to;
+                });
             }
         }
         if moved.iter().any(|m| m.from != m.to) {
@@ -374,9 +455,13 @@ impl Binning {
         let stale_tiles = (0..marked.len() as u32)
             .filter(|&t| marked[t as usize])
             .collect();
+        let crossing_tiles = (0..crossing.len() as u32)
+            .filter(|&t| crossing[t as usize])
+            .collect();
         Rebin {
             moved,
             stale_tiles,
+            crossing_tiles,
             x_abs,
         }
     }
@@ -516,6 +601,8 @@ pub struct Tile {
     core: CellBox,
     near: CellBox,
     near_cells: Vec<u32>,
+    /// The cells of T, ascending.
+    core_cells: Vec<u32>,
     /// Per cell of T (ascending): the indices into `near_cells` of its 3 × 3 × 3
     /// neighbourhood N(c) (clamped), CSR.
     nbr_ptr: Vec<u32>,
@@ -555,6 +642,7 @@ impl Tile {
         }
         let near_cells = near.cells(grid);
         Tile {
+            core_cells: core.cells(grid),
             core,
             near,
             cell_ptr: vec![0; near_cells.len() + 1],
@@ -588,8 +676,24 @@ impl Tile {
     /// spread of x_d − y^T_d over N(c) is at most skin − 4ε̂; false also when the tile is
     /// marked stale or has never been built.
     pub fn test(&self, x: &[[f64; 3]], skin: f64) -> TileTest {
+        self.test_with(x, skin, &mut Vec::new(), &mut Vec::new())
+    }
+
+    /// [`Tile::test`] with its scratch (`range`, per cell of N(T)) given, and the norm
+    /// |S| of the spreads (S_x, S_y, S_z) over each cell's N(c) written to `spreads`, per
+    /// cell of T in the order of [`Tile::cells`] (+∞ for an empty N(c)): the bound on how
+    /// far the nodes around a slave have moved apart since b_T that the narrow phase's
+    /// skip test reads (`Side::margin`).
+    pub fn test_with(
+        &self,
+        x: &[[f64; 3]],
+        skin: f64,
+        range: &mut Vec<[f64; 6]>,
+        spreads: &mut Vec<f64>,
+    ) -> TileTest {
         // Per cell of N(T): min Δ (3), max Δ (3); and the largest |x|, |y|.
-        let mut range = vec![EMPTY_RANGE; self.near_cells.len()];
+        range.clear();
+        range.resize(self.near_cells.len(), EMPTY_RANGE);
         let mut big = 0.0f64;
         for (c, r) in range.iter_mut().enumerate() {
             for i in self.cell_ptr[c] as usize..self.cell_ptr[c + 1] as usize {
@@ -606,6 +710,7 @@ impl Tile {
         let limit = skin - 4.0 * eps;
         let mut fresh = !self.stale && self.epoch > 0;
         let mut spread = f64::NEG_INFINITY;
+        spreads.clear();
         for k in 0..self.nbr_ptr.len() - 1 {
             let mut m = range[self.nbr[self.nbr_ptr[k] as usize] as usize];
             for &e in &self.nbr[self.nbr_ptr[k] as usize + 1..self.nbr_ptr[k + 1] as usize] {
@@ -615,12 +720,14 @@ impl Tile {
                     m[d + 3] = m[d + 3].max(o[d + 3]);
                 }
             }
-            for d in 0..3 {
-                let s = m[d + 3] - m[d];
+            let sd: [f64; 3] = std::array::from_fn(|d| m[d + 3] - m[d]);
+            for &s in &sd {
                 // (A NaN spread is not ≤ the limit: stale.)
                 fresh &= s <= limit;
                 spread = spread.max(s);
             }
+            // (An empty neighbourhood: −∞ spreads, an infinite norm.)
+            spreads.push((sd[0] * sd[0] + sd[1] * sd[1] + sd[2] * sd[2]).sqrt());
         }
         TileTest { fresh, spread, eps }
     }
@@ -675,6 +782,11 @@ impl Tile {
     /// The cells of T, ascending.
     pub fn cells(&self, grid: &CellGrid) -> Vec<u32> {
         self.core.cells(grid)
+    }
+
+    /// The cells of T, ascending (as [`Tile::cells`], kept).
+    pub fn core_cells(&self) -> &[u32] {
+        &self.core_cells
     }
 
     /// The cells of N(T), ascending.

@@ -293,14 +293,83 @@ fn visit(
     }
 }
 
+/// How a side's slaves find their candidates in a [`Grid`] over the inflated thickness
+/// boxes of some of its faces (`to_face` maps the grid's entries to face indices, in face
+/// order; None: all faces, the identity).
+struct Lister<'a> {
+    grid: &'a Grid,
+    to_face: Option<&'a [u32]>,
+    /// The inflation r of the boxes [m].
+    r: f64,
+    x: &'a [[f64; 3]],
+    side: &'a Side,
+}
+
+impl Lister<'_> {
+    /// Slave `si`'s candidates pushed onto `list` (ascending), and its margin (see
+    /// `Side::margin`). (Pushes directly: a closure taking `dyn FnMut` made a call per
+    /// candidate.)
+    #[inline]
+    fn candidates(&self, si: usize, list: &mut Vec<u32>) -> f64 {
+        let sd = self.side;
+        let (r, nf) = (self.r, sd.nf);
+        let s = sd.slaves[si];
+        let p = &self.x[s as usize];
+        let mut near = f64::INFINITY;
+        for &gi in self.grid.cell_of(p) {
+            let fi = self.to_face.map_or(gi, |l| l[gi as usize]);
+            // (The inflated box, as the grid holds it.)
+            let b = &sd.face_box[fi as usize];
+            if (0..3).all(|d| p[d] >= b[d] - r && p[d] <= b[d + 3] + r)
+                && !sd.faces[fi as usize][..nf].contains(&s)
+            {
+                list.push(fi);
+                near = fmin(near, excess(p, b, &sd.face_dir[fi as usize], nf));
+            }
+        }
+        near - 0.5 * sd.slave_t[si] - 2.0 * sd.box_margin
+    }
+}
+
+/// The candidate lists of one tile's slaves ([`Side::build_tile`]): the list, and per
+/// slave (ascending) its index, its range in the list and its margin.
+#[derive(Debug, Clone, Default)]
+pub(super) struct TileLists {
+    pub(super) cand: Vec<u32>,
+    pub(super) slaves: Vec<(u32, u32, u32, f64)>,
+}
+
 impl Side {
+    /// The reach r of a build: a slave within t_s/2 + η of a thickness box at some step
+    /// before the next build was within this of it per component at the build (see
+    /// `super::staleness` and `super::super::tiles`).
+    fn build_reach(&self, skin: f64) -> f64 {
+        0.5 * self.slave_t_max + skin + self.box_margin
+    }
+
+    /// The grid over the inflated thickness boxes of faces `set` (face indices in
+    /// ascending order; None: every face).
+    fn grid_over(&self, r: f64, set: Option<&[u32]>) -> Grid {
+        let inflate = |b: &[f64; 8]| {
+            (
+                [b[0] - r, b[1] - r, b[2] - r],
+                [b[3] + r, b[4] + r, b[5] + r],
+            )
+        };
+        let boxes: Vec<([f64; 3], [f64; 3])> = match set {
+            None => self.face_box.par_iter().map(inflate).collect(),
+            Some(l) => l
+                .iter()
+                .map(|&f| inflate(&self.face_box[f as usize]))
+                .collect(),
+        };
+        Grid::new(&boxes)
+    }
+
     /// Broad phase: candidates of every slave at the positions `x`, whose face boxes
-    /// [`Side::update_boxes`] has computed.
+    /// [`Side::update_boxes`] has computed; one list for all slaves.
     pub(super) fn build(&mut self, x: &[[f64; 3]], skin: f64) {
-        // A slave within t_s/2 + η of a thickness box at some step before the next build
-        // was within this of it per component at the build (see `super::staleness`).
-        let r = 0.5 * self.slave_t_max + skin + self.box_margin;
-        let nf = self.nf;
+        let r = self.build_reach(skin);
         // Eroded faces stay out of the grid: it lists the live ones, `live` maps its
         // entries back to face indices (in face order, so the candidates keep it).
         let live: Option<Vec<u32>> = (self.dead_faces > 0).then(|| {
@@ -308,93 +377,100 @@ impl Side {
                 .filter(|&f| self.face_alive[f as usize])
                 .collect()
         });
-        let inflate = |b: &[f64; 8]| {
-            (
-                [b[0] - r, b[1] - r, b[2] - r],
-                [b[3] + r, b[4] + r, b[5] + r],
-            )
+        let grid = self.grid_over(r, live.as_deref());
+        let lister = Lister {
+            grid: &grid,
+            to_face: live.as_deref(),
+            r,
+            x,
+            side: self,
         };
-        let boxes: Vec<([f64; 3], [f64; 3])> = match &live {
-            None => self.face_box.par_iter().map(inflate).collect(),
-            Some(l) => l
-                .iter()
-                .map(|&f| inflate(&self.face_box[f as usize]))
-                .collect(),
-        };
-        let grid = Grid::new(&boxes);
-        let to_face = |g: u32| live.as_ref().map_or(g, |l| l[g as usize]);
         // Candidates: count, then fill, each in parallel over fixed slave chunks.
-        let faces = &self.faces;
-        let slaves = &self.slaves;
-        let (slave_t, face_box, face_dir) = (&self.slave_t, &self.face_box, &self.face_dir);
-        let eta = self.box_margin;
-        // A slave's candidates, and its margin (see `Side::margin`).
-        // (Pushes directly: a closure taking `dyn FnMut` made a call per candidate.)
-        let candidates = |si: usize, list: &mut Vec<u32>| -> f64 {
-            let s = slaves[si];
-            let p = &x[s as usize];
-            let mut near = f64::INFINITY;
-            for &gi in grid.cell_of(p) {
-                let fi = to_face(gi);
-                // (The inflated box, as `boxes` holds it.)
-                let b = &face_box[fi as usize];
-                if (0..3).all(|d| p[d] >= b[d] - r && p[d] <= b[d + 3] + r)
-                    && !faces[fi as usize][..nf].contains(&s)
-                {
-                    list.push(fi);
-                    near = fmin(near, excess(p, b, &face_dir[fi as usize], nf));
-                }
-            }
-            near - 0.5 * slave_t[si] - 2.0 * eta
-        };
-        let ns = slaves.len();
-        // One pass: each fixed chunk of slaves collects its candidates, the chunks are
-        // then joined in order.
-        self.margin.resize(ns, 0.0);
-        let chunks: Vec<(Vec<u32>, Vec<u32>)> = self
-            .margin
-            .par_chunks_mut(SLAVE_CHUNK)
-            .enumerate()
-            .map(|(ci, ms)| {
+        let ns = self.slaves.len();
+        // One pass: each fixed chunk of slaves collects its candidates and margins, the
+        // chunks are then joined in order.
+        let chunks: Vec<(Vec<u32>, Vec<u32>, Vec<f64>)> = (0..ns.div_ceil(SLAVE_CHUNK))
+            .into_par_iter()
+            .map(|ci| {
                 let c0 = ci * SLAVE_CHUNK;
-                let mut counts = Vec::with_capacity(ms.len());
+                let n = SLAVE_CHUNK.min(ns - c0);
+                let mut counts = Vec::with_capacity(n);
+                let mut margins = Vec::with_capacity(n);
                 let mut list = Vec::new();
-                for (j, m) in ms.iter_mut().enumerate() {
+                for si in c0..c0 + n {
                     let before = list.len();
-                    *m = candidates(c0 + j, &mut list);
+                    margins.push(lister.candidates(si, &mut list));
                     counts.push((list.len() - before) as u32);
                 }
-                (counts, list)
+                (counts, list, margins)
             })
             .collect();
-        // The chunks' offsets, then each chunk writes its own slices of the lists and of
-        // the pointers, in parallel.
+        // The chunks' offsets, then each chunk writes its own slices of the list, the
+        // ranges and the margins, in parallel.
         let mut offsets = Vec::with_capacity(chunks.len());
         let mut total = 0u32;
-        for (_, list) in &chunks {
+        for (_, list, _) in &chunks {
             offsets.push(total);
             total += list.len() as u32;
         }
-        let mut ptr = vec![0u32; ns + 1];
+        let mut at = vec![[0u32; 3]; ns];
+        let mut margin = vec![0.0f64; ns];
         let mut cand = vec![0u32; total as usize];
-        let (mut ptr_rest, mut cand_rest) = (&mut ptr[1..], &mut cand[..]);
+        let mut cand_rest = &mut cand[..];
         let mut jobs = Vec::with_capacity(chunks.len());
-        for ((counts, list), &o) in chunks.iter().zip(&offsets) {
-            let (p, pt) = std::mem::take(&mut ptr_rest).split_at_mut(counts.len());
+        for (((counts, list, ms), &o), (a, m)) in chunks.iter().zip(&offsets).zip(
+            at.chunks_mut(SLAVE_CHUNK)
+                .zip(margin.chunks_mut(SLAVE_CHUNK)),
+        ) {
             let (c, ct) = std::mem::take(&mut cand_rest).split_at_mut(list.len());
-            (ptr_rest, cand_rest) = (pt, ct);
-            jobs.push((counts, list, o, p, c));
+            cand_rest = ct;
+            jobs.push((counts, list, ms, o, c, a, m));
         }
-        jobs.into_par_iter().for_each(|(counts, list, o, p, c)| {
-            c.copy_from_slice(list);
-            let mut run = o;
-            for (q, &n) in p.iter_mut().zip(counts) {
-                run += n;
-                *q = run;
-            }
-        });
-        self.cand_ptr = ptr;
-        self.cand = cand;
+        jobs.into_par_iter()
+            .for_each(|(counts, list, ms, o, c, a, m)| {
+                c.copy_from_slice(list);
+                let mut run = o;
+                for ((q, &n), (mq, &mv)) in a.iter_mut().zip(counts).zip(m.iter_mut().zip(ms)) {
+                    *q = [0, run, run + n];
+                    run += n;
+                    *mq = mv;
+                }
+            });
+        self.cand_at = at;
+        self.margin = margin;
+        self.lists.clear();
+        self.lists.push(cand);
+    }
+
+    /// One tile's broad phase: the candidates, among the faces `set` (live, ascending),
+    /// of the slaves `slaves` (indices, ascending) at `x`, whose face boxes and envelope
+    /// directions are up to date for `set`. Serial: the tiles are built in parallel.
+    pub(super) fn build_tile(
+        &self,
+        x: &[[f64; 3]],
+        skin: f64,
+        set: &[u32],
+        slaves: &[u32],
+    ) -> TileLists {
+        let r = self.build_reach(skin);
+        let grid = self.grid_over(r, Some(set));
+        let lister = Lister {
+            grid: &grid,
+            to_face: Some(set),
+            r,
+            x,
+            side: self,
+        };
+        let mut out = TileLists {
+            cand: Vec::new(),
+            slaves: Vec::with_capacity(slaves.len()),
+        };
+        for &si in slaves {
+            let a = out.cand.len() as u32;
+            let m = lister.candidates(si as usize, &mut out.cand);
+            out.slaves.push((si, a, out.cand.len() as u32, m));
+        }
+        out
     }
 
     /// After a build at `x`: each slave's cell of the staleness test (`cell`).

@@ -92,6 +92,7 @@ pub mod kernels;
 pub mod narrow;
 pub mod side;
 pub mod solid;
+pub mod tiled;
 
 use rayon::prelude::*;
 
@@ -104,6 +105,86 @@ use crate::model::{ElementKind, Model};
 pub use kernels::{pair_force, thickness_gradient, Friction, SlaveState, MAX_THICKNESS_GRADIENT};
 use side::{part_nodes, ChunkSums};
 pub use side::{PairOut, Reaction, Side};
+use tiled::TileSearch;
+pub use tiled::TileStats;
+
+/// How the broad phase finds each slave's candidate faces. Both give the same bits in
+/// every result (see [`tiled`]); they differ in what they rebuild.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Search {
+    /// One set of lists for all slaves, rebuilt whole when the staleness test
+    /// ([`super::staleness`]) finds any region stale: the default (the faster on every
+    /// model measured, see [`tiled::TILE_CELLS`]).
+    #[default]
+    Global,
+    /// Lists per tile of cells, each rebuilt when its own test finds it stale
+    /// ([`tiled`]).
+    Tiles,
+}
+
+/// The search a run's contact uses, and whether it checks itself against the global one
+/// at every step ([`SurfaceContact::oracle`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SearchChoice {
+    pub search: Search,
+    pub oracle: bool,
+    /// The tiles' size in cells and the binning's hysteresis in skins (defaults
+    /// [`tiled::TILE_CELLS`], [`tiled::TILE_U_PER_SKIN`]; tests take small ones, so that
+    /// small models have many tiles and nodes that change cell).
+    pub tile_cells: usize,
+    pub tile_u_per_skin: f64,
+}
+
+impl SearchChoice {
+    /// `search`, without the oracle, the tiles at their defaults.
+    pub fn new(search: Search) -> SearchChoice {
+        SearchChoice {
+            search,
+            oracle: false,
+            tile_cells: tiled::TILE_CELLS,
+            tile_u_per_skin: tiled::TILE_U_PER_SKIN,
+        }
+    }
+}
+
+thread_local! {
+    static CHOICE: std::cell::Cell<Option<SearchChoice>> = const { std::cell::Cell::new(None) };
+}
+
+/// Runs `f` with the contacts it creates on this thread using `choice` (tests and
+/// benchmarks; inside a thread pool's `install`, so that the solver is created on the
+/// thread that set it).
+pub fn with_search<T>(choice: SearchChoice, f: impl FnOnce() -> T) -> T {
+    let old = CHOICE.with(|c| c.replace(Some(choice)));
+    let r = f();
+    CHOICE.with(|c| c.set(old));
+    r
+}
+
+/// The search of a new contact: [`with_search`]'s on this thread, else the environment's
+/// `WEFT_CONTACT_SEARCH` (`global` or `tiles`; the same results, for timing one against
+/// the other) and `WEFT_CONTACT_ORACLE=1`, else the global search without the oracle.
+pub fn chosen_search() -> SearchChoice {
+    if let Some(c) = CHOICE.with(|c| c.get()) {
+        return c;
+    }
+    let search = match std::env::var("WEFT_CONTACT_SEARCH").as_deref() {
+        Ok("global") | Err(_) => Search::Global,
+        Ok("tiles") => Search::Tiles,
+        Ok(other) => {
+            eprintln!(
+                "warning: WEFT_CONTACT_SEARCH=`{other}` is neither `global` nor `tiles`; \
+                 using `global`"
+            );
+            Search::Global
+        }
+    };
+    let oracle = std::env::var("WEFT_CONTACT_ORACLE").is_ok_and(|v| v == "1");
+    SearchChoice {
+        oracle,
+        ..SearchChoice::new(search)
+    }
+}
 
 /// A recorded initial penetration.
 #[derive(Debug, Clone)]
@@ -150,8 +231,12 @@ pub struct ContactReport {
     /// Slave-steps skipped whole: the slave was farther from every candidate at the
     /// build than its neighbourhood's nodes have since moved apart (see `Side::margin`).
     pub skipped: u64,
-    /// What the stale tests that triggered the builds (after the setup's) found.
+    /// What the stale tests that triggered the builds (after the setup's) found (the
+    /// global search).
     pub triggers: TriggerStats,
+    /// The search used, and what the tiled search rebuilt (None: the global search).
+    pub search: Option<Search>,
+    pub tiles: Option<TileStats>,
 }
 
 /// Over the stale tests that triggered a build: how local the staleness was, the gate of
@@ -276,8 +361,19 @@ pub struct SurfaceContact {
     /// Nodes that take part (slaves and face nodes), sorted.
     nodes: Vec<u32>,
     /// Their positions at the last broad phase, and the test of when the candidate lists
-    /// go stale.
+    /// go stale (the global search).
     motion: Staleness,
+    /// The search ([`chosen_search`] at creation), and the tiled search's state (from
+    /// [`SurfaceContact::start`]).
+    pub search: Search,
+    tile_cells: usize,
+    tile_u_per_skin: f64,
+    tiles: Option<Box<TileSearch>>,
+    /// Check every step's results against the global search's, and stop on a
+    /// difference (tests: the tiled search must find the same pairs and the same bits).
+    pub oracle: bool,
+    /// Force evaluations so far (the oracle names the step of a difference).
+    evaluations: u64,
     /// Whether the narrow phase skips the slaves that no candidate can reach yet (see
     /// `Side::margin`; on by default, the same results either way).
     pub skip_far: bool,
@@ -346,10 +442,15 @@ impl SurfaceContact {
             0.0
         };
         let kappa_max = sides.iter().map(|s| s.kappa).fold(0.0, f64::max);
+        let choice = chosen_search();
         SurfaceContact {
             sides,
             nodes,
             motion: Staleness::new(skin),
+            search: choice.search,
+            oracle: choice.oracle,
+            tile_cells: choice.tile_cells,
+            tile_u_per_skin: choice.tile_u_per_skin,
             skip_far: true,
             skin,
             kappa_max,
@@ -491,6 +592,40 @@ impl SurfaceContact {
         self.motion.stale(x)
     }
 
+    /// Per cell, |S| of the skip test at this step (of the tiles' grid or the staleness
+    /// test's).
+    fn spread(&self) -> &[f64] {
+        match self.tiles.as_ref() {
+            Some(t) => t.spread(),
+            None => self.motion.spread(),
+        }
+    }
+
+    /// The oracle ([`SurfaceContact::oracle`]): the sides as they were before this
+    /// step's narrow phase (`before`) get fresh global lists at `x` and a narrow phase
+    /// that skips no slave; every slave's contact, state and reaction shares, and every
+    /// chunk's energies and penetrated count, must be the same bits as this step's.
+    fn check_oracle(
+        &self,
+        before: Vec<Side>,
+        x: &[[f64; 3]],
+        v: &[[f64; 3]],
+        dt: f64,
+        dt_prev: f64,
+    ) {
+        for (k, mut r) in before.into_iter().enumerate() {
+            r.build(x, self.skin);
+            r.narrow(x, v, dt, dt_prev, false, None);
+            if let Err(e) = same_results(&self.sides[k], &r) {
+                panic!(
+                    "contact oracle: the {:?} search differs from the global one at force \
+                     evaluation {}, contact {} (side {k}): {e}",
+                    self.search, self.evaluations, self.sides[k].contact_id
+                );
+            }
+        }
+    }
+
     /// Books what the stale test that has just triggered a build found: which cells went
     /// stale, and the slaves of the tiles around them (measured on the slaves' cells of
     /// the last build, before the build replaces them).
@@ -522,7 +657,21 @@ impl SurfaceContact {
         for s in &mut self.sides {
             s.update_boxes(x);
         }
-        self.rebuild(x);
+        if self.search == Search::Tiles {
+            let mut t = TileSearch::new(
+                &self.sides,
+                &self.nodes,
+                x,
+                self.skin,
+                (self.tile_cells, self.tile_u_per_skin),
+            );
+            t.check(&self.sides, x);
+            t.rebuild(&mut self.sides, x);
+            self.tiles = Some(Box::new(t));
+            self.builds += 1;
+        } else {
+            self.rebuild(x);
+        }
         let zero = vec![[0.0; 3]; m.num_nodes()];
         for s in &mut self.sides {
             s.narrow(x, &zero, 1.0, 0.0, true, None);
@@ -577,24 +726,42 @@ impl SurfaceContact {
             s.update_boxes(x);
         }
         let t_boxes = std::time::Instant::now();
-        let stale = self.stale(x);
-        if stale {
+        let stale = match self.tiles.as_mut() {
+            Some(t) => t.check(&self.sides, x) > 0,
+            None => self.stale(x),
+        };
+        if stale && self.tiles.is_none() {
             self.record_trigger();
         }
         let t_stale = std::time::Instant::now();
         if stale {
-            self.rebuild(x);
+            match self.tiles.as_mut() {
+                Some(t) => {
+                    t.rebuild(&mut self.sides, x);
+                    self.builds += 1;
+                }
+                None => self.rebuild(x),
+            }
         }
         let t1 = std::time::Instant::now();
         self.build_time += t1 - t0;
+        self.evaluations += 1;
         let mut stored = 0.0;
         let probed = if self.sides.iter().any(|s| !s.pending.is_empty()) {
-            let sp = self.skip_far.then(|| self.motion.spread().to_vec());
+            let sp = self.skip_far.then(|| self.spread().to_vec());
             Some(self.probe_erosion(x, v, dt, dt_prev, sp.as_deref()))
         } else {
             None
         };
-        let spread = self.skip_far.then(|| self.motion.spread());
+        let before = self.oracle.then(|| self.sides.clone());
+        let spread = if self.skip_far {
+            Some(match self.tiles.as_ref() {
+                Some(t) => t.spread(),
+                None => self.motion.spread(),
+            })
+        } else {
+            None
+        };
         for s in &mut self.sides {
             s.narrow(x, v, dt, dt_prev, false, spread);
             // Sums in chunk order: bit-identical for any thread count.
@@ -616,6 +783,9 @@ impl SurfaceContact {
                 }
             }
         }
+        if let Some(before) = before {
+            self.check_oracle(before, x, v, dt, dt_prev);
+        }
         if let Some(with) = probed {
             self.book_erosion(&with, v, dt_prev);
         }
@@ -631,6 +801,11 @@ impl SurfaceContact {
         self.stored = stored;
         self.phases.scatter += t_narrow.elapsed().as_secs_f64();
         self.narrow_time += t1.elapsed();
+    }
+
+    /// What the tiled search did (None: the global search).
+    pub fn tile_stats(&self) -> Option<TileStats> {
+        self.tiles.as_ref().map(|t| t.stats)
     }
 
     /// A summary for reports.
@@ -663,6 +838,8 @@ impl SurfaceContact {
             evaluated: self.counts.evaluated,
             penetrated: self.counts.penetrated,
             triggers: self.triggers,
+            search: (!self.sides.is_empty()).then_some(self.search),
+            tiles: self.tile_stats(),
         }
     }
 
@@ -673,4 +850,73 @@ impl SurfaceContact {
             .map(|s| s.chunk_active.iter().map(|a| a.len()).sum::<usize>())
             .sum()
     }
+}
+
+/// Whether two narrow phases of a side gave the same bits (the oracle): the slaves in
+/// contact, their results, every slave's state, the reaction shares, and the chunks'
+/// energies and penetrated counts.
+fn same_results(a: &Side, b: &Side) -> std::result::Result<(), String> {
+    let node = |si: u32| a.slaves[si as usize];
+    if a.chunk_active != b.chunk_active {
+        let (x, y): (Vec<u32>, Vec<u32>) = (
+            a.chunk_active.iter().flatten().copied().collect(),
+            b.chunk_active.iter().flatten().copied().collect(),
+        );
+        let only_a: Vec<u32> = x
+            .iter()
+            .filter(|s| !y.contains(s))
+            .map(|&s| node(s))
+            .collect();
+        let only_b: Vec<u32> = y
+            .iter()
+            .filter(|s| !x.contains(s))
+            .map(|&s| node(s))
+            .collect();
+        return Err(format!(
+            "slaves in contact differ: only here nodes {only_a:?}, only in the global search {only_b:?}"
+        ));
+    }
+    let bits = |v: &[f64]| v.iter().map(|f| f.to_bits()).collect::<Vec<_>>();
+    for &si in a.chunk_active.iter().flatten() {
+        let (p, q) = (&a.out[si as usize], &b.out[si as usize]);
+        let pv = [p.f[0], p.f[1], p.f[2], p.stored, p.dissipated, p.g];
+        let qv = [q.f[0], q.f[1], q.f[2], q.stored, q.dissipated, q.g];
+        if p.face != q.face || bits(&pv) != bits(&qv) {
+            return Err(format!(
+                "node {}: {p:?} against the global search's {q:?}",
+                node(si)
+            ));
+        }
+    }
+    for (si, (p, q)) in a.state.iter().zip(&b.state).enumerate() {
+        let pv = [p.ft[0], p.ft[1], p.ft[2], p.k, p.g0];
+        let qv = [q.ft[0], q.ft[1], q.ft[2], q.k, q.g0];
+        if bits(&pv) != bits(&qv) || a.held[si] != b.held[si] {
+            return Err(format!(
+                "node {}: state {p:?} against the global search's {q:?}",
+                node(si as u32)
+            ));
+        }
+    }
+    for (ra, rb) in a.chunk_reactions.iter().zip(&b.chunk_reactions) {
+        let same = ra.len() == rb.len()
+            && ra
+                .iter()
+                .zip(rb)
+                .all(|(p, q)| p.slave == q.slave && p.face == q.face && bits(&p.w) == bits(&q.w));
+        if !same {
+            return Err("reaction shares differ".into());
+        }
+    }
+    for (ci, (p, q)) in a.chunk_sums.iter().zip(&b.chunk_sums).enumerate() {
+        if p.stored.to_bits() != q.stored.to_bits()
+            || p.dissipated.to_bits() != q.dissipated.to_bits()
+            || p.penetrated != q.penetrated
+        {
+            return Err(format!(
+                "chunk {ci}: {p:?} against the global search's {q:?}"
+            ));
+        }
+    }
+    Ok(())
 }

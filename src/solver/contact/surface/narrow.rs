@@ -266,8 +266,8 @@ struct Narrow<'a> {
     slaves: &'a [u32],
     slave_t: &'a [f64],
     slave_m: &'a [f64],
-    cand_ptr: &'a [u32],
-    cand: &'a [u32],
+    cand_at: &'a [[u32; 3]],
+    lists: &'a [Vec<u32>],
     fr: Friction,
     kappa: f64,
     zeta: f64,
@@ -348,8 +348,8 @@ impl Side {
             slaves: &self.slaves,
             slave_t: &self.slave_t,
             slave_m: &self.slave_m,
-            cand_ptr: &self.cand_ptr,
-            cand: &self.cand,
+            cand_at: &self.cand_at,
+            lists: &self.lists,
             fr: self.friction,
             kappa: self.kappa,
             zeta: self.damping,
@@ -553,7 +553,8 @@ impl Narrow<'_> {
         // Only faces the node penetrates (g > 0) matter: a node whose best g is
         // ≤ 0 is open whether or not some face was evaluated, and a tracked initial
         // penetration g₀ then drops to 0 either way.
-        let list = &self.cand[self.cand_ptr[si] as usize..self.cand_ptr[si + 1] as usize];
+        let [l, a, b] = self.cand_at[si];
+        let list = &self.lists[l as usize][a as usize..b as usize];
         sums.tested += list.len() as u64;
         for block in list.chunks(32) {
             let nn = filter_block::<NF>(

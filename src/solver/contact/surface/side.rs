@@ -110,9 +110,11 @@ pub struct Side {
     pub(super) slave_t_max: f64,
     /// Round-off allowance η of the thickness-box tests [m] (see [`BOX_MARGIN`]).
     pub(super) box_margin: f64,
-    /// Candidates per slave (CSR), from the last broad phase.
-    pub(super) cand_ptr: Vec<u32>,
-    pub(super) cand: Vec<u32>,
+    /// Candidate lists from the last broad phase: per slave, (list, first, end) into
+    /// `lists` (one list per tile of the tiled search, each rebuilt alone; one for all
+    /// slaves in the global search), each slave's candidates ascending.
+    pub(super) cand_at: Vec<[u32; 3]>,
+    pub(super) lists: Vec<Vec<u32>>,
     /// Per slave, from the last broad phase: its margin [m] (+∞ without candidates), so
     /// that the narrow phase can skip a slave that no candidate can reach yet.
     ///
@@ -132,7 +134,9 @@ pub struct Side {
     /// times it as in the box test. Measured on the 60 × 60 woven quarter: 86 % of the
     /// slave-steps skipped to 10 µs, 43 % to 60 µs.
     pub(super) margin: Vec<f64>,
-    /// Per slave, its cell of the staleness test at the last build.
+    /// Per slave, its cell at the last build: of the staleness test in the global
+    /// search, of the tiles' grid in the tiled one (the narrow phase reads its spread
+    /// |S| there).
     pub(super) slave_cell: Vec<u32>,
     /// The faces' thickness boxes at the current step (lo, hi) [m], and their envelope
     /// bounds h₊, h₋ along `face_dir` (see [`Side::set_directions`]).
@@ -418,8 +422,8 @@ impl Side {
             reach: 0.5 * (ts_max + tf_max),
             slave_t_max: ts_max,
             box_margin: BOX_MARGIN * (x_max + 0.5 * (ts_max + tf_box)),
-            cand_ptr: vec![],
-            cand: vec![],
+            cand_at: vec![],
+            lists: vec![],
             margin: vec![],
             slave_cell: vec![],
             // Before the first broad phase there are no directions yet: zero ones never
@@ -528,6 +532,11 @@ impl Side {
     /// its thickest node). Any unit direction gives a sound bound, so they are refreshed
     /// only here, while the bounds follow the nodes every step.
     pub(super) fn set_directions(&mut self, x: &[[f64; 3]]) {
+        self.set_directions_of(x, None);
+    }
+
+    /// [`Side::set_directions`] for the faces `mask` marks (None: all).
+    pub(super) fn set_directions_of(&mut self, x: &[[f64; 3]], mask: Option<&[bool]>) {
         let (faces, face_t, nf) = (&self.faces, &self.face_t, self.nf);
         if nf < 3 {
             return;
@@ -541,7 +550,7 @@ impl Side {
             .for_each(|(c, (ds, bs))| {
                 for (j, (d, b)) in ds.iter_mut().zip(bs.iter_mut()).enumerate() {
                     let fi = c * 4096 + j;
-                    if any_dead && !alive[fi] {
+                    if (any_dead && !alive[fi]) || mask.is_some_and(|m| !m[fi]) {
                         continue;
                     }
                     *d = envelope_directions(&faces[fi], &face_t[fi], nf, x);

@@ -1,0 +1,122 @@
+//! The tiled contact search (`solver::contact::surface::tiled`, issue 39 step 3) against
+//! the global one, on the solver's own trajectories.
+//!
+//! Independent reasoning: both searches are exact (each slave's list holds every face it
+//! can penetrate, in ascending order, and a slave is skipped only when no candidate can
+//! pass the filters), so every force, energy and state must be the same bits; a missed
+//! or a spurious pair, or a changed order, shows as a difference. Two checks:
+//! - the oracle (`SurfaceContact::oracle`): at every force evaluation of the tiled run,
+//!   the sides as they were before its narrow phase get fresh global lists at the same
+//!   positions and a narrow phase that skips nothing, and every slave's contact, state
+//!   and reaction shares, and every chunk's energies and penetrated count, must equal
+//!   the tiled run's bit for bit (it panics, naming the step and the node, otherwise);
+//! - whole runs: the tiled run's displacements, energies and projectile on 1 and 3
+//!   threads equal the global search's on 1 thread.
+//!
+//! Models: a band patch, a chain patch, two chain layers (contact between the layers),
+//! a chain patch whose yarns fail and are perforated (erosion, the deepest-face law, the
+//! erosion probe), and a chain patch struck by a deformable bullet (a solid's boundary
+//! faces as the master surface).
+
+use weft::generate::bullet::BulletParams;
+use weft::generate::woven::{woven, WovenBandParams, YarnFailure, YarnModel};
+use weft::model::Model;
+use weft::solver::contact::surface::{with_search, ContactReport, Search, SearchChoice};
+use weft::solver::run_in_memory;
+
+/// What a run gives, printed exactly (`{:?}` of an f64 round-trips, so equal strings are
+/// equal bits), and its contact report.
+fn run(m: &Model, threads: usize, search: Search, oracle: bool) -> (String, ContactReport) {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap()
+        .install(|| {
+            // Tiles of one cell and a hysteresis of one skin: many tiles and many changes
+            // of cell on these small models.
+            let choice = SearchChoice {
+                oracle,
+                tile_cells: 1,
+                tile_u_per_skin: 1.0,
+                ..SearchChoice::new(search)
+            };
+            with_search(choice, || {
+                let (s, out, _) = run_in_memory(m).unwrap();
+                let rep = s.op.surfaces.report(&s.node_id);
+                let text = format!(
+                    "{:?}\n{:?}\n{:?}\n{:?}",
+                    out.u, out.energy, out.projectile, out.layers
+                );
+                (text, rep)
+            })
+        })
+}
+
+fn params(yarns: usize, model: YarnModel, end_time: f64) -> WovenBandParams {
+    WovenBandParams {
+        yarns,
+        yarn_model: model,
+        end_time,
+        output_interval: end_time / 10.0,
+        ..WovenBandParams::default()
+    }
+}
+
+fn failing() -> YarnFailure {
+    YarnFailure {
+        strain: 0.036,
+        ..YarnFailure::default()
+    }
+}
+
+#[test]
+fn the_tiled_search_finds_the_global_searchs_pairs_and_bits() {
+    let bands = params(10, YarnModel::Band, 8e-6);
+    let chains = params(14, YarnModel::Chain, 1.5e-5);
+    let layers = WovenBandParams {
+        layers: 2,
+        ..params(8, YarnModel::Chain, 1e-5)
+    };
+    let perforated = WovenBandParams {
+        failure: failing(),
+        projectile_velocity: 400.0,
+        ..params(8, YarnModel::Chain, 2e-5)
+    };
+    let bullet = WovenBandParams {
+        failure: failing(),
+        bullet: Some(BulletParams::default()),
+        ..params(8, YarnModel::Chain, 6e-6)
+    };
+    for (name, p) in [
+        ("bands", bands),
+        ("chains", chains),
+        ("two layers", layers),
+        ("perforated", perforated),
+        ("bullet", bullet),
+    ] {
+        let (m, _) = woven(&p).unwrap();
+        let (want, global) = run(&m, 1, Search::Global, false);
+        for threads in [1, 3] {
+            let (got, tiled) = run(&m, threads, Search::Tiles, true);
+            let t = tiled.tiles.expect("the tiled search's statistics");
+            println!(
+                "{name}, {threads} thread(s): {} global builds; {} tiles, {} tile builds at {} steps ({} by a change of cell), {} penetrated",
+                global.builds, t.tiles, t.tile_builds, t.steps_with_builds, t.marked, tiled.penetrated
+            );
+            assert!(got == want, "{name}, {threads} threads: the runs differ");
+            assert_eq!(
+                tiled.penetrated, global.penetrated,
+                "{name}: pairs penetrated"
+            );
+            assert_eq!(
+                tiled.friction_work.to_bits(),
+                global.friction_work.to_bits()
+            );
+            // The tiled search rebuilt tiles after the setup, and not all at once.
+            assert!(
+                t.tile_builds > t.tiles as u64,
+                "{name}: no tile rebuilt after the setup"
+            );
+        }
+    }
+}
