@@ -11,7 +11,10 @@
 //!   and reaction shares, and every chunk's energies and penetrated count, must equal
 //!   the tiled run's bit for bit (it panics, naming the step and the node, otherwise);
 //! - whole runs: the tiled run's displacements, energies and projectile on 1 and 3
-//!   threads equal the global search's on 1 thread.
+//!   threads equal the global search's on 1 thread. The oracle's run computes every
+//!   face's thickness box at every step; the global run, at the steps where a side's
+//!   last narrow phase skipped most of its slaves, only the boxes its narrow phase can
+//!   read (`Side::update_needed_boxes`): the equality checks that too.
 //!
 //! Models: a band patch, a chain patch, two chain layers (contact between the layers),
 //! a chain patch whose yarns fail and are perforated (erosion, the deepest-face law, the
@@ -100,8 +103,8 @@ fn the_tiled_search_finds_the_global_searchs_pairs_and_bits() {
             let (got, tiled) = run(&m, threads, Search::Tiles, true);
             let t = tiled.tiles.expect("the tiled search's statistics");
             println!(
-                "{name}, {threads} thread(s): {} global builds; {} tiles, {} tile builds at {} steps ({} by a change of cell), {} penetrated",
-                global.builds, t.tiles, t.tile_builds, t.steps_with_builds, t.marked, tiled.penetrated
+                "{name}, {threads} thread(s): {} global builds, {} side-steps with only the needed boxes; {} tiles, {} tile builds at {} steps ({} by a change of cell), {} penetrated",
+                global.builds, global.lazy_boxes, t.tiles, t.tile_builds, t.steps_with_builds, t.marked, tiled.penetrated
             );
             assert!(got == want, "{name}, {threads} threads: the runs differ");
             assert_eq!(
@@ -111,6 +114,12 @@ fn the_tiled_search_finds_the_global_searchs_pairs_and_bits() {
             assert_eq!(
                 tiled.friction_work.to_bits(),
                 global.friction_work.to_bits()
+            );
+            // The global run computed only the needed boxes at some steps (the tiled run
+            // with the oracle computes every box): the two agree.
+            assert!(
+                name != "two layers" || global.lazy_boxes > 0,
+                "{name}: no step with only the needed boxes"
             );
             // The tiled search rebuilt tiles after the setup, and not all at once.
             assert!(

@@ -70,6 +70,10 @@ struct Cli {
     /// `weft-weave woven --yarn-model`).
     #[arg(long, value_enum, default_value_t = weft::generate::woven::YarnModel::Band)]
     woven_yarn_model: weft::generate::woven::YarnModel,
+    /// Layers of the woven benchmark's patch (`weft-weave woven --layers`): each layer's
+    /// warp against its weft, and each pair of adjacent layers, in contact.
+    #[arg(long, default_value_t = 1)]
+    woven_layers: usize,
     /// Sweep sizes for the pipeline benchmark.
     #[arg(long, num_args = 1.., value_delimiter = ',', default_values_t = vec![1000usize, 10_000])]
     instances: Vec<usize>,
@@ -297,6 +301,7 @@ fn bench_woven(
     yarns: usize,
     end_time: f64,
     yarn_model: weft::generate::woven::YarnModel,
+    layers: usize,
     threads: &[usize],
 ) -> anyhow::Result<()> {
     use weft::generate::woven::{woven, WovenBandParams, YarnModel};
@@ -308,6 +313,7 @@ fn bench_woven(
         yarns,
         end_time,
         yarn_model,
+        layers,
         output_interval: end_time / 20.0,
         ..WovenBandParams::default()
     };
@@ -340,7 +346,7 @@ fn bench_woven(
             rep.builds
         );
         eprintln!(
-            "  woven {yarns}×{yarns} quarter ({model}s), {t} thread(s): {} elements, {} nodes, {steps} steps of {:.3e} s in {wall:.1} s: {cycles:.3e} element-cycles/s; contact {c:.1} s ({:.0} %: broad phase {:.1} s in {} builds, narrow {:.1} s); finished: {done}",
+            "  woven {yarns}×{yarns} quarter ({model}s, {layers} layer(s)), {t} thread(s): {} elements, {} nodes, {steps} steps of {:.3e} s in {wall:.1} s: {cycles:.3e} element-cycles/s; contact {c:.1} s ({:.0} %: broad phase {:.1} s in {} builds, narrow {:.1} s); finished: {done}",
             m.num_elements(),
             m.num_nodes(),
             s.stable.dt,
@@ -472,6 +478,7 @@ fn main() -> anyhow::Result<()> {
             cli.woven_yarns,
             cli.woven_end_time,
             cli.woven_yarn_model,
+            cli.woven_layers,
             &cli.threads,
         );
     }

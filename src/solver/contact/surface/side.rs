@@ -3,6 +3,8 @@
 //! envelope directions (updated here), the candidate lists of the last broad phase, and
 //! the slaves' history and results ([`PairOut`], [`Reaction`], `ChunkSums`).
 
+use std::sync::atomic::{AtomicU32, Ordering::Relaxed};
+
 use rayon::prelude::*;
 
 use super::kernels::{bbox, envelope_directions, thickness_box, Friction, SlaveState};
@@ -160,6 +162,24 @@ pub struct Side {
     /// ... and, on more than one thread, its forces on the nodes by node block, for the
     /// parallel gather (`super::gather`).
     pub(super) chunk_contribs: Vec<ChunkContribs>,
+    /// Per face, the force evaluation whose narrow phase last needed its box
+    /// ([`Side::update_needed_boxes`]).
+    pub(super) box_stamp: Stamps,
+}
+
+/// Stamps written in parallel (each slot by whoever needs it, all with the same value).
+#[derive(Debug, Default)]
+pub(super) struct Stamps(pub(super) Vec<AtomicU32>);
+
+impl Clone for Stamps {
+    fn clone(&self) -> Stamps {
+        Stamps(
+            self.0
+                .iter()
+                .map(|a| AtomicU32::new(a.load(Relaxed)))
+                .collect(),
+        )
+    }
 }
 
 /// What one chunk of slaves adds up in a narrow phase: the stored energy and the friction
@@ -434,6 +454,7 @@ impl Side {
             chunk_reactions: vec![],
             chunk_sums: vec![],
             chunk_contribs: vec![],
+            box_stamp: Stamps((0..n_faces).map(|_| AtomicU32::new(0)).collect()),
         }
     }
 
@@ -454,14 +475,23 @@ impl Side {
     /// the narrow phase then reads one box instead of gathering its face's nodes; measured:
     /// those gathers were ~40 % of the narrow phase of the woven patch).
     pub(super) fn update_boxes(&mut self, x: &[[f64; 3]]) {
+        self.update_boxes_of(x, None);
+    }
+
+    /// [`Side::update_boxes`] for the faces stamped with `stamp` only (None: every face).
+    fn update_boxes_of(&mut self, x: &[[f64; 3]], stamp: Option<u32>) {
         let (faces, face_t, nf) = (&self.faces, &self.face_t, self.nf);
         let (dirs, alive, any_dead) = (&self.face_dir, &self.face_alive, self.dead_faces > 0);
+        let stamps = &self.box_stamp.0;
         self.face_box
             .par_chunks_mut(4096)
             .enumerate()
             .for_each(|(c, bs)| {
                 for (j, b) in bs.iter_mut().enumerate() {
                     let fi = c * 4096 + j;
+                    if stamp.is_some_and(|e| stamps[fi].load(Relaxed) != e) {
+                        continue;
+                    }
                     *b = if any_dead && !alive[fi] {
                         DEAD_BOX
                     } else {
@@ -469,6 +499,35 @@ impl Side {
                     };
                 }
             });
+    }
+
+    /// The thickness boxes at `x` of the faces that this step's narrow phase can read:
+    /// the candidates of the slaves it does not skip (with the spreads `spread` of the
+    /// skip test, as `Side::narrow` decides). The others keep older boxes, which nothing
+    /// reads before the next build computes every box again. `epoch`: this force
+    /// evaluation's number (> 0), stamped on the faces it needs. Measured on the
+    /// four-layer chain patch, 60 × 60 to 30 µs, where 91 % of the slave-steps are
+    /// skipped: the boxes took 10.3 of its 40.7 s, 5.5 s of 33.6 s this way.
+    pub(super) fn update_needed_boxes(&mut self, x: &[[f64; 3]], spread: &[f64], epoch: u32) {
+        let stamps = &self.box_stamp.0;
+        let (margin, cell) = (&self.margin, &self.slave_cell);
+        let (cand_at, lists) = (&self.cand_at, &self.lists);
+        (0..self.slaves.len().div_ceil(SLAVE_CHUNK))
+            .into_par_iter()
+            .for_each(|ci| {
+                let s0 = ci * SLAVE_CHUNK;
+                let s1 = (s0 + SLAVE_CHUNK).min(margin.len());
+                for si in s0..s1 {
+                    if margin[si] > spread[cell[si] as usize] {
+                        continue;
+                    }
+                    let [l, a, b] = cand_at[si];
+                    for &fi in &lists[l as usize][a as usize..b as usize] {
+                        stamps[fi as usize].store(epoch, Relaxed);
+                    }
+                }
+            });
+        self.update_boxes_of(x, Some(epoch));
     }
 
     /// The faces of element `e` (of the master's kind) are to leave the surface (one, or
