@@ -30,6 +30,17 @@ use weft::solver::run_in_memory;
 /// What a run gives, printed exactly (`{:?}` of an f64 round-trips, so equal strings are
 /// equal bits), and its contact report.
 fn run(m: &Model, threads: usize, search: Search, oracle: bool) -> (String, ContactReport) {
+    run_with(m, threads, search, oracle, 2.0)
+}
+
+/// [`run`] with the tiles' width cap W + `slack` U (0: a re-grid whenever a box widens).
+fn run_with(
+    m: &Model,
+    threads: usize,
+    search: Search,
+    oracle: bool,
+    slack: f64,
+) -> (String, ContactReport) {
     rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
@@ -41,6 +52,7 @@ fn run(m: &Model, threads: usize, search: Search, oracle: bool) -> (String, Cont
                 oracle,
                 tile_cells: 1,
                 tile_u_per_skin: 1.0,
+                tile_width_slack: slack,
                 ..SearchChoice::new(search)
             };
             with_search(choice, || {
@@ -128,4 +140,23 @@ fn the_tiled_search_finds_the_global_searchs_pairs_and_bits() {
             );
         }
     }
+}
+
+/// The tiled search's re-grid (new cells when a face's box passes the width cap, every
+/// tile rebuilt) keeps the bits: with no slack in the cap the band patch re-grids
+/// whenever a box widens, and the run must still equal the global search's, under the
+/// oracle.
+#[test]
+fn a_regrid_keeps_the_global_searchs_bits() {
+    let (m, _) = woven(&params(10, YarnModel::Band, 4e-6)).unwrap();
+    let (want, _) = run(&m, 1, Search::Global, false);
+    let (got, tiled) = run_with(&m, 2, Search::Tiles, true, 0.0);
+    let t = tiled.tiles.expect("the tiled search's statistics");
+    println!("{} re-grids, {} tile builds", t.regrids, t.tile_builds);
+    assert!(
+        t.regrids > 3,
+        "the cap must be passed: {} re-grids",
+        t.regrids
+    );
+    assert!(got == want, "the runs differ");
 }

@@ -133,6 +133,9 @@ pub struct SearchChoice {
     /// small models have many tiles and nodes that change cell).
     pub tile_cells: usize,
     pub tile_u_per_skin: f64,
+    /// The tiles' width cap W_cap = W + `tile_width_slack` U, W the widest box at the
+    /// last grid (default 2; 0 in a test re-grids whenever a box widens).
+    pub tile_width_slack: f64,
 }
 
 impl SearchChoice {
@@ -143,6 +146,7 @@ impl SearchChoice {
             oracle: false,
             tile_cells: tiled::TILE_CELLS,
             tile_u_per_skin: tiled::TILE_U_PER_SKIN,
+            tile_width_slack: 2.0,
         }
     }
 }
@@ -379,6 +383,7 @@ pub struct SurfaceContact {
     pub search: Search,
     tile_cells: usize,
     tile_u_per_skin: f64,
+    tile_width_slack: f64,
     tiles: Option<Box<TileSearch>>,
     /// Check every step's results against the global search's, and stop on a
     /// difference (tests: the tiled search must find the same pairs and the same bits).
@@ -464,6 +469,7 @@ impl SurfaceContact {
             oracle: choice.oracle,
             tile_cells: choice.tile_cells,
             tile_u_per_skin: choice.tile_u_per_skin,
+            tile_width_slack: choice.tile_width_slack,
             skip_far: true,
             skin,
             kappa_max,
@@ -676,7 +682,7 @@ impl SurfaceContact {
                 &self.nodes,
                 x,
                 self.skin,
-                (self.tile_cells, self.tile_u_per_skin),
+                (self.tile_cells, self.tile_u_per_skin, self.tile_width_slack),
             );
             t.check(&self.sides, x);
             t.rebuild(&mut self.sides, x);

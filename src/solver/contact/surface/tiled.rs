@@ -82,8 +82,9 @@ pub struct TileSearch {
     /// The contact nodes (model indices, sorted).
     nodes: Vec<u32>,
     tiling: Tiling,
-    /// Cells per tile side.
+    /// Cells per tile side, and the width cap's slack in U (W_cap = W + slack U).
     cells: usize,
+    slack: f64,
     binning: Binning,
     /// The largest |x_d| at the last grid.
     x_abs: f64,
@@ -124,7 +125,7 @@ impl TileSearch {
         nodes: &[u32],
         x: &[[f64; 3]],
         skin: f64,
-        (cells, u_per_skin): (usize, f64),
+        (cells, u_per_skin, slack): (usize, f64, f64),
     ) -> TileSearch {
         let rho = sides
             .iter()
@@ -159,6 +160,7 @@ impl TileSearch {
             nodes: nodes.to_vec(),
             tiling: Tiling::new(grid, cells),
             cells,
+            slack,
             binning,
             x_abs: 0.0,
             index,
@@ -172,10 +174,10 @@ impl TileSearch {
         t
     }
 
-    /// New cells for the widest box `w` at `x` (the cap W_cap = w + 2U), every node
-    /// binned at x, every tile stale.
+    /// New cells for the widest box `w` at `x` (the cap W_cap = w + 2U by default), every
+    /// node binned at x, every tile stale.
     fn regrid(&mut self, x: &[[f64; 3]], w: f64) {
-        self.reach.w_cap = w + 2.0 * self.reach.u;
+        self.reach.w_cap = w + self.slack * self.reach.u;
         let grid = CellGrid::for_nodes(&self.nodes, x, &self.reach);
         self.binning = Binning::with_hysteresis(&grid, &self.nodes, x, self.reach.u);
         self.x_abs = self
