@@ -919,7 +919,7 @@ fn same_results(a: &Side, b: &Side) -> std::result::Result<(), String> {
             .map(|&s| node(s))
             .collect();
         return Err(format!(
-            "slaves in contact differ: only here nodes {only_a:?}, only in the global search {only_b:?}"
+            "slaves in contact differ: only here node indices {only_a:?}, only in the global search {only_b:?}"
         ));
     }
     let bits = |v: &[f64]| v.iter().map(|f| f.to_bits()).collect::<Vec<_>>();
@@ -929,7 +929,7 @@ fn same_results(a: &Side, b: &Side) -> std::result::Result<(), String> {
         let qv = [q.f[0], q.f[1], q.f[2], q.stored, q.dissipated, q.g];
         if p.face != q.face || bits(&pv) != bits(&qv) {
             return Err(format!(
-                "node {}: {p:?} against the global search's {q:?}",
+                "node index {}: {p:?} against the global search's {q:?}",
                 node(si)
             ));
         }
@@ -939,7 +939,7 @@ fn same_results(a: &Side, b: &Side) -> std::result::Result<(), String> {
         let qv = [q.ft[0], q.ft[1], q.ft[2], q.k, q.g0];
         if bits(&pv) != bits(&qv) || a.held[si] != b.held[si] {
             return Err(format!(
-                "node {}: state {p:?} against the global search's {q:?}",
+                "node index {}: state {p:?} against the global search's {q:?}",
                 node(si as u32)
             ));
         }

@@ -54,8 +54,9 @@ use crate::solver::contact::tiles::{Binning, CellGrid, FaceIndex, Reach, Tiling}
 pub const TILE_CELLS: usize = 3;
 pub const TILE_U_PER_SKIN: f64 = 4.0;
 
-/// A re-grid when a coordinate passes this multiple of the largest at the last grid:
-/// the cells' round-off allowance ([`Reach::cell_size`]) holds to about 1600.
+/// A re-grid when a coordinate passes this multiple of the largest at the last grid plus
+/// the cell size the lemma needs: the cells' round-off allowance ([`Reach::cell_size`])
+/// holds to about 1600.
 const X_ABS_LIMIT: f64 = 1000.0;
 
 /// What the tiled search did over a run.
@@ -199,7 +200,10 @@ impl TileSearch {
         let mut marked: Vec<u32> = Vec::new();
         if !regrid {
             let rb = self.binning.rebin(&self.tiling, x);
-            if rb.x_abs <= X_ABS_LIMIT * self.x_abs {
+            // (The allowance's scale is the coordinates at the grid plus the cell size the
+            // lemma needs, see `Reach::cell_size`.)
+            let need = self.reach.r() + self.reach.w_cap + 2.0 * self.reach.u;
+            if rb.x_abs <= X_ABS_LIMIT * (self.x_abs + need) {
                 self.tiling.mark_stale(&rb.crossing_tiles);
                 marked = rb.crossing_tiles;
             } else {
