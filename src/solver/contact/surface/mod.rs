@@ -94,8 +94,6 @@ pub mod side;
 pub mod solid;
 pub mod tiled;
 
-use rayon::prelude::*;
-
 pub use super::closest::{closest_on_face, closest_on_quad};
 use super::projectile::PENALTY_FACTOR;
 use super::staleness::Staleness;
@@ -587,16 +585,7 @@ impl SurfaceContact {
         let rho_w = self
             .sides
             .iter()
-            .map(|s| {
-                // (A maximum: exact in any order.)
-                let w = s
-                    .face_box
-                    .par_iter()
-                    .with_min_len(4096)
-                    .map(|b| (b[3] - b[0]).max(b[4] - b[1]).max(b[5] - b[2]))
-                    .reduce(|| 0.0, f64::max);
-                0.5 * s.slave_t_max + s.box_margin + w
-            })
+            .map(|s| 0.5 * s.slave_t_max + s.box_margin + s.widest_box())
             .fold(0.0, f64::max);
         self.motion.reset(&self.nodes, x, rho_w);
         let motion = &self.motion;
@@ -609,15 +598,6 @@ impl SurfaceContact {
     /// Whether the candidate lists may miss a pair at `x` (see [`Staleness`]).
     fn stale(&mut self, x: &[[f64; 3]]) -> bool {
         self.motion.stale(x)
-    }
-
-    /// Per cell, |S| of the skip test at this step (of the tiles' grid or the staleness
-    /// test's).
-    fn spread(&self) -> &[f64] {
-        match self.tiles.as_ref() {
-            Some(t) => t.spread(),
-            None => self.motion.spread(),
-        }
     }
 
     /// The oracle ([`SurfaceContact::oracle`]): the sides as they were before this
@@ -796,20 +776,15 @@ impl SurfaceContact {
         ph.builds += (t1 - t_lazy).as_secs_f64();
         let mut stored = 0.0;
         let probed = if self.sides.iter().any(|s| !s.pending.is_empty()) {
-            let sp = self.skip_far.then(|| self.spread().to_vec());
+            let sp = self
+                .skip_far
+                .then(|| spread_of(&self.tiles, &self.motion).to_vec());
             Some(self.probe_erosion(x, v, dt, dt_prev, sp.as_deref()))
         } else {
             None
         };
         let before = self.oracle.then(|| self.sides.clone());
-        let spread = if self.skip_far {
-            Some(match self.tiles.as_ref() {
-                Some(t) => t.spread(),
-                None => self.motion.spread(),
-            })
-        } else {
-            None
-        };
+        let spread = self.skip_far.then(|| spread_of(&self.tiles, &self.motion));
         for s in &mut self.sides {
             s.narrow(x, v, dt, dt_prev, false, spread);
             // Sums in chunk order: bit-identical for any thread count.
@@ -895,6 +870,15 @@ impl SurfaceContact {
             .iter()
             .map(|s| s.chunk_active.iter().map(|a| a.len()).sum::<usize>())
             .sum()
+    }
+}
+
+/// Per cell, |S| of the skip test at this step: the tiles' grid's, or the staleness
+/// test's (a function of the two fields, so that the sides can be borrowed beside it).
+fn spread_of<'a>(tiles: &'a Option<Box<TileSearch>>, motion: &'a Staleness) -> &'a [f64] {
+    match tiles.as_ref() {
+        Some(t) => t.spread(),
+        None => motion.spread(),
     }
 }
 

@@ -478,6 +478,16 @@ impl Side {
         self.update_boxes_of(x, None);
     }
 
+    /// The widest thickness box of the step, per component [m] (eroded faces' boxes are
+    /// empty: −∞). A maximum: exact in any order.
+    pub(super) fn widest_box(&self) -> f64 {
+        self.face_box
+            .par_iter()
+            .with_min_len(4096)
+            .map(|b| (b[3] - b[0]).max(b[4] - b[1]).max(b[5] - b[2]))
+            .reduce(|| 0.0, f64::max)
+    }
+
     /// [`Side::update_boxes`] for the faces stamped with `stamp` only (None: every face).
     fn update_boxes_of(&mut self, x: &[[f64; 3]], stamp: Option<u32>) {
         let (faces, face_t, nf) = (&self.faces, &self.face_t, self.nf);

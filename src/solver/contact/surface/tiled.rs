@@ -104,17 +104,7 @@ pub struct TileSearch {
 /// The widest live thickness box over the sides, per component [m] (from the step's
 /// boxes; eroded faces' boxes are empty).
 fn widest(sides: &[Side]) -> f64 {
-    sides
-        .iter()
-        .map(|s| {
-            // (A maximum: exact in any order.)
-            s.face_box
-                .par_iter()
-                .with_min_len(4096)
-                .map(|b| (b[3] - b[0]).max(b[4] - b[1]).max(b[5] - b[2]))
-                .reduce(|| 0.0, f64::max)
-        })
-        .fold(0.0, f64::max)
+    sides.iter().map(Side::widest_box).fold(0.0, f64::max)
 }
 
 impl TileSearch {
