@@ -12,14 +12,16 @@
 //!   the tiled run's bit for bit (it panics, naming the step and the node, otherwise);
 //! - whole runs: the tiled run's displacements, energies and projectile on 1 and 3
 //!   threads equal the global search's on 1 thread. The oracle's run computes every
-//!   face's thickness box at every step; the global run, at the steps where a side's
-//!   last narrow phase skipped most of its slaves, only the boxes its narrow phase can
-//!   read (`Side::update_needed_boxes`): the equality checks that too.
+//!   face's thickness box at every step; the global run, at the steps where the sides of
+//!   a master surface skipped most of their slaves, only the boxes their narrow phases
+//!   can read (`Side::stamp_needed`): the equality checks that too.
 //!
 //! Models: a band patch, a chain patch, two chain layers (contact between the layers),
 //! a chain patch whose yarns fail and are perforated (erosion, the deepest-face law, the
 //! erosion probe), and a chain patch struck by a deformable bullet (a solid's boundary
-//! faces as the master surface).
+//! faces as the master surface). The sides that share a master surface (its boxes and
+//! broad-phase grid) are checked with the oracle on the global search too, with slaves
+//! of two thicknesses on each surface.
 
 use weft::generate::bullet::BulletParams;
 use weft::generate::woven::{woven, WovenBandParams, YarnFailure, YarnModel};
@@ -159,4 +161,46 @@ fn a_regrid_keeps_the_global_searchs_bits() {
         t.regrids
     );
     assert!(got == want, "the runs differ");
+}
+
+/// Sides that have the same master surface share its thickness boxes and its broad-phase
+/// grid, the grid's boxes inflated by the largest reach among them, while each side
+/// lists its candidates with its own reach (`SurfaceContact::rebuild`). On two chain
+/// layers with slaves 0.3 times as thick in each layer's own definition as between the
+/// layers, each yarn surface is the master of sides of two reaches. Under the oracle,
+/// which builds every side alone at every step (a grid of its own, at its own reach) and
+/// skips nothing, the run must keep every bit, on 1 and 3 threads; and the run without
+/// the oracle, whose lazy steps compute only the boxes the sides of a surface need, must
+/// equal it. (Checked by hand: with only the first side of each surface stamping the
+/// faces it needs, the runs differ. A grid inflated by the smallest reach instead of the
+/// largest is not caught here, the skin being wide; the grid's unit test checks the
+/// lists at a smaller reach by brute force.)
+#[test]
+fn sides_sharing_a_master_surface_find_what_each_alone_would() {
+    let p = WovenBandParams {
+        layers: 2,
+        ..params(8, YarnModel::Chain, 1e-5)
+    };
+    let (mut m, _) = woven(&p).unwrap();
+    // Each layer's warp against its weft: the first and the last definition.
+    let last = m.contacts.len() - 1;
+    for row in [0, last] {
+        let d = &mut m.contacts[row];
+        let t = d.slave_thickness.expect("chains have a slave thickness");
+        d.slave_thickness = Some(0.3 * t);
+    }
+    let (want, rep) = run(&m, 1, Search::Global, false);
+    println!(
+        "{} definitions, {} sides on {} master surfaces, {} builds, {} side-steps with only the needed boxes, {} penetrated",
+        rep.definitions, rep.sides, rep.surfaces, rep.builds, rep.lazy_boxes, rep.penetrated
+    );
+    // 2 in-layer and 4 between-layer definitions, each two-way; 4 yarn surfaces.
+    assert_eq!((rep.definitions, rep.sides, rep.surfaces), (6, 12, 4));
+    assert!(rep.lazy_boxes > 0, "no step with only the needed boxes");
+    assert!(rep.penetrated > 0, "no contact");
+    for threads in [1, 3] {
+        let (got, checked) = run(&m, threads, Search::Global, true);
+        assert!(got == want, "{threads} threads: the runs differ");
+        assert_eq!(checked.penetrated, rep.penetrated);
+    }
 }

@@ -357,7 +357,9 @@ fn bench_woven(
         );
         let (ph, n) = (&rep.phases, rep.slave_steps.max(1) as f64);
         eprintln!(
-            "    contact phases: thickness boxes {:.1} s, staleness test {:.1} s, builds {:.1} s ({:.1} ms each), narrow {:.1} s, scatter {:.1} s; per slave-step: {:.3} skipped whole, {:.2} candidate boxes tested, {:.3} faces evaluated, {:.3} penetrated ({} slave-steps)",
+            "    contact phases ({} sides on {} master surfaces): thickness boxes {:.1} s, staleness test {:.1} s, builds {:.1} s ({:.1} ms each), narrow {:.1} s, scatter {:.1} s; per slave-step: {:.3} skipped whole, {:.2} candidate boxes tested, {:.3} faces evaluated, {:.3} penetrated ({} slave-steps)",
+            rep.sides,
+            rep.surfaces,
             ph.boxes,
             ph.staleness,
             ph.builds,

@@ -155,8 +155,8 @@ fn run_cli() -> anyhow::Result<ExitCode> {
     );
     if let Some(c) = &r.contact {
         eprintln!(
-            "  contact: {} definitions, {} slave nodes against {} faces or segments; {} broad-phase builds (skin {:.3e} m) {:.3} s, narrow phase {:.3} s; {} slaves in contact at the end, friction work {:.4e} J",
-            c.definitions, c.slaves, c.faces, c.builds, c.skin, c.build_seconds, c.narrow_seconds, c.active, c.friction_work
+            "  contact: {} definitions ({} sides on {} master surfaces), {} slave nodes against {} faces or segments; {} broad-phase builds (skin {:.3e} m) {:.3} s, narrow phase {:.3} s; {} slaves in contact at the end, friction work {:.4e} J",
+            c.definitions, c.sides, c.surfaces, c.slaves, c.faces, c.builds, c.skin, c.build_seconds, c.narrow_seconds, c.active, c.friction_work
         );
         if let Some(t) = &c.tiles {
             eprintln!(

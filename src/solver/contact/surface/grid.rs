@@ -4,6 +4,7 @@
 
 use rayon::prelude::*;
 
+use super::boxes::MasterBoxes;
 use super::kernels::{excess, fmin};
 use super::side::{Side, SLAVE_CHUNK};
 use crate::solver::contact::tiles::cell_counts;
@@ -293,16 +294,17 @@ fn visit(
     }
 }
 
-/// How a side's slaves find their candidates in a [`Grid`] over the inflated thickness
-/// boxes of some of its faces (`to_face` maps the grid's entries to face indices, in face
-/// order; None: all faces, the identity).
+/// How a side's slaves find their candidates in a [`Grid`] over the thickness boxes of
+/// some of its faces, inflated by r or more (`to_face` maps the grid's entries to face
+/// indices, in face order; None: all faces, the identity).
 struct Lister<'a> {
     grid: &'a Grid,
     to_face: Option<&'a [u32]>,
-    /// The inflation r of the boxes [m].
+    /// The side's own inflation r of the boxes [m].
     r: f64,
     x: &'a [[f64; 3]],
     side: &'a Side,
+    boxes: &'a MasterBoxes,
 }
 
 impl Lister<'_> {
@@ -318,13 +320,15 @@ impl Lister<'_> {
         let mut near = f64::INFINITY;
         for &gi in self.grid.cell_of(p) {
             let fi = self.to_face.map_or(gi, |l| l[gi as usize]);
-            // (The inflated box, as the grid holds it.)
-            let b = &sd.face_box[fi as usize];
+            // (The box inflated by the side's own reach: the grid's may be inflated more,
+            // for another side of the surface. A box inflated by r that holds p is held by
+            // p's cell, as it lies in the larger one: the same candidates, in face order.)
+            let b = &self.boxes.face_box[fi as usize];
             if (0..3).all(|d| p[d] >= b[d] - r && p[d] <= b[d + 3] + r)
                 && !sd.faces[fi as usize][..nf].contains(&s)
             {
                 list.push(fi);
-                near = fmin(near, excess(p, b, &sd.face_dir[fi as usize], nf));
+                near = fmin(near, excess(p, b, &self.boxes.face_dir[fi as usize], nf));
             }
         }
         near - 0.5 * sd.slave_t[si] - 2.0 * sd.box_margin
@@ -339,17 +343,28 @@ pub(super) struct TileLists {
     pub(super) slaves: Vec<(u32, u32, u32, f64)>,
 }
 
+/// A broad-phase grid over the live faces of a master surface, their thickness boxes
+/// inflated by `r`: one per surface at a build, for every side of it whose reach is at
+/// most `r` ([`Side::build`]).
+pub(super) struct SurfaceGrid {
+    grid: Grid,
+    /// The grid's entries as face indices, in face order (None: every face, the identity;
+    /// eroded faces stay out of the grid).
+    live: Option<Vec<u32>>,
+    r: f64,
+}
+
 impl Side {
     /// The reach r of a build: a slave within t_s/2 + η of a thickness box at some step
     /// before the next build was within this of it per component at the build (see
     /// `super::staleness` and `super::super::tiles`).
-    fn build_reach(&self, skin: f64) -> f64 {
+    pub(super) fn build_reach(&self, skin: f64) -> f64 {
         0.5 * self.slave_t_max + skin + self.box_margin
     }
 
-    /// The grid over the inflated thickness boxes of faces `set` (face indices in
-    /// ascending order; None: every face).
-    fn grid_over(&self, r: f64, set: Option<&[u32]>) -> Grid {
+    /// The grid over the thickness boxes `boxes` of faces `set` (face indices in
+    /// ascending order; None: every face), inflated by `r`.
+    fn grid_over(boxes: &MasterBoxes, r: f64, set: Option<&[u32]>) -> Grid {
         let inflate = |b: &[f64; 8]| {
             (
                 [b[0] - r, b[1] - r, b[2] - r],
@@ -357,33 +372,55 @@ impl Side {
             )
         };
         let boxes: Vec<([f64; 3], [f64; 3])> = match set {
-            None => self.face_box.par_iter().map(inflate).collect(),
+            None => boxes.face_box.par_iter().map(inflate).collect(),
             Some(l) => l
                 .iter()
-                .map(|&f| inflate(&self.face_box[f as usize]))
+                .map(|&f| inflate(&boxes.face_box[f as usize]))
                 .collect(),
         };
         Grid::new(&boxes)
     }
 
-    /// Broad phase: candidates of every slave at the positions `x`, whose face boxes
-    /// [`Side::update_boxes`] has computed; one list for all slaves.
-    pub(super) fn build(&mut self, x: &[[f64; 3]], skin: f64) {
-        let r = self.build_reach(skin);
-        // Eroded faces stay out of the grid: it lists the live ones, `live` maps its
-        // entries back to face indices (in face order, so the candidates keep it).
+    /// The grid of this side's master surface (its thickness boxes `boxes`, computed)
+    /// over its live faces, inflated by `r` (at least the reach of every side that lists
+    /// its candidates in it).
+    pub(super) fn surface_grid(&self, boxes: &MasterBoxes, r: f64) -> SurfaceGrid {
         let live: Option<Vec<u32>> = (self.dead_faces > 0).then(|| {
             (0..self.faces.len() as u32)
                 .filter(|&f| self.face_alive[f as usize])
                 .collect()
         });
-        let grid = self.grid_over(r, live.as_deref());
+        SurfaceGrid {
+            grid: Side::grid_over(boxes, r, live.as_deref()),
+            live,
+            r,
+        }
+    }
+
+    /// Broad phase: candidates of every slave at the positions `x`, in the grid `sg` of
+    /// its master surface, whose thickness boxes `boxes` are computed; one list for all
+    /// slaves.
+    pub(super) fn build(
+        &mut self,
+        x: &[[f64; 3]],
+        skin: f64,
+        boxes: &MasterBoxes,
+        sg: &SurfaceGrid,
+    ) {
+        let r = self.build_reach(skin);
+        assert!(
+            r <= sg.r,
+            "contact {}: a broad-phase grid inflated by {:e} m for a side of reach {r:e} m",
+            self.contact_id,
+            sg.r
+        );
         let lister = Lister {
-            grid: &grid,
-            to_face: live.as_deref(),
+            grid: &sg.grid,
+            to_face: sg.live.as_deref(),
             r,
             x,
             side: self,
+            boxes,
         };
         // Candidates: count, then fill, each in parallel over fixed slave chunks.
         let ns = self.slaves.len();
@@ -449,17 +486,19 @@ impl Side {
         &self,
         x: &[[f64; 3]],
         skin: f64,
+        boxes: &MasterBoxes,
         set: &[u32],
         slaves: &[u32],
     ) -> TileLists {
         let r = self.build_reach(skin);
-        let grid = self.grid_over(r, Some(set));
+        let grid = Side::grid_over(boxes, r, Some(set));
         let lister = Lister {
             grid: &grid,
             to_face: Some(set),
             r,
             x,
             side: self,
+            boxes,
         };
         let mut out = TileLists {
             cand: Vec::new(),
@@ -550,6 +589,34 @@ mod tests {
         assert!(
             found > points.len(),
             "the test must exercise overlaps: {found}"
+        );
+        // A side of smaller reach lists its candidates in a grid built for a larger one
+        // (the sides of a master surface share the grid of the largest, see
+        // `SurfaceContact::rebuild`): the boxes it filters by are the grid's less the
+        // difference d of the reaches, and the cell's entries so filtered must be exactly
+        // the smaller boxes that contain the point, by brute force.
+        let d = 0.15;
+        let small: Vec<([f64; 3], [f64; 3])> = boxes
+            .iter()
+            .map(|(a, b)| (a.map(|v| v + d), b.map(|v| v - d)))
+            .collect();
+        let mut found_small = 0;
+        for p in &points {
+            let got: Vec<u32> = grid
+                .cell_of(p)
+                .iter()
+                .copied()
+                .filter(|&i| inside(p, &small[i as usize]))
+                .collect();
+            let want: Vec<u32> = (0..small.len() as u32)
+                .filter(|&i| inside(p, &small[i as usize]))
+                .collect();
+            assert_eq!(got, want, "point {p:?}, boxes less {d}");
+            found_small += want.len();
+        }
+        assert!(
+            found_small > points.len() / 10 && found_small < found,
+            "the smaller boxes must hold fewer points, and some: {found_small} of {found}"
         );
     }
 

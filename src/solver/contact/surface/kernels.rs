@@ -248,7 +248,7 @@ pub(super) fn thickness_box(
     b
 }
 
-/// The unit directions m₊, m₋ of a face's envelope bounds (see `Side::set_directions`);
+/// The unit directions m₊, m₋ of a face's envelope bounds (see `MasterBoxes::set_directions_of`);
 /// zero where the face has no normal or the direction is ill-defined (a zero direction
 /// never rejects: its bound is max_a t_a/2 ≥ 0).
 pub(super) fn envelope_directions(

@@ -86,10 +86,12 @@
 //! ([`SurfaceContact`]: setup, the step's phases in order, the report), and `gather` (the
 //! forces onto the nodes in a canonical order, in parallel).
 
+mod boxes;
 mod gather;
 pub mod grid;
 pub mod kernels;
 pub mod narrow;
+mod oracle;
 pub mod side;
 pub mod solid;
 pub mod tiled;
@@ -100,6 +102,7 @@ use super::staleness::Staleness;
 use crate::error::{Result, WeftError};
 use crate::model::contacts::{InitialPenetration, Slave};
 use crate::model::{ElementKind, Model};
+use boxes::MasterBoxes;
 pub use kernels::{pair_force, thickness_gradient, Friction, SlaveState, MAX_THICKNESS_GRADIENT};
 use side::{part_nodes, ChunkSums};
 pub use side::{PairOut, Reaction, Side};
@@ -204,6 +207,10 @@ pub struct ContactReport {
     /// Slave nodes and master faces over all sides (a two-way definition counts twice).
     pub slaves: usize,
     pub faces: usize,
+    /// Sides (a two-way definition has two), and their distinct master surfaces: the
+    /// sides of a surface share its thickness boxes and broad-phase grid.
+    pub sides: usize,
+    pub surfaces: usize,
     /// Broad-phase builds.
     pub builds: u64,
     /// Slaves in contact at the end.
@@ -309,8 +316,8 @@ pub struct ContactPhases {
 const SKIN_PER_FACE: f64 = 0.5;
 
 /// The fraction of a side's slaves that its last narrow phase skipped from which the next
-/// step computes only the thickness boxes its narrow phase can read
-/// (`Side::update_needed_boxes`). Measured on the 60 × 60 quarter to 60 µs, 2 threads,
+/// step computes only the thickness boxes its narrow phase can read (`Side::stamp_needed`;
+/// on a master surface shared by several sides, when every one of them skipped so many). Measured on the 60 × 60 quarter to 60 µs, 2 threads,
 /// alternately with every box computed: the band patch (43 % of its slave-steps skipped)
 /// spent 1.8–1.9 s in the boxes against 1.4–1.7 s; the four-layer chain patch (91 %, its
 /// sides between layers nearly all) 30.8 and 33.1 s against 37.2 and 38.6 s in all.
@@ -371,6 +378,9 @@ pub struct Deepest {
 #[derive(Debug, Clone, Default)]
 pub struct SurfaceContact {
     pub sides: Vec<Side>,
+    /// The distinct master surfaces of the sides: their faces' boxes and envelope
+    /// directions, computed once per step for all the sides of each ([`MasterBoxes`]).
+    masters: Vec<MasterBoxes>,
     /// Nodes that take part (slaves and face nodes), sorted.
     nodes: Vec<u32>,
     /// Their positions at the last broad phase, and the test of when the candidate lists
@@ -458,9 +468,11 @@ impl SurfaceContact {
             0.0
         };
         let kappa_max = sides.iter().map(|s| s.kappa).fold(0.0, f64::max);
+        let masters = MasterBoxes::group(&mut sides);
         let choice = chosen_search();
         SurfaceContact {
             sides,
+            masters,
             nodes,
             motion: Staleness::new(skin),
             search: choice.search,
@@ -523,10 +535,13 @@ impl SurfaceContact {
                 continue;
             }
             let kept = (s.state.clone(), s.held.clone(), s.out.clone());
-            s.narrow(x, v, dt, dt_prev, false, spread);
+            s.narrow(&self.masters[s.surface], x, v, dt, dt_prev, false, spread);
             with[k] = s.pair_energy(v, dt_prev);
             (s.state, s.held, s.out) = kept;
-            s.drop_pending();
+        }
+        // (Only once every side has been probed: the sides of a surface share its boxes.)
+        for s in &mut self.sides {
+            s.drop_pending(&mut self.masters[s.surface]);
         }
         with
     }
@@ -574,18 +589,32 @@ impl SurfaceContact {
         best
     }
 
-    /// Broad phase for every side at `x` (whose thickness boxes are up to date).
+    /// Broad phase for every side at `x` (whose thickness boxes are up to date): per
+    /// master surface its envelope directions and one grid, inflated by the largest
+    /// reach of its sides, in which each side lists its candidates with its own reach
+    /// (the lists a grid of its own would give, see `grid::Lister`).
     fn rebuild(&mut self, x: &[[f64; 3]]) {
-        for s in &mut self.sides {
-            s.set_directions(x);
-            s.build(x, self.skin);
+        let skin = self.skin;
+        for mb in &mut self.masters {
+            let sides = &mut self.sides;
+            mb.set_directions_of(&sides[mb.sides[0]], x, None);
+            let r = mb
+                .sides
+                .iter()
+                .map(|&k| sides[k].build_reach(skin))
+                .fold(0.0, f64::max);
+            let sg = sides[mb.sides[0]].surface_grid(mb, r);
+            for &k in &mb.sides {
+                sides[k].build(x, skin, mb, &sg);
+            }
         }
         // ρ + W of the staleness test: the farthest a slave can be from a thickness box
         // that the narrow phase evaluates, and the widest box.
+        let widest: Vec<f64> = self.masters.iter().map(MasterBoxes::widest).collect();
         let rho_w = self
             .sides
             .iter()
-            .map(|s| 0.5 * s.slave_t_max + s.box_margin + s.widest_box())
+            .map(|s| 0.5 * s.slave_t_max + s.box_margin + widest[s.surface])
             .fold(0.0, f64::max);
         self.motion.reset(&self.nodes, x, rho_w);
         let motion = &self.motion;
@@ -595,34 +624,44 @@ impl SurfaceContact {
         self.builds += 1;
     }
 
+    /// Every master surface's thickness boxes at `x`.
+    fn update_all_boxes(&mut self, x: &[[f64; 3]]) {
+        for mb in &mut self.masters {
+            mb.update(&self.sides[mb.sides[0]], x, None);
+        }
+    }
+
+    /// The thickness boxes at `x` after the staleness test (`stale`: a build follows):
+    /// every box at a build, and otherwise, on a surface all of whose sides' last narrow
+    /// phases skipped most of their slaves, only the boxes of the candidates that this
+    /// step's narrow phases will test (each side stamps its own, [`Side::stamp_needed`]).
+    fn update_needed_boxes(&mut self, x: &[[f64; 3]], stale: bool) {
+        // (The stamps wrap after 2³² evaluations: a face stamped then and not since would
+        // be taken as needed, which costs a box, never a missed one.)
+        let epoch = (self.evaluations as u32).max(1);
+        for mb in &mut self.masters {
+            // (Only where the last narrow phases skipped most slaves: marking the needed
+            // faces costs more than it saves where half of them search.)
+            let mostly = mb.sides.iter().all(|&k| {
+                let s = &self.sides[k];
+                let skipped: u64 = s.chunk_sums.iter().map(|c| c.skipped).sum();
+                skipped as f64 >= LAZY_BOXES_SKIPPED * s.slaves.len() as f64
+            });
+            if stale || !mostly {
+                mb.update(&self.sides[mb.sides[0]], x, None);
+            } else {
+                for &k in &mb.sides {
+                    self.sides[k].stamp_needed(&mb.stamp, self.motion.spread(), epoch);
+                }
+                mb.update(&self.sides[mb.sides[0]], x, Some(epoch));
+                self.lazy_boxes += mb.sides.len() as u64;
+            }
+        }
+    }
+
     /// Whether the candidate lists may miss a pair at `x` (see [`Staleness`]).
     fn stale(&mut self, x: &[[f64; 3]]) -> bool {
         self.motion.stale(x)
-    }
-
-    /// The oracle ([`SurfaceContact::oracle`]): the sides as they were before this
-    /// step's narrow phase (`before`) get fresh global lists at `x` and a narrow phase
-    /// that skips no slave; every slave's contact, state and reaction shares, and every
-    /// chunk's energies and penetrated count, must be the same bits as this step's.
-    fn check_oracle(
-        &self,
-        before: Vec<Side>,
-        x: &[[f64; 3]],
-        v: &[[f64; 3]],
-        dt: f64,
-        dt_prev: f64,
-    ) {
-        for (k, mut r) in before.into_iter().enumerate() {
-            r.build(x, self.skin);
-            r.narrow(x, v, dt, dt_prev, false, None);
-            if let Err(e) = same_results(&self.sides[k], &r) {
-                panic!(
-                    "contact oracle: the {:?} search differs from the global one at force \
-                     evaluation {}, contact {} (side {k}): {e}",
-                    self.search, self.evaluations, self.sides[k].contact_id
-                );
-            }
-        }
     }
 
     /// Books what the stale test that has just triggered a build found: which cells went
@@ -653,19 +692,18 @@ impl SurfaceContact {
     /// the broad phase, and the nodes that start inside a surface (recorded, or an error
     /// when their definition says so).
     pub fn start(&mut self, m: &Model, x: &[[f64; 3]]) -> Result<()> {
-        for s in &mut self.sides {
-            s.update_boxes(x);
-        }
+        self.update_all_boxes(x);
         if self.search == Search::Tiles {
             let mut t = TileSearch::new(
                 &self.sides,
+                &self.masters,
                 &self.nodes,
                 x,
                 self.skin,
                 (self.tile_cells, self.tile_u_per_skin, self.tile_width_slack),
             );
-            t.check(&self.sides, x);
-            t.rebuild(&mut self.sides, x);
+            t.check(&self.masters, x);
+            t.rebuild(&mut self.sides, &mut self.masters, x);
             self.tiles = Some(Box::new(t));
             self.builds += 1;
         } else {
@@ -673,7 +711,7 @@ impl SurfaceContact {
         }
         let zero = vec![[0.0; 3]; m.num_nodes()];
         for s in &mut self.sides {
-            s.narrow(x, &zero, 1.0, 0.0, true, None);
+            s.narrow(&self.masters[s.surface], x, &zero, 1.0, 0.0, true, None);
             for (si, o) in s.out.iter().enumerate() {
                 if o.face == u32::MAX {
                     continue;
@@ -725,16 +763,14 @@ impl SurfaceContact {
         // Every box when the search or the oracle reads them all (the tiles' width test,
         // the oracle's build) or when no slave is skipped; else, after the staleness
         // test, every box at a build and otherwise those of the candidates that the narrow
-        // phase will test (`Side::update_needed_boxes`).
+        // phase will test (`SurfaceContact::update_needed_boxes`).
         let all_boxes = self.tiles.is_some() || self.oracle || !self.skip_far;
         if all_boxes {
-            for s in &mut self.sides {
-                s.update_boxes(x);
-            }
+            self.update_all_boxes(x);
         }
         let t_boxes = std::time::Instant::now();
         let stale = match self.tiles.as_mut() {
-            Some(t) => t.check(&self.sides, x) > 0,
+            Some(t) => t.check(&self.masters, x) > 0,
             None => self.stale(x),
         };
         if stale && self.tiles.is_none() {
@@ -742,27 +778,13 @@ impl SurfaceContact {
         }
         let t_stale = std::time::Instant::now();
         if !all_boxes {
-            // (The stamps wrap after 2³² evaluations: a face stamped then and not since
-            // would be taken as needed, which costs a box, never a missed one.)
-            let epoch = (self.evaluations as u32).max(1);
-            for s in &mut self.sides {
-                // (Only where the last narrow phase skipped most slaves: marking the
-                // needed faces costs more than it saves where half of them search.)
-                let skipped: u64 = s.chunk_sums.iter().map(|c| c.skipped).sum();
-                let mostly = skipped as f64 >= LAZY_BOXES_SKIPPED * s.slaves.len() as f64;
-                if stale || !mostly {
-                    s.update_boxes(x);
-                } else {
-                    s.update_needed_boxes(x, self.motion.spread(), epoch);
-                    self.lazy_boxes += 1;
-                }
-            }
+            self.update_needed_boxes(x, stale);
         }
         let t_lazy = std::time::Instant::now();
         if stale {
             match self.tiles.as_mut() {
                 Some(t) => {
-                    t.rebuild(&mut self.sides, x);
+                    t.rebuild(&mut self.sides, &mut self.masters, x);
                     self.builds += 1;
                 }
                 None => self.rebuild(x),
@@ -786,7 +808,7 @@ impl SurfaceContact {
         let before = self.oracle.then(|| self.sides.clone());
         let spread = self.skip_far.then(|| spread_of(&self.tiles, &self.motion));
         for s in &mut self.sides {
-            s.narrow(x, v, dt, dt_prev, false, spread);
+            s.narrow(&self.masters[s.surface], x, v, dt, dt_prev, false, spread);
             // Sums in chunk order: bit-identical for any thread count.
             for c in &s.chunk_sums {
                 stored += c.stored;
@@ -843,6 +865,8 @@ impl SurfaceContact {
                 .len(),
             slaves: self.sides.iter().map(|s| s.slaves.len()).sum(),
             faces: self.sides.iter().map(|s| s.faces.len()).sum(),
+            sides: self.sides.len(),
+            surfaces: self.masters.len(),
             builds: self.builds,
             active: self.active(),
             initial_penetrations: self.initial.len(),
@@ -880,73 +904,4 @@ fn spread_of<'a>(tiles: &'a Option<Box<TileSearch>>, motion: &'a Staleness) -> &
         Some(t) => t.spread(),
         None => motion.spread(),
     }
-}
-
-/// Whether two narrow phases of a side gave the same bits (the oracle): the slaves in
-/// contact, their results, every slave's state, the reaction shares, and the chunks'
-/// energies and penetrated counts.
-fn same_results(a: &Side, b: &Side) -> std::result::Result<(), String> {
-    let node = |si: u32| a.slaves[si as usize];
-    if a.chunk_active != b.chunk_active {
-        let (x, y): (Vec<u32>, Vec<u32>) = (
-            a.chunk_active.iter().flatten().copied().collect(),
-            b.chunk_active.iter().flatten().copied().collect(),
-        );
-        let only_a: Vec<u32> = x
-            .iter()
-            .filter(|s| !y.contains(s))
-            .map(|&s| node(s))
-            .collect();
-        let only_b: Vec<u32> = y
-            .iter()
-            .filter(|s| !x.contains(s))
-            .map(|&s| node(s))
-            .collect();
-        return Err(format!(
-            "slaves in contact differ: only here node indices {only_a:?}, only in the global search {only_b:?}"
-        ));
-    }
-    let bits = |v: &[f64]| v.iter().map(|f| f.to_bits()).collect::<Vec<_>>();
-    for &si in a.chunk_active.iter().flatten() {
-        let (p, q) = (&a.out[si as usize], &b.out[si as usize]);
-        let pv = [p.f[0], p.f[1], p.f[2], p.stored, p.dissipated, p.g];
-        let qv = [q.f[0], q.f[1], q.f[2], q.stored, q.dissipated, q.g];
-        if p.face != q.face || bits(&pv) != bits(&qv) {
-            return Err(format!(
-                "node index {}: {p:?} against the global search's {q:?}",
-                node(si)
-            ));
-        }
-    }
-    for (si, (p, q)) in a.state.iter().zip(&b.state).enumerate() {
-        let pv = [p.ft[0], p.ft[1], p.ft[2], p.k, p.g0];
-        let qv = [q.ft[0], q.ft[1], q.ft[2], q.k, q.g0];
-        if bits(&pv) != bits(&qv) || a.held[si] != b.held[si] {
-            return Err(format!(
-                "node index {}: state {p:?} against the global search's {q:?}",
-                node(si as u32)
-            ));
-        }
-    }
-    for (ra, rb) in a.chunk_reactions.iter().zip(&b.chunk_reactions) {
-        let same = ra.len() == rb.len()
-            && ra
-                .iter()
-                .zip(rb)
-                .all(|(p, q)| p.slave == q.slave && p.face == q.face && bits(&p.w) == bits(&q.w));
-        if !same {
-            return Err("reaction shares differ".into());
-        }
-    }
-    for (ci, (p, q)) in a.chunk_sums.iter().zip(&b.chunk_sums).enumerate() {
-        if p.stored.to_bits() != q.stored.to_bits()
-            || p.dissipated.to_bits() != q.dissipated.to_bits()
-            || p.penetrated != q.penetrated
-        {
-            return Err(format!(
-                "chunk {ci}: {p:?} against the global search's {q:?}"
-            ));
-        }
-    }
-    Ok(())
 }

@@ -5,6 +5,7 @@
 
 use rayon::prelude::*;
 
+use super::boxes::MasterBoxes;
 use super::gather::{block_size, ChunkParts};
 use super::kernels::{
     box_distance2, fmax, pair_force, release, thickness_gradient, Friction, Hit, SlaveState,
@@ -299,12 +300,15 @@ type Chunk<'c> = (
 );
 
 impl Side {
-    /// Narrow phase and friction for every slave, in parallel chunks, into `out`.
+    /// Narrow phase and friction for every slave, in parallel chunks, into `out`, with
+    /// the thickness boxes and envelope bounds `boxes` of its master surface.
     /// `initial`: report penetrations instead of pushing (setup).
     /// `spread`: per cell of the staleness test, |S| of `Side::margin` at this step
     /// (None: no slave is skipped).
+    #[allow(clippy::too_many_arguments)]
     pub(super) fn narrow(
         &mut self,
+        boxes: &MasterBoxes,
         x: &[[f64; 3]],
         v: &[[f64; 3]],
         dt: f64,
@@ -315,15 +319,17 @@ impl Side {
         // One copy per face kind, so that the loops over a face's nodes are unrolled (and
         // the solid's one-sided faces are a copy of their own: no branch in the others).
         match (self.nf, self.solid.is_some()) {
-            (4, true) => self.narrow_n::<4, true>(x, v, dt, dt_prev, initial, spread),
-            (2, _) => self.narrow_n::<2, false>(x, v, dt, dt_prev, initial, spread),
-            (3, _) => self.narrow_n::<3, false>(x, v, dt, dt_prev, initial, spread),
-            _ => self.narrow_n::<4, false>(x, v, dt, dt_prev, initial, spread),
+            (4, true) => self.narrow_n::<4, true>(boxes, x, v, dt, dt_prev, initial, spread),
+            (2, _) => self.narrow_n::<2, false>(boxes, x, v, dt, dt_prev, initial, spread),
+            (3, _) => self.narrow_n::<3, false>(boxes, x, v, dt, dt_prev, initial, spread),
+            _ => self.narrow_n::<4, false>(boxes, x, v, dt, dt_prev, initial, spread),
         }
     }
 
+    #[allow(clippy::too_many_arguments)]
     fn narrow_n<const NF: usize, const SOLID: bool>(
         &mut self,
+        boxes: &MasterBoxes,
         x: &[[f64; 3]],
         v: &[[f64; 3]],
         dt: f64,
@@ -338,8 +344,8 @@ impl Side {
             dt_prev,
             initial,
             spread,
-            face_box: &self.face_box,
-            face_dir: &self.face_dir,
+            face_box: &boxes.face_box,
+            face_dir: &boxes.face_dir,
             margin: &self.margin,
             slave_cell: &self.slave_cell,
             faces: &self.faces,

@@ -1,13 +1,10 @@
 //! A side of a contact definition: its slaves against a master surface ([`Side`]), built
-//! from the model, and the per-step data its phases share: the faces' thickness boxes and
-//! envelope directions (updated here), the candidate lists of the last broad phase, and
-//! the slaves' history and results ([`PairOut`], [`Reaction`], `ChunkSums`).
+//! from the model, and the per-step data its phases share: the candidate lists of the
+//! last broad phase, and the slaves' history and results ([`PairOut`], [`Reaction`],
+//! `ChunkSums`). The faces' thickness boxes and envelope directions belong to the master
+//! surface, shared by its sides (`super::boxes::MasterBoxes`).
 
-use std::sync::atomic::{AtomicU32, Ordering::Relaxed};
-
-use rayon::prelude::*;
-
-use super::kernels::{bbox, envelope_directions, thickness_box, Friction, SlaveState};
+use super::kernels::{bbox, Friction, SlaveState};
 use super::solid::{boundary_faces, boundary_nodes};
 use crate::model::contacts::{ContactDef, InitialPenetration, Slave};
 use crate::model::{ElementKind, Model};
@@ -16,19 +13,6 @@ use crate::solver::vec3::dot;
 
 /// Slaves per parallel chunk of the narrow phase.
 pub(super) const SLAVE_CHUNK: usize = 256;
-
-/// The thickness box of an eroded face: lo = +∞, hi = −∞ and envelope bounds −∞, so that
-/// every box test and envelope filter rejects it.
-pub(super) const DEAD_BOX: [f64; 8] = [
-    f64::INFINITY,
-    f64::INFINITY,
-    f64::INFINITY,
-    f64::NEG_INFINITY,
-    f64::NEG_INFINITY,
-    f64::NEG_INFINITY,
-    f64::NEG_INFINITY,
-    f64::NEG_INFINITY,
-];
 
 /// Round-off allowance of the thickness-box tests relative to the largest coordinate of a
 /// side's nodes: its foot and box are computed within ~10⁻¹⁵ of that.
@@ -140,12 +124,6 @@ pub struct Side {
     /// search, of the tiles' grid in the tiled one (the narrow phase reads its spread
     /// |S| there).
     pub(super) slave_cell: Vec<u32>,
-    /// The faces' thickness boxes at the current step (lo, hi) [m], and their envelope
-    /// bounds h₊, h₋ along `face_dir` (see [`Side::set_directions`]).
-    pub(super) face_box: Vec<[f64; 8]>,
-    /// Per face, the unit directions m₊, m₋ of its envelope bounds, from the last broad
-    /// phase (zero for a segment or a face too distorted to have them).
-    pub(super) face_dir: Vec<[f32; 6]>,
     pub state: Vec<SlaveState>,
     /// Per slave: whether its state differs from the default (a stick spring or a
     /// tracked initial penetration).
@@ -162,24 +140,10 @@ pub struct Side {
     /// ... and, on more than one thread, its forces on the nodes by node block, for the
     /// parallel gather (`super::gather`).
     pub(super) chunk_contribs: Vec<ChunkContribs>,
-    /// Per face, the force evaluation whose narrow phase last needed its box
-    /// ([`Side::update_needed_boxes`]).
-    pub(super) box_stamp: Stamps,
-}
-
-/// Stamps written in parallel (each slot by whoever needs it, all with the same value).
-#[derive(Debug, Default)]
-pub(super) struct Stamps(pub(super) Vec<AtomicU32>);
-
-impl Clone for Stamps {
-    fn clone(&self) -> Stamps {
-        Stamps(
-            self.0
-                .iter()
-                .map(|a| AtomicU32::new(a.load(Relaxed)))
-                .collect(),
-        )
-    }
+    /// Its master surface's index in `SurfaceContact::masters`: the faces' boxes and
+    /// envelope directions, shared with the other sides of that surface
+    /// (`super::boxes::MasterBoxes`).
+    pub(super) surface: usize,
 }
 
 /// What one chunk of slaves adds up in a narrow phase: the stored energy and the friction
@@ -403,7 +367,6 @@ impl Side {
             .chain(faces.iter().flat_map(|f| f[..npe].iter()))
             .flat_map(|&n| m.coords[n as usize])
             .fold(0.0, |a: f64, c| a.max(c.abs()));
-        let n_faces = faces.len();
         Side {
             contact_id: d.id,
             row,
@@ -446,15 +409,11 @@ impl Side {
             lists: vec![],
             margin: vec![],
             slave_cell: vec![],
-            // Before the first broad phase there are no directions yet: zero ones never
-            // reject.
-            face_box: vec![[0.0; 8]; n_faces],
-            face_dir: vec![[0.0; 6]; n_faces],
             chunk_active: vec![],
             chunk_reactions: vec![],
             chunk_sums: vec![],
             chunk_contribs: vec![],
-            box_stamp: Stamps((0..n_faces).map(|_| AtomicU32::new(0)).collect()),
+            surface: 0,
         }
     }
 
@@ -471,75 +430,6 @@ impl Side {
         s / self.faces.len() as f64
     }
 
-    /// The faces' thickness boxes at `x`, once per step, in parallel (each candidate of
-    /// the narrow phase then reads one box instead of gathering its face's nodes; measured:
-    /// those gathers were ~40 % of the narrow phase of the woven patch).
-    pub(super) fn update_boxes(&mut self, x: &[[f64; 3]]) {
-        self.update_boxes_of(x, None);
-    }
-
-    /// The widest thickness box of the step, per component [m] (eroded faces' boxes are
-    /// empty: −∞). A maximum: exact in any order.
-    pub(super) fn widest_box(&self) -> f64 {
-        self.face_box
-            .par_iter()
-            .with_min_len(4096)
-            .map(|b| (b[3] - b[0]).max(b[4] - b[1]).max(b[5] - b[2]))
-            .reduce(|| 0.0, f64::max)
-    }
-
-    /// [`Side::update_boxes`] for the faces stamped with `stamp` only (None: every face).
-    fn update_boxes_of(&mut self, x: &[[f64; 3]], stamp: Option<u32>) {
-        let (faces, face_t, nf) = (&self.faces, &self.face_t, self.nf);
-        let (dirs, alive, any_dead) = (&self.face_dir, &self.face_alive, self.dead_faces > 0);
-        let stamps = &self.box_stamp.0;
-        self.face_box
-            .par_chunks_mut(4096)
-            .enumerate()
-            .for_each(|(c, bs)| {
-                for (j, b) in bs.iter_mut().enumerate() {
-                    let fi = c * 4096 + j;
-                    if stamp.is_some_and(|e| stamps[fi].load(Relaxed) != e) {
-                        continue;
-                    }
-                    *b = if any_dead && !alive[fi] {
-                        DEAD_BOX
-                    } else {
-                        thickness_box(&faces[fi], &face_t[fi], &dirs[fi], nf, x)
-                    };
-                }
-            });
-    }
-
-    /// The thickness boxes at `x` of the faces that this step's narrow phase can read:
-    /// the candidates of the slaves it does not skip (with the spreads `spread` of the
-    /// skip test, as `Side::narrow` decides). The others keep older boxes, which nothing
-    /// reads before the next build computes every box again. `epoch`: this force
-    /// evaluation's number (> 0), stamped on the faces it needs. Measured on the
-    /// four-layer chain patch, 60 × 60 to 30 µs, where 91 % of the slave-steps are
-    /// skipped: the boxes took 10.3 of its 40.7 s, 5.5 s of 33.6 s this way.
-    pub(super) fn update_needed_boxes(&mut self, x: &[[f64; 3]], spread: &[f64], epoch: u32) {
-        let stamps = &self.box_stamp.0;
-        let (margin, cell) = (&self.margin, &self.slave_cell);
-        let (cand_at, lists) = (&self.cand_at, &self.lists);
-        (0..self.slaves.len().div_ceil(SLAVE_CHUNK))
-            .into_par_iter()
-            .for_each(|ci| {
-                let s0 = ci * SLAVE_CHUNK;
-                let s1 = (s0 + SLAVE_CHUNK).min(margin.len());
-                for si in s0..s1 {
-                    if margin[si] > spread[cell[si] as usize] {
-                        continue;
-                    }
-                    let [l, a, b] = cand_at[si];
-                    for &fi in &lists[l as usize][a as usize..b as usize] {
-                        stamps[fi as usize].store(epoch, Relaxed);
-                    }
-                }
-            });
-        self.update_boxes_of(x, Some(epoch));
-    }
-
     /// The faces of element `e` (of the master's kind) are to leave the surface (one, or
     /// a solid's boundary faces of it: `face_elem` is ascending): pending until
     /// [`Side::drop_pending`].
@@ -550,16 +440,6 @@ impl Side {
             if self.face_alive[f] && !self.pending.contains(&(f as u32)) {
                 self.pending.push(f as u32);
             }
-        }
-    }
-
-    /// The pending faces leave the surface: an empty thickness box from now on.
-    pub(super) fn drop_pending(&mut self) {
-        for f in self.pending.drain(..) {
-            let f = f as usize;
-            self.face_alive[f] = false;
-            self.face_box[f] = DEAD_BOX;
-            self.dead_faces += 1;
         }
     }
 
@@ -591,42 +471,6 @@ impl Side {
             }
         }
         e + 0.5 * dt_prev * p
-    }
-
-    /// The directions of the faces' envelope bounds at `x`, then their bounds (at a broad
-    /// phase). For a face of unit normal n̂ and in-plane thickness gradient ∇t_F
-    /// ([`thickness_gradient`]), m± = (±n̂ − ½∇t_F)/|±n̂ − ½∇t_F|: the outward normals of the
-    /// two sides of the thickness envelope of a flat face with a linear thickness (a
-    /// lenticular band's quad thins to its edge, where the thickness box stays as high as
-    /// its thickest node). Any unit direction gives a sound bound, so they are refreshed
-    /// only here, while the bounds follow the nodes every step.
-    pub(super) fn set_directions(&mut self, x: &[[f64; 3]]) {
-        self.set_directions_of(x, None);
-    }
-
-    /// [`Side::set_directions`] for the faces `mask` marks (None: all).
-    pub(super) fn set_directions_of(&mut self, x: &[[f64; 3]], mask: Option<&[bool]>) {
-        let (faces, face_t, nf) = (&self.faces, &self.face_t, self.nf);
-        if nf < 3 {
-            return;
-        }
-        // (The boxes are up to date: only the bounds along the new directions change.)
-        let (alive, any_dead) = (&self.face_alive, self.dead_faces > 0);
-        self.face_dir
-            .par_chunks_mut(4096)
-            .zip(self.face_box.par_chunks_mut(4096))
-            .enumerate()
-            .for_each(|(c, (ds, bs))| {
-                for (j, (d, b)) in ds.iter_mut().zip(bs.iter_mut()).enumerate() {
-                    let fi = c * 4096 + j;
-                    if (any_dead && !alive[fi]) || mask.is_some_and(|m| !m[fi]) {
-                        continue;
-                    }
-                    *d = envelope_directions(&faces[fi], &face_t[fi], nf, x);
-                    let fb = thickness_box(&faces[fi], &face_t[fi], d, nf, x);
-                    (b[6], b[7]) = (fb[6], fb[7]);
-                }
-            });
     }
 }
 

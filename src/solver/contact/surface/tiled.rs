@@ -41,6 +41,7 @@
 
 use rayon::prelude::*;
 
+use super::boxes::MasterBoxes;
 use super::side::Side;
 use crate::solver::contact::tiles::{Binning, CellGrid, FaceIndex, Reach, Tiling};
 
@@ -101,18 +102,19 @@ pub struct TileSearch {
     pub stats: TileStats,
 }
 
-/// The widest live thickness box over the sides, per component [m] (from the step's
-/// boxes; eroded faces' boxes are empty).
-fn widest(sides: &[Side]) -> f64 {
-    sides.iter().map(Side::widest_box).fold(0.0, f64::max)
+/// The widest live thickness box over the master surfaces, per component [m] (from the
+/// step's boxes; eroded faces' boxes are empty).
+fn widest(masters: &[MasterBoxes]) -> f64 {
+    masters.iter().map(MasterBoxes::widest).fold(0.0, f64::max)
 }
 
 impl TileSearch {
     /// The search over `nodes` (every slave and face node of `sides`) at `x`, whose face
-    /// boxes are up to date, with the broad phase's `skin`; every tile is stale until the
-    /// first [`TileSearch::rebuild`].
+    /// boxes (`masters`) are up to date, with the broad phase's `skin`; every tile is
+    /// stale until the first [`TileSearch::rebuild`].
     pub(super) fn new(
         sides: &[Side],
+        masters: &[MasterBoxes],
         nodes: &[u32],
         x: &[[f64; 3]],
         skin: f64,
@@ -160,7 +162,7 @@ impl TileSearch {
             stale: Vec::new(),
             stats: TileStats::default(),
         };
-        t.regrid(x, widest(sides));
+        t.regrid(x, widest(masters));
         t.stats.regrids = 0;
         t
     }
@@ -182,10 +184,10 @@ impl TileSearch {
         self.stats.regrids += 1;
     }
 
-    /// Restores (W) and (B) at `x` (the step's face boxes computed), tests every tile and
-    /// keeps its cells' spreads; returns how many tiles must rebuild.
-    pub(super) fn check(&mut self, sides: &[Side], x: &[[f64; 3]]) -> usize {
-        let w = widest(sides);
+    /// Restores (W) and (B) at `x` (the step's face boxes `masters` computed), tests
+    /// every tile and keeps its cells' spreads; returns how many tiles must rebuild.
+    pub(super) fn check(&mut self, masters: &[MasterBoxes], x: &[[f64; 3]]) -> usize {
+        let w = widest(masters);
         let mut regrid = !(w <= self.reach.w_cap);
         let mut marked: Vec<u32> = Vec::new();
         if !regrid {
@@ -237,8 +239,15 @@ impl TileSearch {
     }
 
     /// Rebuilds the tiles [`TileSearch::check`] found stale, at `x`: their node sets and
-    /// references, then per side the candidate lists of their slaves (module docs).
-    pub(super) fn rebuild(&mut self, sides: &mut [Side], x: &[[f64; 3]]) {
+    /// references, then per side the candidate lists of their slaves (module docs), the
+    /// envelope directions of their faces refreshed in the side's master surface (the
+    /// same faces and values for every side of it).
+    pub(super) fn rebuild(
+        &mut self,
+        sides: &mut [Side],
+        masters: &mut [MasterBoxes],
+        x: &[[f64; 3]],
+    ) {
         if self.stale.is_empty() {
             return;
         }
@@ -276,9 +285,10 @@ impl TileSearch {
                     mask[f as usize] = true;
                 }
             }
-            side.set_directions_of(x, Some(&mask));
-            let slave_of = &self.slave_of[k];
             let sd: &Side = side;
+            masters[sd.surface].set_directions_of(sd, x, Some(&mask));
+            let boxes = &masters[sd.surface];
+            let slave_of = &self.slave_of[k];
             let built: Vec<_> = core
                 .par_iter()
                 .zip(&sets)
@@ -288,7 +298,7 @@ impl TileSearch {
                         .map(|&n| slave_of[n as usize])
                         .filter(|&si| si != u32::MAX)
                         .collect();
-                    sd.build_tile(x, skin, set, &slaves)
+                    sd.build_tile(x, skin, boxes, set, &slaves)
                 })
                 .collect();
             let ns = side.slaves.len();
