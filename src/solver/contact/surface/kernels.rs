@@ -248,9 +248,9 @@ pub(super) fn thickness_box(
     b
 }
 
-/// The unit directions m₊, m₋ of a face's envelope bounds (see `MasterBoxes::set_directions_of`);
-/// zero where the face has no normal or the direction is ill-defined (a zero direction
-/// never rejects: its bound is max_a t_a/2 ≥ 0).
+/// The unit directions m₊, m₋ of a face's envelope bounds (see
+/// `MasterBoxes::set_directions_of`); zero where the face has no normal or the direction
+/// is ill-defined (a zero direction never rejects: its bound is max_a t_a/2 ≥ 0).
 pub(super) fn envelope_directions(
     f: &[u32; 4],
     t: &[f64; 4],

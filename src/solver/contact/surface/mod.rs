@@ -317,10 +317,12 @@ const SKIN_PER_FACE: f64 = 0.5;
 
 /// The fraction of a side's slaves that its last narrow phase skipped from which the next
 /// step computes only the thickness boxes its narrow phase can read (`Side::stamp_needed`;
-/// on a master surface shared by several sides, when every one of them skipped so many). Measured on the 60 × 60 quarter to 60 µs, 2 threads,
-/// alternately with every box computed: the band patch (43 % of its slave-steps skipped)
-/// spent 1.8–1.9 s in the boxes against 1.4–1.7 s; the four-layer chain patch (91 %, its
-/// sides between layers nearly all) 30.8 and 33.1 s against 37.2 and 38.6 s in all.
+/// on a master surface shared by several sides, when every one of them skipped so many).
+/// Measured on the 60 × 60 quarter to 60 µs, 2 threads, alternately with every box
+/// computed, each side with boxes of its own then: the band patch (43 % of its
+/// slave-steps skipped) spent 1.8–1.9 s in the boxes against 1.4–1.7 s; the four-layer
+/// chain patch (91 %, its sides between layers nearly all) 30.8 and 33.1 s against 37.2
+/// and 38.6 s in all.
 const LAZY_BOXES_SKIPPED: f64 = 0.75;
 
 /// The largest total penalty factor that can act on one node: Σ κ_c over the contact
