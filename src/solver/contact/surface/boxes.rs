@@ -13,21 +13,8 @@ use std::sync::atomic::{AtomicU32, Ordering::Relaxed};
 
 use rayon::prelude::*;
 
-use super::kernels::{envelope_directions, thickness_box};
+use super::kernels::{envelope_directions, thickness_box, DEAD_BOX};
 use super::side::{Side, SLAVE_CHUNK};
-
-/// The thickness box of an eroded face: lo = +∞, hi = −∞ and envelope bounds −∞, so that
-/// every box test and envelope filter rejects it.
-pub(super) const DEAD_BOX: [f64; 8] = [
-    f64::INFINITY,
-    f64::INFINITY,
-    f64::INFINITY,
-    f64::NEG_INFINITY,
-    f64::NEG_INFINITY,
-    f64::NEG_INFINITY,
-    f64::NEG_INFINITY,
-    f64::NEG_INFINITY,
-];
 
 /// Faces per parallel task of the box updates.
 const FACE_CHUNK: usize = 4096;

@@ -572,20 +572,26 @@ mod tests {
             .collect();
         // Corners of boxes: on the boundary of the box, and of the grid.
         points.extend(boxes.iter().flat_map(|b| [b.0, b.1]));
-        let mut found = 0;
-        for p in &points {
-            let got: Vec<u32> = grid
-                .cell_of(p)
-                .iter()
-                .copied()
-                .filter(|&i| inside(p, &boxes[i as usize]))
-                .collect();
-            let want: Vec<u32> = (0..boxes.len() as u32)
-                .filter(|&i| inside(p, &boxes[i as usize]))
-                .collect();
-            assert_eq!(got, want, "point {p:?}");
-            found += want.len();
-        }
+        // Per point, the grid's entries whose box (among `bs`) holds it must be exactly the
+        // boxes that hold it by brute force; returns how many there were.
+        let check = |bs: &[([f64; 3], [f64; 3])], what: &str| -> usize {
+            let mut found = 0;
+            for p in &points {
+                let got: Vec<u32> = grid
+                    .cell_of(p)
+                    .iter()
+                    .copied()
+                    .filter(|&i| inside(p, &bs[i as usize]))
+                    .collect();
+                let want: Vec<u32> = (0..bs.len() as u32)
+                    .filter(|&i| inside(p, &bs[i as usize]))
+                    .collect();
+                assert_eq!(got, want, "point {p:?}, {what}");
+                found += want.len();
+            }
+            found
+        };
+        let found = check(&boxes, "the grid's boxes");
         assert!(
             found > points.len(),
             "the test must exercise overlaps: {found}"
@@ -600,20 +606,7 @@ mod tests {
             .iter()
             .map(|(a, b)| (a.map(|v| v + d), b.map(|v| v - d)))
             .collect();
-        let mut found_small = 0;
-        for p in &points {
-            let got: Vec<u32> = grid
-                .cell_of(p)
-                .iter()
-                .copied()
-                .filter(|&i| inside(p, &small[i as usize]))
-                .collect();
-            let want: Vec<u32> = (0..small.len() as u32)
-                .filter(|&i| inside(p, &small[i as usize]))
-                .collect();
-            assert_eq!(got, want, "point {p:?}, boxes less {d}");
-            found_small += want.len();
-        }
+        let found_small = check(&small, "the boxes less d = 0.15");
         assert!(
             found_small > points.len() / 10 && found_small < found,
             "the smaller boxes must hold fewer points, and some: {found_small} of {found}"

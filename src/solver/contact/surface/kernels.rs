@@ -213,6 +213,20 @@ pub(super) fn excess(p: &[f64; 3], b: &[f64; 8], m: &[f32; 6], nf: usize) -> f64
     fmax(e, fmax(up, dn))
 }
 
+/// The empty thickness box, that of an eroded face and the start of the folds of
+/// [`thickness_box`]: lo = +∞, hi = −∞ and envelope bounds −∞, so that
+/// every box test and envelope filter rejects it.
+pub(super) const DEAD_BOX: [f64; 8] = [
+    f64::INFINITY,
+    f64::INFINITY,
+    f64::INFINITY,
+    f64::NEG_INFINITY,
+    f64::NEG_INFINITY,
+    f64::NEG_INFINITY,
+    f64::NEG_INFINITY,
+    f64::NEG_INFINITY,
+];
+
 /// The thickness box of a face (`nf` nodes `f` of nodal thicknesses `t`) at `x`: the
 /// bounding box of the balls of radius t_a/2 about its nodes, (lo, hi); then the bounds
 /// h = max_a (m·x_a + t_a/2) of those balls along the face's two envelope directions
@@ -226,16 +240,7 @@ pub(super) fn thickness_box(
     x: &[[f64; 3]],
 ) -> [f64; 8] {
     let m: [f64; 6] = std::array::from_fn(|k| m[k] as f64);
-    let mut b = [
-        f64::INFINITY,
-        f64::INFINITY,
-        f64::INFINITY,
-        f64::NEG_INFINITY,
-        f64::NEG_INFINITY,
-        f64::NEG_INFINITY,
-        f64::NEG_INFINITY,
-        f64::NEG_INFINITY,
-    ];
+    let mut b = DEAD_BOX;
     for a in 0..nf {
         let (xa, r) = (&x[f[a] as usize], 0.5 * t[a]);
         for d in 0..3 {
