@@ -45,7 +45,7 @@ pub struct MasterBoxes {
     /// phase (zero for a segment or a face too distorted to have them).
     pub(super) face_dir: Vec<[f32; 6]>,
     /// Per face, the force evaluation whose narrow phase last needed its box, on any of
-    /// the sides ([`Side::stamp_needed`]).
+    /// the sides ([`stamp_sides`]).
     pub(super) stamp: Stamps,
     /// The sides that have this surface as master, ascending (the first gives the faces).
     pub(super) sides: Vec<usize>,
@@ -88,32 +88,6 @@ impl MasterBoxes {
             sides[k].surface = g;
         }
         out
-    }
-
-    /// The faces' thickness boxes at `x` (`sd`: a side of this surface), once per step, in
-    /// parallel (each candidate of the narrow phase then reads one box instead of
-    /// gathering its face's nodes; measured: those gathers were ~40 % of the narrow phase
-    /// of the woven patch). `stamp`: only the faces stamped with it (None: every face).
-    pub(super) fn update(&mut self, sd: &Side, x: &[[f64; 3]], stamp: Option<u32>) {
-        let (faces, face_t, nf) = (&sd.faces, &sd.face_t, sd.nf);
-        let (alive, any_dead) = (&sd.face_alive, sd.dead_faces > 0);
-        let (dirs, stamps) = (&self.face_dir, &self.stamp.0);
-        self.face_box
-            .par_chunks_mut(FACE_CHUNK)
-            .enumerate()
-            .for_each(|(c, bs)| {
-                for (j, b) in bs.iter_mut().enumerate() {
-                    let fi = c * FACE_CHUNK + j;
-                    if stamp.is_some_and(|e| stamps[fi].load(Relaxed) != e) {
-                        continue;
-                    }
-                    *b = if any_dead && !alive[fi] {
-                        DEAD_BOX
-                    } else {
-                        thickness_box(&faces[fi], &face_t[fi], &dirs[fi], nf, x)
-                    };
-                }
-            });
     }
 
     /// The widest thickness box of the step, per component [m] (eroded faces' boxes are
@@ -175,33 +149,91 @@ impl Side {
             self.dead_faces += 1;
         }
     }
+}
 
-    /// Stamps with `epoch` (this force evaluation's number, > 0), in `stamps` of this
-    /// side's master surface, the faces whose boxes this step's narrow phase can read: the
-    /// candidates of the slaves it does not skip (with the spreads `spread` of the skip
-    /// test, as `Side::narrow` decides). [`MasterBoxes::update`] then computes those
-    /// boxes; the others keep older ones, which nothing reads before the next build
-    /// computes every box again. Measured on the four-layer chain patch, 60 × 60 to
-    /// 30 µs, where 91 % of the slave-steps are skipped: the boxes took 10.3 of its
-    /// 40.7 s, 5.5 s of 33.6 s this way (each side its own boxes then).
-    pub(super) fn stamp_needed(&self, stamps: &Stamps, spread: &[f64], epoch: u32) {
-        let stamps = &stamps.0;
-        let (margin, cell) = (&self.margin, &self.slave_cell);
-        let (cand_at, lists) = (&self.cand_at, &self.lists);
-        (0..self.slaves.len().div_ceil(SLAVE_CHUNK))
-            .into_par_iter()
-            .for_each(|ci| {
-                let s0 = ci * SLAVE_CHUNK;
-                let s1 = (s0 + SLAVE_CHUNK).min(margin.len());
-                for si in s0..s1 {
-                    if margin[si] > spread[cell[si] as usize] {
-                        continue;
-                    }
-                    let [l, a, b] = cand_at[si];
-                    for &fi in &lists[l as usize][a as usize..b as usize] {
-                        stamps[fi as usize].store(epoch, Relaxed);
-                    }
-                }
-            });
+/// The faces' thickness boxes at `x` of each master surface in `surfaces` (with a side of
+/// it, which gives its faces, and a stamp: only the faces stamped with it, None: every
+/// face), once per step, in one parallel loop over all their chunks of faces (each
+/// candidate of the narrow phase then reads one box instead of gathering its face's
+/// nodes; measured: those gathers were ~40 % of the narrow phase of the woven patch).
+/// One loop rather than one per surface: a pack's eight surfaces were each a short
+/// parallel region, the idle thread asleep at its start (docs/benchmarks.md, "Two
+/// threads"); each chunk writes its own boxes, in any order.
+pub(super) fn update_surfaces<'a>(
+    surfaces: impl Iterator<Item = (&'a mut MasterBoxes, &'a Side, Option<u32>)>,
+    x: &[[f64; 3]],
+) {
+    let mut reads = Vec::new();
+    let mut tasks = Vec::new();
+    for (k, (mb, sd, stamp)) in surfaces.enumerate() {
+        let MasterBoxes {
+            ref mut face_box,
+            ref face_dir,
+            stamp: ref stamps,
+            ..
+        } = *mb;
+        reads.push((sd, face_dir, &stamps.0, stamp));
+        tasks.extend(
+            face_box
+                .chunks_mut(FACE_CHUNK)
+                .enumerate()
+                .map(|(c, bs)| (k, c, bs)),
+        );
     }
+    tasks.into_par_iter().for_each(|(k, c, bs)| {
+        let (sd, dirs, stamps, stamp) = reads[k];
+        let (faces, face_t, nf) = (&sd.faces, &sd.face_t, sd.nf);
+        let (alive, any_dead) = (&sd.face_alive, sd.dead_faces > 0);
+        for (j, b) in bs.iter_mut().enumerate() {
+            let fi = c * FACE_CHUNK + j;
+            if stamp.is_some_and(|e| stamps[fi].load(Relaxed) != e) {
+                continue;
+            }
+            *b = if any_dead && !alive[fi] {
+                DEAD_BOX
+            } else {
+                thickness_box(&faces[fi], &face_t[fi], &dirs[fi], nf, x)
+            };
+        }
+    });
+}
+
+/// Stamps with `epoch` (this force evaluation's number, > 0), for each side in `sides`
+/// into the stamps of its master surface, the faces whose boxes this step's narrow phase
+/// can read: the candidates of the slaves it does not skip (with the spreads `spread` of
+/// the skip test, as the narrow phase decides). [`update_surfaces`] then computes those
+/// boxes; the others keep older ones, which nothing reads before the next build computes
+/// every box again. Measured on the four-layer chain patch, 60 × 60 to 30 µs, where 91 %
+/// of the slave-steps are skipped: the boxes took 10.3 of its 40.7 s, 5.5 s of 33.6 s
+/// this way (each side its own boxes then). One parallel loop over every side's chunks
+/// of slaves, as [`update_surfaces`] is over the surfaces' (the stores are of one value:
+/// their order does not matter).
+pub(super) fn stamp_sides<'a>(
+    sides: impl Iterator<Item = (&'a Side, &'a Stamps)>,
+    spread: &[f64],
+    epoch: u32,
+) {
+    let sides: Vec<(&Side, &Stamps)> = sides.collect();
+    let tasks: Vec<(usize, usize)> = sides
+        .iter()
+        .enumerate()
+        .flat_map(|(k, (sd, _))| (0..sd.slaves.len().div_ceil(SLAVE_CHUNK)).map(move |c| (k, c)))
+        .collect();
+    tasks.into_par_iter().for_each(|(k, ci)| {
+        let (sd, stamps) = sides[k];
+        let stamps = &stamps.0;
+        let (margin, cell) = (&sd.margin, &sd.slave_cell);
+        let (cand_at, lists) = (&sd.cand_at, &sd.lists);
+        let s0 = ci * SLAVE_CHUNK;
+        let s1 = (s0 + SLAVE_CHUNK).min(margin.len());
+        for si in s0..s1 {
+            if margin[si] > spread[cell[si] as usize] {
+                continue;
+            }
+            let [l, a, b] = cand_at[si];
+            for &fi in &lists[l as usize][a as usize..b as usize] {
+                stamps[fi as usize].store(epoch, Relaxed);
+            }
+        }
+    });
 }

@@ -316,7 +316,7 @@ pub struct ContactPhases {
 const SKIN_PER_FACE: f64 = 0.5;
 
 /// The fraction of a side's slaves that its last narrow phase skipped from which the next
-/// step computes only the thickness boxes its narrow phase can read (`Side::stamp_needed`;
+/// step computes only the thickness boxes its narrow phase can read (`boxes::stamp_sides`;
 /// on a master surface shared by several sides, when every one of them skipped so many).
 /// Measured on the 60 × 60 quarter to 60 µs, 2 threads, alternately with every box
 /// computed, each side with boxes of its own then: the band patch (43 % of its
@@ -628,37 +628,58 @@ impl SurfaceContact {
 
     /// Every master surface's thickness boxes at `x`.
     fn update_all_boxes(&mut self, x: &[[f64; 3]]) {
-        for mb in &mut self.masters {
-            mb.update(&self.sides[mb.sides[0]], x, None);
-        }
+        let sides = &self.sides;
+        boxes::update_surfaces(
+            self.masters.iter_mut().map(|mb| {
+                let sd = &sides[mb.sides[0]];
+                (mb, sd, None)
+            }),
+            x,
+        );
     }
 
     /// The thickness boxes at `x` after the staleness test (`stale`: a build follows):
     /// every box at a build, and otherwise, on a surface all of whose sides' last narrow
     /// phases skipped most of their slaves, only the boxes of the candidates that this
-    /// step's narrow phases will test (each side stamps its own, [`Side::stamp_needed`]).
+    /// step's narrow phases will test (each side stamps its own, [`stamp_sides`](boxes::stamp_sides)).
     fn update_needed_boxes(&mut self, x: &[[f64; 3]], stale: bool) {
         // (The stamps wrap after 2³² evaluations: a face stamped then and not since would
         // be taken as needed, which costs a box, never a missed one.)
         let epoch = (self.evaluations as u32).max(1);
-        for mb in &mut self.masters {
-            // (Only where the last narrow phases skipped most slaves: marking the needed
-            // faces costs more than it saves where half of them search.)
-            let mostly = mb.sides.iter().all(|&k| {
-                let s = &self.sides[k];
-                let skipped: u64 = s.chunk_sums.iter().map(|c| c.skipped).sum();
-                skipped as f64 >= LAZY_BOXES_SKIPPED * s.slaves.len() as f64
-            });
-            if stale || !mostly {
-                mb.update(&self.sides[mb.sides[0]], x, None);
-            } else {
-                for &k in &mb.sides {
-                    self.sides[k].stamp_needed(&mb.stamp, self.motion.spread(), epoch);
-                }
-                mb.update(&self.sides[mb.sides[0]], x, Some(epoch));
-                self.lazy_boxes += mb.sides.len() as u64;
-            }
+        // (Only where the last narrow phases skipped most slaves: marking the needed
+        // faces costs more than it saves where half of them search.)
+        let sides = &self.sides;
+        let lazy: Vec<bool> = self
+            .masters
+            .iter()
+            .map(|mb| {
+                !stale
+                    && mb.sides.iter().all(|&k| {
+                        let s = &sides[k];
+                        let skipped: u64 = s.chunk_sums.iter().map(|c| c.skipped).sum();
+                        skipped as f64 >= LAZY_BOXES_SKIPPED * s.slaves.len() as f64
+                    })
+            })
+            .collect();
+        boxes::stamp_sides(
+            self.masters
+                .iter()
+                .zip(&lazy)
+                .filter(|(_, &l)| l)
+                .flat_map(|(mb, _)| mb.sides.iter().map(|&k| (&sides[k], &mb.stamp))),
+            self.motion.spread(),
+            epoch,
+        );
+        for (mb, _) in self.masters.iter().zip(&lazy).filter(|(_, &l)| l) {
+            self.lazy_boxes += mb.sides.len() as u64;
         }
+        boxes::update_surfaces(
+            self.masters.iter_mut().zip(&lazy).map(|(mb, &l)| {
+                let sd = &sides[mb.sides[0]];
+                (mb, sd, l.then_some(epoch))
+            }),
+            x,
+        );
     }
 
     /// Whether the candidate lists may miss a pair at `x` (see [`Staleness`]).
@@ -809,9 +830,21 @@ impl SurfaceContact {
         };
         let before = self.oracle.then(|| self.sides.clone());
         let spread = self.skip_far.then(|| spread_of(&self.tiles, &self.motion));
-        for s in &mut self.sides {
-            s.narrow(&self.masters[s.surface], x, v, dt, dt_prev, false, spread);
-            // Sums in chunk order: bit-identical for any thread count.
+        let masters = &self.masters;
+        narrow::narrow_sides(
+            self.sides.iter_mut().map(|s| {
+                let mb = &masters[s.surface];
+                (s, mb)
+            }),
+            x,
+            v,
+            dt,
+            dt_prev,
+            false,
+            spread,
+        );
+        for s in &self.sides {
+            // Sums in side and chunk order: bit-identical for any thread count.
             for c in &s.chunk_sums {
                 stored += c.stored;
                 self.dissipated += c.dissipated;

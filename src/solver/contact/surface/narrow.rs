@@ -281,6 +281,9 @@ struct Narrow<'a> {
     solid_t: f64,
     /// The deepest face alone takes the contact (see [`Side::deepest_only`]).
     deepest_only: bool,
+    /// Nodes per face, and whether the faces are a solid's (one-sided).
+    nf: usize,
+    one_sided: bool,
 }
 
 /// One fixed chunk of slaves as the narrow phase writes it: (chunk index, ((((results,
@@ -299,9 +302,14 @@ type Chunk<'c> = (
     ),
 );
 
+/// One chunk of one side's slaves as a task of the fused narrow phase: (side, the
+/// chunk, its forces on the nodes by node block where the gather is parallel).
+type Task<'c> = (usize, Chunk<'c>, Option<&'c mut ChunkContribs>);
+
 impl Side {
-    /// Narrow phase and friction for every slave, in parallel chunks, into `out`, with
-    /// the thickness boxes and envelope bounds `boxes` of its master surface.
+    /// Narrow phase and friction for every slave of this side alone, into `out`, with
+    /// the thickness boxes and envelope bounds `boxes` of its master surface (the setup,
+    /// the erosion probe and the oracle; a step runs every side at once, [`narrow_sides`]).
     /// `initial`: report penetrations instead of pushing (setup).
     /// `spread`: per cell of the staleness test, |S| of `Side::margin` at this step
     /// (None: no slave is skipped).
@@ -316,27 +324,66 @@ impl Side {
         initial: bool,
         spread: Option<&[f64]>,
     ) {
-        // One copy per face kind, so that the loops over a face's nodes are unrolled (and
-        // the solid's one-sided faces are a copy of their own: no branch in the others).
-        match (self.nf, self.solid.is_some()) {
-            (4, true) => self.narrow_n::<4, true>(boxes, x, v, dt, dt_prev, initial, spread),
-            (2, _) => self.narrow_n::<2, false>(boxes, x, v, dt, dt_prev, initial, spread),
-            (3, _) => self.narrow_n::<3, false>(boxes, x, v, dt, dt_prev, initial, spread),
-            _ => self.narrow_n::<4, false>(boxes, x, v, dt, dt_prev, initial, spread),
-        }
+        narrow_sides(
+            std::iter::once((self, boxes)),
+            x,
+            v,
+            dt,
+            dt_prev,
+            initial,
+            spread,
+        );
     }
 
+    /// What this side's narrow phase reads (borrowed from the side and its surface's
+    /// `boxes`), and its fixed chunks of slaves, each with the results, states and lists
+    /// it writes (`lists`: with its forces by node block, for the parallel gather).
     #[allow(clippy::too_many_arguments)]
-    fn narrow_n<const NF: usize, const SOLID: bool>(
-        &mut self,
-        boxes: &MasterBoxes,
-        x: &[[f64; 3]],
-        v: &[[f64; 3]],
+    fn narrow_parts<'a>(
+        &'a mut self,
+        boxes: &'a MasterBoxes,
+        x: &'a [[f64; 3]],
+        v: &'a [[f64; 3]],
         dt: f64,
         dt_prev: f64,
         initial: bool,
-        spread: Option<&[f64]>,
-    ) {
+        spread: Option<&'a [f64]>,
+        lists: bool,
+    ) -> (Narrow<'a>, Vec<(Chunk<'a>, Option<&'a mut ChunkContribs>)>) {
+        let nchunks = self.slaves.len().div_ceil(SLAVE_CHUNK);
+        self.chunk_active.resize_with(nchunks, Vec::new);
+        self.chunk_reactions.resize_with(nchunks, Vec::new);
+        self.chunk_sums.resize(nchunks, ChunkSums::default());
+        self.chunk_contribs
+            .resize_with(if lists { nchunks } else { 0 }, Default::default);
+        let Side {
+            ref margin,
+            ref slave_cell,
+            ref faces,
+            ref face_t,
+            ref face_m,
+            ref slaves,
+            ref slave_t,
+            ref slave_m,
+            ref cand_at,
+            ref lists,
+            friction,
+            kappa,
+            damping,
+            on_initial,
+            box_margin,
+            solid,
+            deepest_only,
+            nf,
+            ref mut out,
+            ref mut state,
+            ref mut held,
+            ref mut chunk_active,
+            ref mut chunk_reactions,
+            ref mut chunk_sums,
+            ref mut chunk_contribs,
+            ..
+        } = *self;
         let nar = Narrow {
             x,
             v,
@@ -346,103 +393,114 @@ impl Side {
             spread,
             face_box: &boxes.face_box,
             face_dir: &boxes.face_dir,
-            margin: &self.margin,
-            slave_cell: &self.slave_cell,
-            faces: &self.faces,
-            face_t: &self.face_t,
-            face_m: &self.face_m,
-            slaves: &self.slaves,
-            slave_t: &self.slave_t,
-            slave_m: &self.slave_m,
-            cand_at: &self.cand_at,
-            lists: &self.lists,
-            fr: self.friction,
-            kappa: self.kappa,
-            zeta: self.damping,
-            keep: self.on_initial == InitialPenetration::Keep,
-            eta: self.box_margin,
-            solid_t: self.solid.unwrap_or(0.0),
-            deepest_only: self.deepest_only,
+            margin,
+            slave_cell,
+            faces,
+            face_t,
+            face_m,
+            slaves,
+            slave_t,
+            slave_m,
+            cand_at,
+            lists,
+            fr: friction,
+            kappa,
+            zeta: damping,
+            keep: on_initial == InitialPenetration::Keep,
+            eta: box_margin,
+            solid_t: solid.unwrap_or(0.0),
+            deepest_only,
+            nf,
+            one_sided: solid.is_some(),
         };
-        let nchunks = self.slaves.len().div_ceil(SLAVE_CHUNK);
-        self.chunk_active.resize_with(nchunks, Vec::new);
-        self.chunk_reactions.resize_with(nchunks, Vec::new);
-        self.chunk_sums.resize(nchunks, ChunkSums::default());
-        // On more than one thread, each chunk also sorts its forces on the nodes by node
-        // block for the parallel gather, while its results are in cache.
-        let lists = rayon::current_num_threads() > 1;
-        self.chunk_contribs
-            .resize_with(if lists { nchunks } else { 0 }, Default::default);
-        let (slaves, faces, nf) = (&self.slaves, &self.faces, self.nf);
-        let bs = block_size(x.len());
-        let body = |(c, contribs): (Chunk, Option<&mut ChunkContribs>)| {
-            let (ci, ((((outs, (sts, held)), active), reactions), sums)) = c;
-            nar.chunk::<NF, SOLID>((
-                ci,
-                (
-                    (((&mut *outs, (sts, held)), &mut *active), &mut *reactions),
-                    sums,
-                ),
-            ));
-            if let Some(cc) = contribs {
-                let p = ChunkParts {
-                    slaves,
-                    faces,
-                    nf,
-                    first: ci * SLAVE_CHUNK,
-                    outs,
-                    active,
-                    reactions,
-                };
-                cc.fill(&p, bs);
-            }
-        };
-        let mut no_lists: Vec<Option<&mut ChunkContribs>> = Vec::new();
-        if self.slaves.len() <= SLAVE_CHUNK {
-            let contribs: Box<dyn Iterator<Item = Option<&mut ChunkContribs>>> = if lists {
-                Box::new(self.chunk_contribs.iter_mut().map(Some))
-            } else {
-                Box::new(std::iter::repeat_with(|| None))
-            };
-            self.out
-                .chunks_mut(SLAVE_CHUNK)
-                .zip(
-                    self.state
-                        .chunks_mut(SLAVE_CHUNK)
-                        .zip(self.held.chunks_mut(SLAVE_CHUNK)),
-                )
-                .zip(self.chunk_active.iter_mut())
-                .zip(self.chunk_reactions.iter_mut())
-                .zip(self.chunk_sums.iter_mut())
-                .enumerate()
-                .zip(contribs)
-                .for_each(body);
-        } else {
-            let contribs: Vec<Option<&mut ChunkContribs>> = if lists {
-                self.chunk_contribs.iter_mut().map(Some).collect()
-            } else {
-                no_lists.resize_with(nchunks, || None);
-                no_lists
-            };
-            self.out
-                .par_chunks_mut(SLAVE_CHUNK)
-                .zip(
-                    self.state
-                        .par_chunks_mut(SLAVE_CHUNK)
-                        .zip(self.held.par_chunks_mut(SLAVE_CHUNK)),
-                )
-                .zip(self.chunk_active.par_iter_mut())
-                .zip(self.chunk_reactions.par_iter_mut())
-                .zip(self.chunk_sums.par_iter_mut())
-                .enumerate()
-                .zip(contribs)
-                // A task per few chunks: the slaves in contact cluster under the nose, and
-                // rayon's default split leaves quarters of the range that a second thread
-                // cannot steal from (measured by thread in perf: the narrow phase's
-                // samples 14.8 % against 13.2 %, the second thread idle meanwhile).
-                .with_max_len(NARROW_TASK_CHUNKS)
-                .for_each(body);
+        let mut contribs = chunk_contribs.iter_mut();
+        let chunks = out
+            .chunks_mut(SLAVE_CHUNK)
+            .zip(
+                state
+                    .chunks_mut(SLAVE_CHUNK)
+                    .zip(held.chunks_mut(SLAVE_CHUNK)),
+            )
+            .zip(chunk_active.iter_mut())
+            .zip(chunk_reactions.iter_mut())
+            .zip(chunk_sums.iter_mut())
+            .enumerate()
+            .map(|c| (c, contribs.next()))
+            .collect();
+        (nar, chunks)
+    }
+}
+
+/// The narrow phase and friction of every side of `sides` (each with the boxes of its
+/// master surface) at one step, in one parallel loop over all their chunks of slaves: a
+/// pack's many sides, most of whose slaves are skipped, would otherwise each be a short
+/// parallel region, the idle thread asleep at its start (docs/benchmarks.md, "Two
+/// threads"). Each chunk writes only its own results, states and lists, so the bits do
+/// not depend on which thread takes it or when.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn narrow_sides<'a>(
+    sides: impl Iterator<Item = (&'a mut Side, &'a MasterBoxes)>,
+    x: &'a [[f64; 3]],
+    v: &'a [[f64; 3]],
+    dt: f64,
+    dt_prev: f64,
+    initial: bool,
+    spread: Option<&'a [f64]>,
+) {
+    // On more than one thread, each chunk also sorts its forces on the nodes by node
+    // block for the parallel gather, while its results are in cache.
+    let lists = rayon::current_num_threads() > 1;
+    let bs = block_size(x.len());
+    let mut nars = Vec::new();
+    let mut tasks: Vec<Task> = Vec::new();
+    for (k, (side, boxes)) in sides.enumerate() {
+        let (nar, chunks) = side.narrow_parts(boxes, x, v, dt, dt_prev, initial, spread, lists);
+        tasks.extend(chunks.into_iter().map(|(c, cc)| (k, c, cc)));
+        nars.push(nar);
+    }
+    let body = |(k, c, contribs): Task| {
+        let nar = &nars[k];
+        let (ci, ((((outs, (sts, held)), active), reactions), sums)) = c;
+        let c = (
+            ci,
+            (
+                (((&mut *outs, (sts, held)), &mut *active), &mut *reactions),
+                sums,
+            ),
+        );
+        // One copy per face kind, so that the loops over a face's nodes are unrolled
+        // (and the solid's one-sided faces are a copy of their own: no branch in the
+        // others).
+        match (nar.nf, nar.one_sided) {
+            (4, true) => nar.chunk::<4, true>(c),
+            (2, _) => nar.chunk::<2, false>(c),
+            (3, _) => nar.chunk::<3, false>(c),
+            _ => nar.chunk::<4, false>(c),
         }
+        if let Some(cc) = contribs {
+            let p = ChunkParts {
+                slaves: nar.slaves,
+                faces: nar.faces,
+                nf: nar.nf,
+                first: ci * SLAVE_CHUNK,
+                outs,
+                active,
+                reactions,
+            };
+            cc.fill(&p, bs);
+        }
+    };
+    if tasks.len() <= 1 {
+        tasks.into_iter().for_each(body);
+    } else {
+        tasks
+            .into_par_iter()
+            // A task per few chunks: the slaves in contact cluster under the nose, and
+            // rayon's default split leaves quarters of the range that a second thread
+            // cannot steal from (measured by thread in perf: the narrow phase's
+            // samples 14.8 % against 13.2 %, the second thread idle meanwhile).
+            .with_max_len(NARROW_TASK_CHUNKS)
+            .for_each(body);
     }
 }
 
