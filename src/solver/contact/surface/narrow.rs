@@ -337,7 +337,7 @@ impl Side {
 
     /// What this side's narrow phase reads (borrowed from the side and its surface's
     /// `boxes`), and its fixed chunks of slaves, each with the results, states and lists
-    /// it writes (`lists`: with its forces by node block, for the parallel gather).
+    /// it writes (`by_block`: with its forces by node block, for the parallel gather).
     #[allow(clippy::too_many_arguments)]
     fn narrow_parts<'a>(
         &'a mut self,
@@ -348,14 +348,14 @@ impl Side {
         dt_prev: f64,
         initial: bool,
         spread: Option<&'a [f64]>,
-        lists: bool,
+        by_block: bool,
     ) -> (Narrow<'a>, Vec<(Chunk<'a>, Option<&'a mut ChunkContribs>)>) {
         let nchunks = self.slaves.len().div_ceil(SLAVE_CHUNK);
         self.chunk_active.resize_with(nchunks, Vec::new);
         self.chunk_reactions.resize_with(nchunks, Vec::new);
         self.chunk_sums.resize(nchunks, ChunkSums::default());
         self.chunk_contribs
-            .resize_with(if lists { nchunks } else { 0 }, Default::default);
+            .resize_with(if by_block { nchunks } else { 0 }, Default::default);
         let Side {
             ref margin,
             ref slave_cell,
@@ -449,12 +449,12 @@ pub(super) fn narrow_sides<'a>(
 ) {
     // On more than one thread, each chunk also sorts its forces on the nodes by node
     // block for the parallel gather, while its results are in cache.
-    let lists = rayon::current_num_threads() > 1;
+    let by_block = rayon::current_num_threads() > 1;
     let bs = block_size(x.len());
     let mut nars = Vec::new();
     let mut tasks: Vec<Task> = Vec::new();
     for (k, (side, boxes)) in sides.enumerate() {
-        let (nar, chunks) = side.narrow_parts(boxes, x, v, dt, dt_prev, initial, spread, lists);
+        let (nar, chunks) = side.narrow_parts(boxes, x, v, dt, dt_prev, initial, spread, by_block);
         tasks.extend(chunks.into_iter().map(|(c, cc)| (k, c, cc)));
         nars.push(nar);
     }
