@@ -63,7 +63,7 @@ src = {m: strip(p.read_text()) for m, p in files.items()}
 # cut #[cfg(test)] mod tests { ... } blocks: tests may import anything
 def cut_tests(t):
     out, i = [], 0
-    for m in re.finditer(r'#\[cfg\(test\)\]\s*(pub\s+)?mod\s+\w+\s*\{', t):
+    for m in re.finditer(r'#\[cfg\(test\)\]\s*(pub(\([^)]*\))?\s+)?mod\s+\w+\s*\{', t):
         if m.start() < i:
             continue
         out.append(t[i:m.start()])

@@ -48,10 +48,10 @@
 use std::path::Path;
 
 use crate::error::{Result, WeftError};
+use crate::material;
 use crate::model::{ElementKind, Model};
 use crate::solver::membrane::{self, Material, Reference};
 use crate::solver::output::SolidValues;
-use crate::solver::solid::material;
 use crate::solver::{truss, Energies, Sink};
 use crate::table::{batch, write_table, Col, Provenance};
 

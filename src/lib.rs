@@ -17,14 +17,17 @@ pub mod export;
 pub mod fit;
 pub mod form;
 pub mod generate;
+pub mod material;
 pub mod model;
 pub mod pipeline;
 pub mod plot;
 pub mod random;
+pub mod shape;
 pub mod simulate;
 pub mod solver;
 pub mod surrogate;
 pub mod table;
+pub mod vec3;
 pub mod vtk;
 
 pub use error::{Result, WeftError};

@@ -17,9 +17,9 @@ use common::solid::on_threads;
 use weft::generate::bullet::{BulletKind, BulletParams};
 use weft::generate::woven::{woven, WovenBandParams, YarnFailure, YarnModel};
 use weft::generate::woven_reduced::{woven_reduced, WovenParams};
+use weft::material::pressure;
 use weft::model::Model;
-use weft::solver::solid::kernel::hex_geometry;
-use weft::solver::solid::material::pressure;
+use weft::shape::hex8::hex_geometry;
 use weft::solver::{run_in_memory, RunStats, Solver};
 
 fn patch(kind: BulletKind, velocity: f64, end_time: f64) -> Model {

@@ -51,7 +51,7 @@ pub const FAILED_T: f64 = 4.0;
 fn slot<'a>(p: &'a mut PartProps, name: &str) -> Option<&'a mut Option<f64>> {
     match props::property(name)?.access {
         props::Access::F64 { slot, .. } => Some(slot(p)),
-        props::Access::Bool { .. } => None,
+        props::Access::Bool { .. } | props::Access::Str { .. } => None,
     }
 }
 

@@ -63,6 +63,11 @@ pub enum Access {
         get: fn(&PartProps) -> Option<bool>,
         slot: fn(&mut PartProps) -> &mut Option<bool>,
     },
+    /// A name (the `material` law); its column is written only when some part sets it.
+    Str {
+        get: fn(&PartProps) -> Option<String>,
+        slot: fn(&mut PartProps) -> &mut Option<String>,
+    },
 }
 
 /// One part property (a nullable column of `parts.parquet`).
@@ -139,6 +144,22 @@ macro_rules! part_properties {
             },
             slot: {
                 fn slot(p: &mut PartProps) -> &mut Option<f64> {
+                    &mut p.$field
+                }
+                slot
+            },
+        }
+    };
+    (@access String $field:ident) => {
+        Access::Str {
+            get: {
+                fn get(p: &PartProps) -> Option<String> {
+                    p.$field.clone()
+                }
+                get
+            },
+            slot: {
+                fn slot(p: &mut PartProps) -> &mut Option<String> {
                     &mut p.$field
                 }
                 slot
@@ -525,6 +546,17 @@ part_properties! {
         aliases: [],
         meaning: "a hexahedron is eroded (removed) when its equivalent plastic strain reaches it",
     },
+    material: String {
+        unit: "",
+        // Checked against the laws' names when the part's material is built.
+        kinds: [Hex: Rule::Free],
+        null: null(
+            "the law the part's columns select",
+            "`yield_stress` selects j2, `jc_a` johnson_cook, neither the elastic law; the column is written only when some part names a law",
+        ),
+        aliases: [],
+        meaning: "the material law of a solid part, by name: `elastic`, `j2`, `johnson_cook` (src/material/)",
+    },
 }
 
 impl PartProps {
@@ -532,6 +564,16 @@ impl PartProps {
     /// descriptor's null; a unit test holds the two equal).
     pub fn hourglass_coefficient(&self) -> f64 {
         self.hourglass.unwrap_or(0.1)
+    }
+}
+
+/// A part's numeric columns by name, as the material laws read them.
+impl crate::material::Columns for PartProps {
+    fn f64(&self, name: &str) -> Option<f64> {
+        match property(name).map(|p| p.access) {
+            Some(Access::F64 { get, .. }) => get(self),
+            _ => None,
+        }
     }
 }
 
@@ -669,18 +711,34 @@ pub fn read_columns(t: &Table, rows: usize) -> Result<Vec<PartProps>> {
                     }
                 }
             }
+            Access::Str { slot, .. } => {
+                if let Some(col) = t.str_opt(p.name)? {
+                    for (q, v) in out.iter_mut().zip(col) {
+                        *slot(q) = v;
+                    }
+                }
+            }
         }
     }
     Ok(out)
 }
 
-/// The property columns of `parts.parquet`, every one, in table order.
+/// The property columns of `parts.parquet` in table order: every numeric and boolean
+/// one, and a name column (`material`) only when some part sets it.
 pub fn columns<'a>(props: impl Iterator<Item = &'a PartProps> + Clone) -> Vec<Col> {
     PROPERTIES
         .iter()
-        .map(|p| match p.access {
-            Access::F64 { get, .. } => Col::OptF64(p.name, props.clone().map(get).collect()),
-            Access::Bool { get, .. } => Col::OptBool(p.name, props.clone().map(get).collect()),
+        .filter_map(|p| match p.access {
+            Access::F64 { get, .. } => Some(Col::OptF64(p.name, props.clone().map(get).collect())),
+            Access::Bool { get, .. } => {
+                Some(Col::OptBool(p.name, props.clone().map(get).collect()))
+            }
+            Access::Str { get, .. } => {
+                let v: Vec<Option<String>> = props.clone().map(get).collect();
+                v.iter()
+                    .any(Option::is_some)
+                    .then_some(Col::OptStr(p.name, v))
+            }
         })
         .collect()
 }
@@ -704,6 +762,7 @@ pub fn parts_table_markdown() -> String {
         let ty = match p.access {
             Access::F64 { .. } => "float64, nullable",
             Access::Bool { .. } => "bool, nullable",
+            Access::Str { .. } => "string, nullable, optional",
         };
         let unit = if p.unit.is_empty() { "–" } else { p.unit };
         let kinds: Vec<&str> = ElementKind::ALL
@@ -785,6 +844,10 @@ mod tests {
                     *slot(&mut q) = Some(true);
                     assert_eq!(get(&q), Some(true), "{}", p.name);
                 }
+                Access::Str { get, slot } => {
+                    *slot(&mut q) = Some(p.name.to_string());
+                    assert_eq!(get(&q).as_deref(), Some(p.name), "{}", p.name);
+                }
             }
             // Exactly one field was set.
             let set = PROPERTIES
@@ -792,9 +855,29 @@ mod tests {
                 .filter(|o| match o.access {
                     Access::F64 { get, .. } => get(&q).is_some(),
                     Access::Bool { get, .. } => get(&q).is_some(),
+                    Access::Str { get, .. } => get(&q).is_some(),
                 })
                 .count();
             assert_eq!(set, 1, "{}", p.name);
+        }
+    }
+
+    /// Every column a material law reads is a numeric property of hexahedra (a law
+    /// reads its constants by name, so a misspelt name would read null).
+    #[test]
+    fn material_laws_read_hex_properties() {
+        let shared: &[&str] = &[
+            "youngs_modulus",
+            "poisson_ratio",
+            "density",
+            "erosion_plastic_strain",
+        ];
+        for (law, _, cols) in crate::material::Law::ALL {
+            for c in cols.iter().chain(shared) {
+                let p = property(c).unwrap_or_else(|| panic!("law {law} reads `{c}`"));
+                assert!(matches!(p.access, Access::F64 { .. }), "{law}: `{c}`");
+                assert!(p.rule(Hex).is_some(), "{law}: `{c}` does not apply to hex");
+            }
         }
     }
 

@@ -20,6 +20,15 @@ pub struct Part {
     pub props: PartProps,
 }
 
+impl Part {
+    /// The material of a solid part: E, ν, ρ, the law its `material` column names or
+    /// its columns select, and its erosion ([`Material::of_part`]); an error names the
+    /// part.
+    pub fn material(&self) -> crate::error::Result<crate::material::Material> {
+        crate::material::Material::of_part(&self.name, self.props.material.as_deref(), &self.props)
+    }
+}
+
 /// Elements of one kind, struct-of-arrays; `nodes` holds `nodes_per_element` node
 /// indices per element.
 #[derive(Debug, Clone, Default, PartialEq)]

@@ -204,7 +204,7 @@ impl Model {
             }
         }
         let x: [[f64; 3]; 8] = std::array::from_fn(|a| self.coords[ns[a]]);
-        let j = crate::solver::solid::kernel::jacobian_at_nodes(&x);
+        let j = crate::shape::hex8::jacobian_at_nodes(&x);
         if let Some(a) = (0..8).find(|&a| !(j[a] > 0.0)) {
             return Err(WeftError::input(format!(
                 "hexahedron `{id}` (nodes {}) has a Jacobian determinant {:.3e} ≤ 0 at its node `{}` (n{})",
@@ -747,7 +747,7 @@ pub fn validate_part(p: &Part) -> Result<()> {
         ElementKind::Tri | ElementKind::Quad => validate_membrane_part(p),
         // The material's constants that involve each other (E_t < E, T_room < T_melt,
         // Johnson–Cook's n ≤ 1, χ ≤ 1, one plasticity model).
-        ElementKind::Hex => crate::solver::solid::hex::part_material(&p.name, &p.props).map(|_| ()),
+        ElementKind::Hex => p.material().map(|_| ()),
         _ => Ok(()),
     }
 }

@@ -55,7 +55,8 @@ pub mod statics;
 pub mod ties;
 pub mod truss;
 mod variable_step;
-pub mod vec3;
+/// The small vector helpers, shared below the solver ([`crate::vec3`]).
+pub use crate::vec3;
 pub mod watch;
 
 use std::time::{Duration, Instant};

@@ -4,12 +4,12 @@
 //! Each step (Belytschko, Liu & Moran, *Nonlinear Finite Elements*, Box 6.1; the
 //! Flanagan–Belytschko element, IJNME 17 (1981)), with v = v^{n−½} and Δt = Δt^{n−½}:
 //! 1. the rate of deformation D and the spin W from the mean gradient operator at the
-//!    mid-step configuration x^{n−½} = x^n − ½Δt v ([`kernel::hex_geometry`]);
+//!    mid-step configuration x^{n−½} = x^n − ½Δt v ([`hex8::hex_geometry`]);
 //! 2. the stress is rotated by the Hughes–Winget increment R = (I − ½WΔt)⁻¹(I + ½WΔt):
 //!    exactly orthogonal, so a rigid rotation leaves its invariants unchanged (objective;
 //!    chosen over the Jaumann rate's σ += (Wσ − σW)Δt, which is orthogonal only to first
 //!    order and lets a long rigid spin grow the stress);
-//! 3. the material updates the stress from the strain increment DΔt ([`material::update`]:
+//! 3. the material updates the stress from the strain increment DΔt ([`Material::update`]:
 //!    hypoelastic trial, radial return);
 //! 4. the nodal forces f_a = −V σ̃ b_a at x^n with σ̃ = σ − q I, q the bulk viscosity
 //!    (LS-DYNA's defaults Q₁ = 1.5, Q₂ = 0.06), plus the viscous hourglass forces of
@@ -36,84 +36,16 @@
 //! test), which the fixed step does not follow: [`HexGroup::add_stiffening`] lets the
 //! run's stiffening check stop it, naming the element, before it goes unstable.
 
-use super::kernel::{self, HexGeometry, BULK_Q1, BULK_Q2};
-use super::material::{self, Hardening, JohnsonCook, Material, Model, PointState};
-use crate::error::{Result, WeftError};
-use crate::model::{ElementKind, PartProps};
+use super::kernel::{self, BULK_Q1, BULK_Q2};
+use crate::error::Result;
+use crate::material::{Material, PointState};
+use crate::model::ElementKind;
+use crate::shape::hex8::{self, HexGeometry};
 use crate::solver::family::{
     chunk_partials, Build, EnergyGroup, EnergyPartial, Family, ForceCtx, StiffCtx, CHUNK,
 };
 use crate::solver::output::SolidValues;
 use crate::solver::vec3::Vec3;
-
-/// The material of a part's hexahedra, from its columns (`docs/tables.md`): elastic;
-/// J2 with `yield_stress` (bilinear with `tangent_modulus`); Johnson–Cook with `jc_a`.
-pub fn part_material(name: &str, p: &PartProps) -> Result<Material> {
-    let e = p.youngs_modulus.unwrap_or(f64::NAN);
-    let nu = p.poisson_ratio.unwrap_or(0.3);
-    let rho = p.density.unwrap_or(f64::NAN);
-    let in_part = |err: WeftError| {
-        WeftError::input(format!("part `{name}` (hex): {err}"))
-            .in_file("parts.parquet")
-            .hint("see docs/tables.md, parts.parquet: the solid's material columns")
-    };
-    let model =
-        match (p.yield_stress, p.jc_a) {
-            (Some(_), Some(_)) => return Err(WeftError::input(format!(
-                "part `{name}` (hex) has both `yield_stress` and `jc_a`"
-            ))
-            .in_file("parts.parquet")
-            .expected(
-                "one plasticity model: J2 (yield_stress, tangent_modulus) or Johnson–Cook (jc_a …)",
-            )),
-            (Some(sy), None) => Model::J2 {
-                yield_stress: sy,
-                hardening: Hardening::from_tangent_modulus(e, p.tangent_modulus.unwrap_or(0.0))
-                    .map_err(in_part)?,
-            },
-            (None, Some(a)) => {
-                // Without m (or T_melt) no thermal softening, without c_p no heating: the
-                // material's T_melt and c_p then stand at f64::MAX, which makes T* = 0 and
-                // ΔT = 0 (to round-off) without a second code path.
-                let softening = p.jc_m.is_some() && p.melt_temperature.is_some();
-                if p.jc_m.is_some() != p.melt_temperature.is_some() {
-                    return Err(WeftError::input(format!(
-                        "part `{name}` (hex) has {} without {}",
-                        if p.jc_m.is_some() {
-                            "`jc_m`"
-                        } else {
-                            "`melt_temperature`"
-                        },
-                        if p.jc_m.is_some() {
-                            "`melt_temperature`"
-                        } else {
-                            "`jc_m`"
-                        },
-                    ))
-                    .in_file("parts.parquet")
-                    .expected("both (thermal softening) or neither"));
-                }
-                Model::JohnsonCook(JohnsonCook {
-                    a,
-                    b: p.jc_b.unwrap_or(0.0),
-                    n: p.jc_n.unwrap_or(1.0),
-                    c: p.jc_c.unwrap_or(0.0),
-                    reference_rate: p.jc_reference_rate.unwrap_or(1.0),
-                    m: if softening { p.jc_m.unwrap() } else { 1.0 },
-                    room_temperature: p.room_temperature.unwrap_or(material::DEFAULT_TEMPERATURE),
-                    melt_temperature: if softening {
-                        p.melt_temperature.unwrap()
-                    } else {
-                        f64::MAX
-                    },
-                    specific_heat: p.specific_heat.unwrap_or(f64::MAX),
-                    taylor_quinney: p.taylor_quinney.unwrap_or(material::TAYLOR_QUINNEY),
-                })
-            }
-            (None, None) => Model::Elastic,
-        };
-    Material::new(e, nu, rho, model, p.erosion_plastic_strain).map_err(in_part)
-}
 
 /// Hexahedra, struct-of-arrays.
 #[derive(Debug, Clone, Default)]
@@ -217,21 +149,21 @@ fn element_step(
     if dt > 0.0 {
         let xm: [Vec3; 8] =
             std::array::from_fn(|a| std::array::from_fn(|i| x[a][i] - 0.5 * dt * v[a][i]));
-        let gm = kernel::hex_geometry(&xm);
+        let gm = hex8::hex_geometry(&xm);
         let l = kernel::velocity_gradient(&gm.b, v);
         let (d, w) = kernel::split_velocity_gradient(&l);
         let r = kernel::hughes_winget(&w, dt);
         kernel::rotate_stress(&mut st.stress, &r);
         let before = st.stress;
         let deps: [f64; 6] = std::array::from_fn(|i| d[i] * dt);
-        material::update(mat, st, &deps, dt);
+        mat.update(st, &deps, dt);
         let mid: [f64; 6] = std::array::from_fn(|i| 0.5 * (before[i] + st.stress[i]));
         work[0] += contract(&mid, &deps) * gm.volume;
         d_mid = d;
         v_mid = gm.volume;
     }
     // 4: forces at xⁿ.
-    let g: HexGeometry = kernel::hex_geometry(x);
+    let g: HexGeometry = hex8::hex_geometry(x);
     let c = mat.dilatational_wave_speed();
     let mut s = st.stress;
     let mut f = [[0.0; 3]; 8];
@@ -239,8 +171,8 @@ fn element_step(
     if dt > 0.0 {
         let l = kernel::velocity_gradient(&g.b, v);
         let d_kk = l[0][0] + l[1][1] + l[2][2];
-        let le = kernel::characteristic_length(x, g.volume);
-        q = kernel::bulk_viscosity(mat.density, le, c, d_kk, BULK_Q1, BULK_Q2);
+        let le = hex8::characteristic_length(x, g.volume);
+        q = kernel::bulk_viscosity(mat.density(), le, c, d_kk, BULK_Q1, BULK_Q2);
         s[0] -= q;
         s[1] -= q;
         s[2] -= q;
@@ -254,7 +186,7 @@ fn element_step(
     // energy ½ m v^{−½}·v^{½} at t = 0 would count their first half step twice.
     if q_hg > 0.0 && dt > 0.0 {
         let gamma = kernel::hourglass_gamma(x, &g.b);
-        let coef = 16.0 * kernel::hourglass_coefficient(q_hg, mat.density, c, g.volume);
+        let coef = 16.0 * kernel::hourglass_coefficient(q_hg, mat.density(), c, g.volume);
         // Flanagan & Belytschko's viscous form: mode forces coef·q_α, nodal forces
         // f_a = −Σ_α γ_aα coef q_α.
         let cq = kernel::hourglass_mode_forces(&gamma, v, coef);
@@ -317,8 +249,8 @@ impl HexGroup {
                 }
                 let ns = &self.nodes[e];
                 let xe: [Vec3; 8] = std::array::from_fn(|a| x[ns[a] as usize]);
-                let g = kernel::hex_geometry(&xe);
-                let l = kernel::characteristic_length(&xe, g.volume);
+                let g = hex8::hex_geometry(&xe);
+                let l = hex8::characteristic_length(&xe, g.volume);
                 let (lam, mu) = self.mat(e).lame();
                 let now = gershgorin_rows(&g, lam, mu);
                 let add = std::array::from_fn(|a| now[a] - self.rows[e][a]);
@@ -358,7 +290,7 @@ impl Family for HexGroup {
             let mi = match by_part[pi] {
                 Some(i) => i,
                 None => {
-                    g.materials.push(part_material(&part.name, &part.props)?);
+                    g.materials.push(part.material()?);
                     let i = (g.materials.len() - 1) as u32;
                     by_part[pi] = Some(i);
                     i
@@ -366,11 +298,11 @@ impl Family for HexGroup {
             };
             let ns: [usize; 8] = std::array::from_fn(|a| b.nodes[8 * e + a]);
             let x: [Vec3; 8] = std::array::from_fn(|a| m.coords[ns[a]]);
-            let geo = kernel::hex_geometry(&x);
+            let geo = hex8::hex_geometry(&x);
             let mat = &g.materials[mi as usize];
             // Lumped mass: an eighth of ρV to each node.
             for &n in &ns {
-                mass[n] += 0.125 * mat.density * geo.volume;
+                mass[n] += 0.125 * mat.density() * geo.volume;
             }
             g.id.push(b.id[e]);
             g.nodes.push(ns.map(|n| n as u32));
@@ -379,7 +311,7 @@ impl Family for HexGroup {
             g.state.push(mat.initial_state());
             g.work.push([0.0; 3]);
             g.previous.push(Previous::default());
-            g.l0.push(kernel::characteristic_length(&x, geo.volume));
+            g.l0.push(hex8::characteristic_length(&x, geo.volume));
             g.v0.push(geo.volume);
             let (lam, mu) = mat.lame();
             g.rows.push(gershgorin_rows(&geo, lam, mu));
@@ -460,7 +392,7 @@ impl Family for HexGroup {
         for (e, ns) in self.nodes.iter().enumerate() {
             let mat = self.mat(e);
             let (v, l) = (self.v0[e], self.l0[e]);
-            let ce = mat.density * v * BULK_Q2 * mat.dilatational_wave_speed() / (2.0 * l);
+            let ce = mat.density() * v * BULK_Q2 * mat.dilatational_wave_speed() / (2.0 * l);
             for (a, &n) in ns.iter().enumerate() {
                 s[n as usize] += self.rows[e][a];
                 c[n as usize] += ce;

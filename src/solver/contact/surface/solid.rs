@@ -43,8 +43,8 @@
 
 use super::kernels::Hit;
 use crate::model::{ElementKind, Model};
+use crate::shape::hex8::FACES as HEX_FACES;
 use crate::solver::contact::closest::closest_on_quad;
-use crate::solver::solid::kernel::FACES as HEX_FACES;
 use crate::solver::vec3::{cross, dot, sub};
 
 /// The depth behind a face that is still caught, as a fraction of R (when above the

@@ -33,6 +33,20 @@ pub fn cross(a: &Vec3, b: &Vec3) -> Vec3 {
     ]
 }
 
+/// The triple product [p, q, r] = p·(q × r).
+#[inline(always)]
+pub fn triple(p: &Vec3, q: &Vec3, r: &Vec3) -> f64 {
+    dot(p, &cross(q, r))
+}
+
+/// y += s x.
+#[inline(always)]
+pub fn axpy(y: &mut Vec3, s: f64, x: &Vec3) {
+    y[0] += s * x[0];
+    y[1] += s * x[1];
+    y[2] += s * x[2];
+}
+
 #[inline(always)]
 pub fn scale(a: &Vec3, s: f64) -> Vec3 {
     [a[0] * s, a[1] * s, a[2] * s]
