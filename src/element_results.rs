@@ -20,9 +20,9 @@
 //!   without the hourglass part ([`crate::solver::membrane`]);
 //! - hex: the integration point's state, which depends on the path and not on the
 //!   positions alone, handed over by the solver at its sample steps
-//!   ([`crate::solver::Sink::solids`], the elements of
-//!   [`crate::solver::solid::hex::HexGroup::output`], which the simulate stage sets to
-//!   [`ElementResults::hex_elements`]; the hex nodes need no history):
+//!   ([`crate::solver::Sink::element_states`], of the elements the simulate stage chooses
+//!   with [`crate::solver::Solver::sample_states_of`]: [`ElementResults::hex_elements`];
+//!   the hex nodes need no history):
 //!   `plastic_strain` the equivalent plastic strain ε_p = ∫√(⅔ ε̇ᵖ:ε̇ᵖ) dt,
 //!   `temperature` T [K] (Johnson–Cook: from the part's `room_temperature` up by the
 //!   adiabatic heating; J2 and elastic parts: 293.15 K throughout), `pressure` p = −tr σ/3 [Pa] (compression
@@ -51,7 +51,7 @@ use crate::error::{Result, WeftError};
 use crate::material;
 use crate::model::{ElementKind, Model};
 use crate::solver::membrane::{self, Material, Reference};
-use crate::solver::output::SolidValues;
+use crate::solver::output::StateValues;
 use crate::solver::{truss, Energies, Sink};
 use crate::table::{batch, write_table, Col, Provenance};
 
@@ -263,7 +263,7 @@ impl ElementResults {
     }
 
     /// The selected hexahedra, as rows of the model's hex table (the indices of the
-    /// solver's hex family): what [`crate::solver::solid::hex::HexGroup::output`] must
+    /// solver's hex family): what [`crate::solver::Solver::sample_states_of`] must
     /// hold for the run to hand over their states.
     pub fn hex_elements(&self) -> &[u32] {
         &self.hex
@@ -271,14 +271,14 @@ impl ElementResults {
 
     /// Add the hexahedra's rows of output time `t` from their states (in the order of
     /// [`ElementResults::hex_elements`]).
-    pub fn sample_solids(&mut self, t: f64, states: &[SolidValues]) -> Result<()> {
+    pub fn sample_solids(&mut self, t: f64, states: &[StateValues]) -> Result<()> {
         if states.len() != self.hex.len() {
             return Err(WeftError::input(format!(
                 "element results: the run handed over {} hexahedra at t = {t:e} s, {} were selected",
                 states.len(),
                 self.hex.len()
             ))
-            .hint("set the solver's hex output to ElementResults::hex_elements before the run"));
+            .hint("choose the hexahedra with Solver::sample_states_of(ElementKind::Hex, ElementResults::hex_elements()) before the run"));
         }
         for (j, st) in states.iter().enumerate() {
             let s: [f64; 6] = std::array::from_fn(|c| st[c]);
@@ -486,8 +486,8 @@ impl<S: Sink> Sink for WithElementResults<'_, S> {
     fn layers(&mut self, t: f64, rows: &[crate::solver::watch::LayerValues]) -> Result<()> {
         self.inner.layers(t, rows)
     }
-    fn solids(&mut self, t: f64, rows: &[SolidValues]) -> Result<()> {
+    fn element_states(&mut self, t: f64, rows: &[StateValues]) -> Result<()> {
         self.results.sample_solids(t, rows)?;
-        self.inner.solids(t, rows)
+        self.inner.element_states(t, rows)
     }
 }

@@ -10,7 +10,7 @@ use serde::Serialize;
 use crate::element_results::{ElementResults, WithElementResults};
 use crate::error::{Result, WeftError};
 use crate::model::io::read_model;
-use crate::model::Model;
+use crate::model::{ElementKind, Model};
 use crate::solver::output::ParquetSink;
 use crate::solver::{RunStats, Solver};
 use crate::table::{batch, write_table, Col, Provenance};
@@ -184,7 +184,7 @@ pub fn run(c: &Config, progress: &mut (dyn FnMut(f64) + Send)) -> Result<Report>
         .transpose()?;
     if let Some(e) = &elements {
         // The selected hexahedra's states come from the run itself (path-dependent).
-        solver.op.el.hex.output = e.hex_elements().to_vec();
+        solver.sample_states_of(ElementKind::Hex, e.hex_elements());
     }
     std::fs::create_dir_all(&c.out).map_err(|e| WeftError::io(&c.out, e))?;
     if c.static_solve {

@@ -198,6 +198,9 @@ impl Family for BeamGroup {
     const KIND: ElementKind = ElementKind::Beam;
     const SLOTS: usize = 2;
     const GROUP: EnergyGroup = EnergyGroup::Beam;
+    fn rotational(&self) -> Option<(&[[u32; 2]], &[[f64; 3]])> {
+        Some((&self.rot, &self.moments))
+    }
 
     fn build(bd: &mut Build) -> Result<Self> {
         let m = bd.model;

@@ -3,7 +3,6 @@
 //! surfaces after each force pass, and the per-layer values and the projectile's
 //! outcome at each output sample ([`super::watch`]).
 
-use super::family::Family;
 use super::vec3::dot;
 use super::{failure, watch, Solver};
 use crate::model::ElementKind;
@@ -38,28 +37,14 @@ impl Solver {
                 r[7] = r[7].max(dot(&u, &axis));
             }
         }
-        let el = &self.op.el;
-        for (kind, len) in [
-            (ElementKind::Truss, el.truss.len()),
-            (ElementKind::Tri, el.tri.len()),
-            (ElementKind::Quad, el.quad.len()),
-        ] {
-            for e in 0..len {
-                let l = w.element_layer(kind, e) as usize;
-                if l == 0 {
-                    continue;
-                }
-                let (stored, eroded) = match kind {
-                    ElementKind::Truss => {
-                        (el.truss.element_energy(xn, e), el.truss.element_eroded(e))
-                    }
-                    ElementKind::Tri => (el.tri.element_energy(xn, e), el.tri.element_eroded(e)),
-                    _ => (el.quad.element_energy(xn, e), el.quad.element_eroded(e)),
-                };
+        self.op.el.for_layer_energies(xn, |kind, e, energies| {
+            let l = w.element_layer(kind, e) as usize;
+            if l > 0 {
+                let (stored, eroded) = energies();
                 rows[l - 1][1] += stored;
                 rows[l - 1][2] += eroded;
             }
-        }
+        });
         for (l, r) in rows.iter_mut().enumerate() {
             r[4] = r[0] + r[1] + r[2] + r[3];
             let (failed, broken) = w.counts(l + 1);

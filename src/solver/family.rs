@@ -12,6 +12,15 @@
 //!   (see [`super::stable`]) and `stiffness` for the report of the controlling element;
 //! - `energies`: per-chunk partial sums (internal, damping, friction, hourglass).
 //!
+//! And, each with a default that does nothing, what only some families need of the time
+//! loop: failure and erosion (`collect_failures`, `alive`, `eroded_energy`, the
+//! per-element energies of `ballistic.parquet`'s layers), the stiffening a deformed
+//! element adds to the stable step's rows (`add_stiffening`, and the variable step that
+//! follows it, [`Family::VARIABLE_STEP`]), the path-dependent state the output samples
+//! carry (`sample_states`), the faces a projectile strikes (`contact_faces`), and what a
+//! family records once the step is set (`step_was_set`). The time loop, the stable step
+//! and the output call them through [`Families`](super::Families) and never name a family.
+//!
 //! Adding a family is one file that implements [`Family`] and one line in
 //! [`families!`](crate::families)' invocation in `solver/families.rs`. The order of that list
 //! is the order of the force slots, of the masses' accumulation and of the sums, so it
@@ -58,6 +67,29 @@ pub struct StiffCtx<'a> {
     /// Rotary inertia of each rotational node [kg·m²].
     pub rot_j: &'a [f64],
 }
+
+/// The element that stiffened a node most, as the stable step's checks keep it: the
+/// stiffness it added, its id, three numbers that say how it deformed, and its family's
+/// [`Family::describe_stiffening`], which puts them in words.
+#[derive(Debug, Clone, Copy)]
+pub struct Stiffened {
+    /// The stiffness added to the node's row [N/m].
+    pub added: f64,
+    pub id: i64,
+    pub q: [f64; 3],
+    pub describe: fn(i64, [f64; 3], f64) -> (String, Option<String>),
+}
+
+impl Stiffened {
+    /// What happened to the element, and a hint of its family's own when it has one.
+    pub fn describe(&self, dt_safety: f64) -> (String, Option<String>) {
+        (self.describe)(self.id, self.q, dt_safety)
+    }
+}
+
+/// The path-dependent state of one element's integration point, as the output samples
+/// carry it (σ [Pa] in Voigt order [xx, yy, zz, xy, yz, zx], ε_p, T [K]).
+pub type StateValues = [f64; 8];
 
 /// Per-chunk partial sums of the element energies [J]:
 /// `[internal, damping, friction, hourglass]`.
@@ -129,6 +161,50 @@ pub trait Family: Sized + Send + Sync {
     fn element_eroded(&self, _e: usize) -> f64 {
         0.0
     }
+    /// Whether `ballistic.parquet` reports its elements' energies by layer
+    /// ([`Family::element_energy`], [`Family::element_eroded`]).
+    const BY_LAYER: bool = false;
+    /// Adds to each node's stable-step row the stiffness its deformed elements have gained
+    /// since the step was set (at positions `x`), and keeps in `most` the element that
+    /// added most to the node.
+    fn add_stiffening(&self, _x: &[Vec3], _extra: &mut [f64], _most: &mut [Option<Stiffened>]) {}
+    /// Whether the variable step (`Analysis::variable_time_step`) follows this family's
+    /// stiffening: its nodes' step is recomputed from it as the run goes (crushed solids).
+    const VARIABLE_STEP: bool = false;
+    /// What the deformation `q` of element `id` (its [`Stiffened`] record) means, for the
+    /// message that stops a run, and a hint of its own when it has one (`dt_safety`: the
+    /// analysis' safety factor). The default reads `q` as membrane Green strains.
+    fn describe_stiffening(id: i64, q: [f64; 3], _dt_safety: f64) -> (String, Option<String>) {
+        (
+            format!(
+                "{} `{id}` has stretched to a Green strain of [{:.3}, {:.3}, {:.3}] (E₁₁, E₂₂, 2E₁₂)",
+                Self::KIND.name(),
+                q[0],
+                q[1],
+                q[2]
+            ),
+            None,
+        )
+    }
+    /// Chooses the elements whose state [`Family::sample_states`] reports (indices into
+    /// the family, which are rows of its element table); families without a
+    /// path-dependent state ignore it.
+    fn set_state_output(&mut self, _elements: &[u32]) {}
+    /// At an output sample, the state at tⁿ of the chosen elements, in their order,
+    /// appended to `rows`.
+    fn sample_states(&self, _rows: &mut Vec<StateValues>) {}
+    /// A family whose nodes carry rotations (beams): per element the indices of its two
+    /// rotational nodes, and its end moments (two per element [N·m], written by
+    /// `forces`), which the rotational nodes' update gathers. One family at most.
+    fn rotational(&self) -> Option<(&[[u32; 2]], &[Vec3])> {
+        None
+    }
+    /// The faces a rigid projectile strikes: each element's nodes and its mass [kg].
+    fn contact_faces<'a>(&'a self, _out: &mut Vec<(&'a [u32], f64)>) {}
+    /// Once the step is set: the reference positions `x_ref`, the nodal masses it was set
+    /// with and the fixed directions (the membranes' collapse criterion keeps what it
+    /// compares with).
+    fn step_was_set(&mut self, _x_ref: &[Vec3], _mass: &[f64], _fixed: &[u8]) {}
 }
 
 /// Totals of the energy ledger's groups (see [`EnergyGroup`]).
@@ -170,6 +246,17 @@ macro_rules! families {
             /// Total number of elements.
             pub fn len(&self) -> usize {
                 0 $(+ $crate::solver::family::Family::len(&self.$field))*
+            }
+            /// Elements that take a force update (all but point masses): the count the
+            /// element-updates rate is of.
+            pub fn updated_elements(&self) -> usize {
+                0 $(+ if <$ty as $crate::solver::family::Family>::KIND
+                    == $crate::model::ElementKind::PointMass
+                {
+                    0
+                } else {
+                    $crate::solver::family::Family::len(&self.$field)
+                })*
             }
             pub fn is_empty(&self) -> bool {
                 self.len() == 0
@@ -258,6 +345,87 @@ macro_rules! families {
             /// The strain energy every failure has taken so far [J], in list order.
             pub fn eroded_energy(&self) -> f64 {
                 0.0 $(+ $crate::solver::family::Family::eroded_energy(&self.$field))*
+            }
+            /// Every family's stiffening at `x` ([`Family::add_stiffening`]), in list order;
+            /// with `variable_only`, that of the families the variable step follows.
+            pub fn add_stiffening(
+                &self,
+                x: &[$crate::solver::vec3::Vec3],
+                extra: &mut [f64],
+                most: &mut [Option<$crate::solver::family::Stiffened>],
+                variable_only: bool,
+            ) {
+                $(
+                    if !variable_only || <$ty as $crate::solver::family::Family>::VARIABLE_STEP {
+                        $crate::solver::family::Family::add_stiffening(&self.$field, x, extra, most);
+                    }
+                )*
+            }
+            /// Marks the nodes of the families the variable step follows.
+            pub fn mark_variable_step_nodes(&self, mark: &mut [bool]) {
+                $(
+                    if <$ty as $crate::solver::family::Family>::VARIABLE_STEP {
+                        for e in 0..$crate::solver::family::Family::len(&self.$field) {
+                            for &n in $crate::solver::family::Family::slot_nodes(&self.$field, e) {
+                                mark[n as usize] = true;
+                            }
+                        }
+                    }
+                )*
+            }
+            /// Chooses the elements of kind `kind` whose state the output samples carry.
+            pub fn set_state_output(&mut self, kind: $crate::model::ElementKind, elements: &[u32]) {
+                $(
+                    if <$ty as $crate::solver::family::Family>::KIND == kind {
+                        $crate::solver::family::Family::set_state_output(&mut self.$field, elements);
+                    }
+                )*
+            }
+            /// The chosen elements' states at an output sample, family by family.
+            pub fn sample_states(&self, rows: &mut Vec<$crate::solver::family::StateValues>) {
+                rows.clear();
+                $($crate::solver::family::Family::sample_states(&self.$field, rows);)*
+            }
+            /// The rotational nodes' slots and the end moments of the family whose nodes
+            /// carry rotations ([`Family::rotational`]), or none.
+            pub fn rotational(&self) -> (&[[u32; 2]], &[$crate::solver::vec3::Vec3]) {
+                $(
+                    if let Some(r) = $crate::solver::family::Family::rotational(&self.$field) {
+                        return r;
+                    }
+                )*
+                (&[], &[])
+            }
+            /// Every family's faces a projectile strikes, in list order.
+            pub fn contact_faces(&self) -> Vec<(&[u32], f64)> {
+                let mut out = vec![];
+                $($crate::solver::family::Family::contact_faces(&self.$field, &mut out);)*
+                out
+            }
+            /// Tells every family the step is set ([`Family::step_was_set`]).
+            pub fn step_was_set(&mut self, x_ref: &[$crate::solver::vec3::Vec3], mass: &[f64], fixed: &[u8]) {
+                $($crate::solver::family::Family::step_was_set(&mut self.$field, x_ref, mass, fixed);)*
+            }
+            /// `f(kind, element, stored energy, eroded energy)` for every element of the
+            /// families that `ballistic.parquet` reports by layer, in list order.
+            pub fn for_layer_energies(
+                &self,
+                xn: &[$crate::solver::vec3::Vec3],
+                mut f: impl FnMut($crate::model::ElementKind, usize, &dyn Fn() -> (f64, f64)),
+            ) {
+                $(
+                    if <$ty as $crate::solver::family::Family>::BY_LAYER {
+                        let fam = &self.$field;
+                        for e in 0..$crate::solver::family::Family::len(fam) {
+                            f(<$ty as $crate::solver::family::Family>::KIND, e, &|| {
+                                (
+                                    $crate::solver::family::Family::element_energy(fam, xn, e),
+                                    $crate::solver::family::Family::element_eroded(fam, e),
+                                )
+                            });
+                        }
+                    }
+                )*
             }
             /// Element energies summed by group (see `EnergyGroup`).
             pub fn energies(&mut self, ctx: &$crate::solver::family::ForceCtx) -> $crate::solver::family::EnergySums {

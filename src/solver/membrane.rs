@@ -453,8 +453,9 @@ use super::collapse::{limit as limit_step, CollapseRef};
 use super::failure::{fibre_strain, taken_energy, Criterion, Erosion, Failure, FailureLaw, Fate};
 use super::family::{
     chunk_partials, for_chunks, Build, EnergyGroup, EnergyPartial, Family, ForceCtx, StiffCtx,
-    CHUNK,
+    Stiffened, CHUNK,
 };
+use super::vec3::Vec3;
 use crate::model::ElementKind;
 
 /// The fibre strains √(1 + 2E_ii) − 1 along the two material directions, and their rates
@@ -535,22 +536,25 @@ pub struct MembraneGroup<const N: usize> {
     pub erosion: Erosion,
     pub failure: Vec<MembraneFailure>,
     /// Per element, what the collapse criterion keeps ([`super::collapse`]): empty until
-    /// the explicit solver sets it ([`MembraneGroup::set_collapse_steps`]), and then
+    /// the explicit solver sets it ([`Family::step_was_set`]), and then
     /// only for a group whose elements can fail.
     pub collapse: Vec<CollapseRef>,
     partials: Vec<EnergyPartial>,
 }
 
-impl<const N: usize> MembraneGroup<N> {
+impl<const N: usize> Family for MembraneGroup<N> {
+    const KIND: ElementKind = if N == 3 {
+        ElementKind::Tri
+    } else {
+        ElementKind::Quad
+    };
+    const SLOTS: usize = N;
+    const GROUP: EnergyGroup = EnergyGroup::Membrane;
+    const BY_LAYER: bool = true;
     /// Adds each element's stiffening (see [`stiffening`]) to its nodes' stiffness rows
     /// of the stable step, (ratio − 1) × its largest eigenvalue k_max, and keeps, per
     /// node, the element that adds most: `(added, kind, element id, Green strain)`.
-    pub fn add_stiffening(
-        &self,
-        x: &[[f64; 3]],
-        extra: &mut [f64],
-        most: &mut [Option<(f64, ElementKind, i64, [f64; 3])>],
-    ) {
+    fn add_stiffening(&self, x: &[Vec3], extra: &mut [f64], most: &mut [Option<Stiffened>]) {
         // The elements' ratios in parallel, added to their nodes in element order (the
         // same sums whatever the threads).
         let ratios: Vec<(f64, [f64; 3])> = (0..self.nodes.len())
@@ -570,20 +574,22 @@ impl<const N: usize> MembraneGroup<N> {
             for &n in ns {
                 let n = n as usize;
                 extra[n] += add;
-                if most[n].is_none_or(|m| add > m.0) {
-                    most[n] = Some((add, Self::KIND, self.id[e], strain));
+                if most[n].is_none_or(|m| add > m.added) {
+                    most[n] = Some(Stiffened {
+                        added: add,
+                        id: self.id[e],
+                        q: strain,
+                        describe: Self::describe_stiffening,
+                    });
                 }
             }
         }
     }
-}
-
-impl<const N: usize> MembraneGroup<N> {
     /// Sets up the collapse criterion ([`super::collapse`]) of a group whose elements can
     /// fail, from the reference positions `x_ref` and the run's nodal masses (with what
     /// ties and mass scaling added); a node fully fixed (`fixed` = 0b111) does not count.
     /// An element that cannot fail is never removed by it.
-    pub fn set_collapse_steps(&mut self, x_ref: &[[f64; 3]], mass: &[f64], fixed: &[u8]) {
+    fn step_was_set(&mut self, x_ref: &[Vec3], mass: &[f64], fixed: &[u8]) {
         if !self.erosion.active() {
             return;
         }
@@ -601,16 +607,14 @@ impl<const N: usize> MembraneGroup<N> {
             })
             .collect();
     }
-}
-
-impl<const N: usize> Family for MembraneGroup<N> {
-    const KIND: ElementKind = if N == 3 {
-        ElementKind::Tri
-    } else {
-        ElementKind::Quad
-    };
-    const SLOTS: usize = N;
-    const GROUP: EnergyGroup = EnergyGroup::Membrane;
+    fn contact_faces<'a>(&'a self, out: &mut Vec<(&'a [u32], f64)>) {
+        out.extend(
+            self.nodes
+                .iter()
+                .map(|f| &f[..])
+                .zip(self.mass.iter().copied()),
+        );
+    }
 
     fn build(bd: &mut Build) -> Result<Self> {
         let (m, kind) = (bd.model, Self::KIND);

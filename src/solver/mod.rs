@@ -242,22 +242,8 @@ impl Solver {
             mass: &mut mass,
             rot: &mut rot,
         })?;
-        rot.finish(m, &el.beam.rot);
-        let faces: Vec<(&[u32], f64)> = el
-            .tri
-            .nodes
-            .iter()
-            .map(|f| &f[..])
-            .zip(el.tri.mass.iter().copied())
-            .chain(
-                el.quad
-                    .nodes
-                    .iter()
-                    .map(|f| &f[..])
-                    .zip(el.quad.mass.iter().copied()),
-            )
-            .collect();
-        let projectiles = contact::ProjectileContact::new(m, &faces);
+        rot.finish(m, el.rotational().0);
+        let projectiles = contact::ProjectileContact::new(m, &el.contact_faces());
         let fixed = fixed_dofs(m);
         let ties = ties::Ties::build(m, &mut mass)?;
         let op = Operator::new(el, ties, projectiles, &m.loads, nn);
@@ -317,10 +303,7 @@ impl Solver {
         let kappa = contact::surface::guard_kappa(m);
         s.set_time_step(kappa)?;
         // The membranes' collapse criterion reads the masses as the step was set with.
-        s.op.el.tri.set_collapse_steps(&m.coords, &s.mass, &s.fixed);
-        s.op.el
-            .quad
-            .set_collapse_steps(&m.coords, &s.mass, &s.fixed);
+        s.op.el.step_was_set(&m.coords, &s.mass, &s.fixed);
         s.ledger.floor = energy_floor(&s.x0, &s.mass, s.stable.dt);
         s.op.projectiles.set_step(&s.mass, s.stable.dt);
         if !m.contacts.is_empty() {
@@ -603,6 +586,13 @@ impl Solver {
         }
     }
 
+    /// Chooses the elements of kind `kind` (indices into their family, rows of its
+    /// element table) whose path-dependent state the output samples carry
+    /// ([`Sink::element_states`]); kinds without such a state ignore it.
+    pub fn sample_states_of(&mut self, kind: ElementKind, elements: &[u32]) {
+        self.op.el.set_state_output(kind, elements);
+    }
+
     /// Current force of every link on its node 2 at the current positions: spring and
     /// slider (the slider return-mapped on a copy of its state), without the dashpot;
     /// the links in global axes first, then those in a local frame, then the sliding
@@ -622,15 +612,12 @@ impl Solver {
     }
 
     /// Internal nodal forces at the current positions (the forces the elements exert;
-    /// the dashpots see the current half-step velocities and the sliders do not advance).
+    /// the dashpots see the current half-step velocities, and no element's state
+    /// advances: sliders, plastic strains and failures are as they were).
     pub fn internal_forces(&mut self) -> Vec<[f64; 3]> {
-        let saved = self.op.el.link.state.clone();
-        let saved_framed = self.op.el.framed_link.state.clone();
-        let saved_sliding = self.op.el.sliding_link.state.clone();
+        let saved = self.op.el.clone();
         self.op.element_forces(&self.state);
-        self.op.el.link.state = saved;
-        self.op.el.framed_link.state = saved_framed;
-        self.op.el.sliding_link.state = saved_sliding;
+        self.op.el = saved;
         (0..self.x0.len())
             .map(|i| {
                 let mut f = [0.0; 3];
@@ -696,7 +683,7 @@ impl Solver {
             times.update += t3 - t2;
             if snap {
                 last_e = self.book_sample(ke, &el_e, contact_e, &mut sampler)?;
-                self.op.el.hex.sample_states(&mut sampler.cur.solids);
+                self.op.el.sample_states(&mut sampler.cur.states);
                 if self.watch.is_active() {
                     self.watch_sample(&mut sampler.cur.layers);
                 }
@@ -740,7 +727,7 @@ impl Solver {
             threads: rayon::current_num_threads(),
             max_balance_error_relative: self.ledger.reported(self.state.step),
             final_energies: last_e,
-            elements: self.op.el.len() - self.op.el.point_mass.id.len(),
+            elements: self.op.el.updated_elements(),
             nodes: self.x0.len(),
         })
     }
@@ -778,7 +765,7 @@ impl Solver {
             threads: rayon::current_num_threads(),
             max_balance_error_relative: self.ledger.reported(self.state.step),
             final_energies: Energies::default(),
-            elements: self.op.el.len() - self.op.el.point_mass.id.len(),
+            elements: self.op.el.updated_elements(),
             nodes: self.x0.len(),
         }
     }
@@ -821,7 +808,7 @@ impl Solver {
         }
         integrator::advance_rotations(
             &mut self.state,
-            &self.op.el.beam.moments,
+            self.op.el.rotational().1,
             self.alpha,
             dt,
             &self.node_id,

@@ -4,10 +4,11 @@
 //! `history.parquet` and `energy.parquet`: docs/tables.md.
 //!
 //! Solver state that the nodal history cannot give (a hexahedron's stress, plastic strain
-//! and temperature depend on the path) goes out the same way: the elements listed in
-//! [`crate::solver::solid::hex::HexGroup::output`] (empty unless element results of hex
-//! parts were asked for: then nothing is collected) are read at the sample steps into
-//! the snapshot and interpolated onto the grid like the nodes ([`Sink::solids`]).
+//! and temperature depend on the path) goes out the same way: the elements chosen with
+//! [`crate::solver::Solver::sample_states_of`] (none unless element results of hex parts
+//! were asked for: then nothing is collected) are read at the sample steps into the
+//! snapshot ([`crate::solver::family::Family::sample_states`]) and interpolated onto the
+//! grid like the nodes ([`Sink::element_states`]).
 
 use std::path::Path;
 use std::sync::Arc;
@@ -16,6 +17,7 @@ use arrow_array::{Float64Array, Int64Array, RecordBatch};
 use arrow_schema::{DataType, Field, Schema, SchemaRef};
 
 use super::energy::Energies;
+pub use super::family::StateValues;
 use super::watch::LayerValues;
 use crate::error::Result;
 use crate::table::{batch, AtomicTableWriter, Col, Provenance};
@@ -33,17 +35,13 @@ pub trait Sink {
     fn layers(&mut self, _t: f64, _rows: &[LayerValues]) -> Result<()> {
         Ok(())
     }
-    /// The states of the sampled hexahedra at time t, in the order of
-    /// [`crate::solver::solid::hex::HexGroup::output`] (only when that is not empty).
-    fn solids(&mut self, _t: f64, _rows: &[SolidValues]) -> Result<()> {
+    /// The states of the sampled elements at time t, in the order they were chosen in
+    /// (only when some were): one [`StateValues`] each (a hexahedron's σ, ε_p and T; an
+    /// eroded element's σ is 0, its ε_p and T those it eroded with).
+    fn element_states(&mut self, _t: f64, _rows: &[StateValues]) -> Result<()> {
         Ok(())
     }
 }
-
-/// One hexahedron's integration point at a sample: σ [Pa] (Voigt xx, yy, zz, xy, yz, zx),
-/// the equivalent plastic strain ε_p and the temperature T [K]. An eroded element's σ is
-/// 0 (it carries none), its ε_p and T those it eroded with.
-pub type SolidValues = [f64; 8];
 
 /// One snapshot of the output nodes at a step.
 #[derive(Debug, Clone, Default)]
@@ -56,8 +54,8 @@ pub(super) struct Snapshot {
     pub(super) proj: Vec<[f64; 9]>,
     /// Per layer of a fabric (layer 1 first), its values (see [`super::watch`]).
     pub(super) layers: Vec<LayerValues>,
-    /// The sampled hexahedra's states (see [`SolidValues`]).
-    pub(super) solids: Vec<SolidValues>,
+    /// The sampled elements' states (see [`StateValues`]).
+    pub(super) states: Vec<StateValues>,
 }
 
 /// Linear interpolation of the step snapshots onto the fixed output grid t_k = k·Δt_out.
@@ -68,7 +66,7 @@ pub(super) struct Sampler {
     interp_u: Vec<[f64; 3]>,
     interp_v: Vec<[f64; 3]>,
     interp_layers: Vec<LayerValues>,
-    interp_solids: Vec<SolidValues>,
+    interp_states: Vec<StateValues>,
 }
 
 impl Sampler {
@@ -85,7 +83,7 @@ impl Sampler {
             interp_u: vec![[0.0; 3]; nout],
             interp_v: vec![[0.0; 3]; nout],
             interp_layers: vec![],
-            interp_solids: vec![],
+            interp_states: vec![],
         }
     }
 
@@ -150,18 +148,18 @@ impl Sampler {
                 };
                 sink.layers(tk, rows)?;
             }
-            if !cur.solids.is_empty() {
-                let rows = if w >= 1.0 || prev.solids.len() != cur.solids.len() {
-                    &cur.solids
+            if !cur.states.is_empty() {
+                let rows = if w >= 1.0 || prev.states.len() != cur.states.len() {
+                    &cur.states
                 } else {
-                    self.interp_solids.clear();
-                    for (a, b) in prev.solids.iter().zip(&cur.solids) {
-                        self.interp_solids
+                    self.interp_states.clear();
+                    for (a, b) in prev.states.iter().zip(&cur.states) {
+                        self.interp_states
                             .push(std::array::from_fn(|c| a[c] + w * (b[c] - a[c])));
                     }
-                    &self.interp_solids
+                    &self.interp_states
                 };
-                sink.solids(tk, rows)?;
+                sink.element_states(tk, rows)?;
             }
             progress(*k, tk);
             *k += 1;

@@ -53,7 +53,7 @@
 //! Stable step: each end's segment nodes take 2k·w (1 + [`CROWDING`]) (the weights w
 //! sum to one), the chord nodes the frame's terms 4(ρ + ρ²) k w with ρ = |r|/|u|, at
 //! the reference ends with |r| allowed to 2|d₀| (or [`LEVER_FLOOR`] of the chord);
-//! [`SlidingLinkGroup::add_crowding`] adds, every few steps of a run, what the ends where
+//! [`Family::add_stiffening`] adds, every few steps of a run, what the ends where
 //! they are add beyond that (yarns bunched closer than half a spacing, a link stretched
 //! with its yarns in contact), to the same check as the membranes' stiffening, which
 //! stops the run naming the link.
@@ -61,7 +61,7 @@
 use rayon::prelude::*;
 
 use super::family::{
-    chunk_partials, Build, EnergyGroup, EnergyPartial, Family, ForceCtx, StiffCtx, CHUNK,
+    chunk_partials, Build, EnergyGroup, EnergyPartial, Family, ForceCtx, StiffCtx, Stiffened, CHUNK,
 };
 use super::link::{
     bound_stiffness, energy_law, force_update_parts, frame_kin, framed_node_forces, link_props,
@@ -86,7 +86,7 @@ pub const LEVER_FLOOR: f64 = 0.05;
 /// yarn that slides half a spacing towards its neighbour puts half its crossing's
 /// stiffness on the neighbour's node (the yarn-level reference's warps bunched to
 /// 0.54 mm at a 1 mm spacing under the nose's rim by 50 µs, measured); closer bunching
-/// stops the run with the link named ([`SlidingLinkGroup::add_crowding`]).
+/// stops the run with the link named ([`Family::add_stiffening`]).
 pub const CROWDING: f64 = 0.5;
 
 /// A window of a yarn as the kernel sees it: its length, whether its first and last
@@ -533,18 +533,18 @@ impl SlidingLinkGroup {
         );
         out
     }
+}
 
+impl Family for SlidingLinkGroup {
+    const KIND: ElementKind = ElementKind::Link;
+    const SLOTS: usize = 2 * WIN;
+    const GROUP: EnergyGroup = EnergyGroup::Line;
     /// Adds to the nodes' stable-step rows what the links add, with their anchors where
     /// they are and the lever |r| as it is, beyond what the static bound took, and keeps
     /// per node the link that adds most, as `(added, Link, id, [slide of A, slide of B,
     /// |r|])` (slides in segments from the reference): two anchors that crowd on one
     /// segment, or a link stretched beyond 2|d₀|, stiffen their nodes.
-    pub fn add_crowding(
-        &self,
-        x: &[Vec3],
-        extra: &mut [f64],
-        most: &mut [Option<(f64, ElementKind, i64, [f64; 3])>],
-    ) {
+    fn add_stiffening(&self, x: &[Vec3], extra: &mut [f64], most: &mut [Option<Stiffened>]) {
         let mut now = [(0usize, 0.0); 12];
         let mut add = [0.0f64; 2 * WIN];
         for e in 0..self.id.len() {
@@ -583,24 +583,27 @@ impl SlidingLinkGroup {
                 }
                 let n = self.nodes[e][slot] as usize;
                 extra[n] += v;
-                if v > 0.0 && most[n].is_none_or(|m| v > m.0) {
+                if v > 0.0 && most[n].is_none_or(|m| v > m.added) {
                     let h = self.home[e];
-                    most[n] = Some((
-                        v,
-                        ElementKind::Link,
-                        self.id[e],
-                        [st[0] - h[0], st[1] - h[1], r],
-                    ));
+                    most[n] = Some(Stiffened {
+                        added: v,
+                        id: self.id[e],
+                        q: [st[0] - h[0], st[1] - h[1], r],
+                        describe: Self::describe_stiffening,
+                    });
                 }
             }
         }
     }
-}
-
-impl Family for SlidingLinkGroup {
-    const KIND: ElementKind = ElementKind::Link;
-    const SLOTS: usize = 2 * WIN;
-    const GROUP: EnergyGroup = EnergyGroup::Line;
+    fn describe_stiffening(id: i64, q: [f64; 3], _dt_safety: f64) -> (String, Option<String>) {
+        (
+            format!(
+                "sliding link `{id}` (its ends slid {:.2} and {:.2} segments, {:.3e} m apart)",
+                q[0], q[1], q[2]
+            ),
+            None,
+        )
+    }
 
     fn build(bd: &mut Build) -> Result<Self> {
         let m = bd.model;

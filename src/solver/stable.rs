@@ -12,7 +12,7 @@
 //! eq. 6.2.23). The step is safety × min_i Δt_i; the report names the node and its
 //! stiffest element.
 
-use super::family::StiffCtx;
+use super::family::{StiffCtx, Stiffened};
 use super::operator::{Operator, State};
 use crate::error::{Result, WeftError};
 use crate::model::ElementKind;
@@ -35,14 +35,14 @@ pub struct StableStep {
 
 /// What [`NodalBound::check_stiffening`] keeps through a run: the stable step's nodal
 /// stiffness and damping rows S_i, C_i, and its buffers (the stiffening added per node,
-/// and the element that added most: `(added, kind, id, Green strain)`).
+/// and the element that added most).
 pub struct StiffeningCheck {
     s: Vec<f64>,
     c: Vec<f64>,
     extra: Vec<f64>,
-    most: Vec<Option<(f64, ElementKind, i64, [f64; 3])>>,
-    /// The nodes of the hexahedra, ascending (the variable step's nodes).
-    solid_nodes: Vec<usize>,
+    most: Vec<Option<Stiffened>>,
+    /// The nodes of the families the variable step follows, ascending.
+    variable_nodes: Vec<usize>,
 }
 
 /// Mass added by mass scaling.
@@ -134,43 +134,39 @@ impl NodalBound<'_> {
     pub fn stiffening_check(&self) -> StiffeningCheck {
         let (s, c) = self.nodal_sums();
         let nn = s.len();
-        let mut solid = vec![false; nn];
-        for ns in &self.op.el.hex.nodes {
-            for &n in ns {
-                solid[n as usize] = true;
-            }
-        }
+        let mut variable = vec![false; nn];
+        self.op.el.mark_variable_step_nodes(&mut variable);
         StiffeningCheck {
             s,
             c,
             extra: vec![0.0; nn],
             most: vec![None; nn],
-            solid_nodes: (0..nn).filter(|&i| solid[i]).collect(),
+            variable_nodes: (0..nn).filter(|&i| variable[i]).collect(),
         }
     }
 
-    /// The variable step's bound: the hexahedra's nodal rows at their current shape
-    /// (the reference rows plus what each element's crushing added, as in
-    /// [`NodalBound::check_stiffening`]), and the smallest stable step of their nodes with
-    /// the node's id index and the element that stiffened it most (kind, id, [V/V₀, l/l₀,
-    /// 0]). `None` when the model has no hexahedra.
-    pub fn solid_step(
+    /// The variable step's bound: the nodal rows of the families it follows
+    /// ([`Family::VARIABLE_STEP`](super::family::Family::VARIABLE_STEP): the hexahedra) at
+    /// their current shape (the reference rows plus what each element's deformation
+    /// added, as in [`NodalBound::check_stiffening`]), and the smallest stable step of
+    /// their nodes with the node's index and the element that stiffened it most (its
+    /// [`Stiffened`] record). `None` when no family is followed.
+    pub fn variable_step(
         &self,
         k: &mut StiffeningCheck,
-    ) -> Option<(f64, usize, Option<(ElementKind, i64, [f64; 3])>)> {
-        if k.solid_nodes.is_empty() {
+    ) -> Option<(f64, usize, Option<Stiffened>)> {
+        if k.variable_nodes.is_empty() {
             return None;
         }
-        for &i in &k.solid_nodes {
+        for &i in &k.variable_nodes {
             k.extra[i] = 0.0;
             k.most[i] = None;
         }
         self.op
             .el
-            .hex
-            .add_stiffening(&self.state.x, &mut k.extra, &mut k.most);
+            .add_stiffening(&self.state.x, &mut k.extra, &mut k.most, true);
         let mut best: Option<(f64, usize)> = None;
-        for &i in &k.solid_nodes {
+        for &i in &k.variable_nodes {
             if self.fixed[i] == 0b111 || self.mass[i] <= 0.0 {
                 continue;
             }
@@ -179,7 +175,7 @@ impl NodalBound<'_> {
                 best = Some((dt_i, i));
             }
         }
-        best.map(|(dt, i)| (dt, i, k.most[i].map(|m| (m.1, m.2, m.3))))
+        best.map(|(dt, i)| (dt, i, k.most[i]))
     }
 
     /// Stops a run whose membranes have stretched so far that the fixed step no longer
@@ -194,13 +190,9 @@ impl NodalBound<'_> {
         let x = &self.state.x;
         k.extra.fill(0.0);
         k.most.fill(None);
-        self.op.el.quad.add_stiffening(x, &mut k.extra, &mut k.most);
-        self.op.el.tri.add_stiffening(x, &mut k.extra, &mut k.most);
         self.op
             .el
-            .sliding_link
-            .add_crowding(x, &mut k.extra, &mut k.most);
-        self.op.el.hex.add_stiffening(x, &mut k.extra, &mut k.most);
+            .add_stiffening(x, &mut k.extra, &mut k.most, false);
         for t in &self.op.ties.ties {
             for (a, &mn) in t.masters.iter().enumerate() {
                 k.extra[mn] += t.w[a] * k.extra[t.slave];
@@ -222,25 +214,11 @@ impl NodalBound<'_> {
                     .iter()
                     .filter(|t| t.masters.contains(&i))
                     .filter_map(|t| k.most[t.slave])
-                    .max_by(|a, b| a.0.total_cmp(&b.0))
+                    .max_by(|a, b| a.added.total_cmp(&b.added))
             });
-            let what = match who {
-                Some((_, ElementKind::Hex, id, q)) => format!(
-                    "hex `{id}` has been compressed to {:.3} of its volume and {:.3} of its length V/A_max",
-                    q[0], q[1]
-                ),
-                Some((_, ElementKind::Link, id, q)) => format!(
-                    "sliding link `{id}` (its ends slid {:.2} and {:.2} segments, {:.3e} m apart)",
-                    q[0], q[1], q[2]
-                ),
-                Some((_, kind, id, e)) => format!(
-                    "{} `{id}` has stretched to a Green strain of [{:.3}, {:.3}, {:.3}] (E₁₁, E₂₂, 2E₁₂)",
-                    kind.name(),
-                    e[0],
-                    e[1],
-                    e[2]
-                ),
-                None => "its membranes have stretched".to_string(),
+            let (what, hint) = match who {
+                Some(w) => w.describe(dt_safety),
+                None => ("its membranes have stretched".to_string(), None),
             };
             return Err(WeftError::Numerical {
                 what: format!(
@@ -249,14 +227,10 @@ impl NodalBound<'_> {
                 ),
                 step: self.state.step,
                 time: self.state.t,
-                hint: Some(if matches!(who, Some((_, ElementKind::Hex, ..))) {
-                    format!(
-                        "the stable step is set once, from the undeformed model, and a crushed solid needs a smaller one: lower dt_safety (now {dt_safety}) to run on"
-                    )
-                } else { format!(
+                hint: Some(hint.unwrap_or_else(|| format!(
                     "the stable step is set once, from the undeformed model; strains this large are beyond what most materials bear (aramid yarns break near 3.6 %; give the part a failure law, `failure_strain`, to remove such elements): shorten end_time, lower the load or the impact velocity, or lower dt_safety (now {}) to run on",
                     dt_safety
-                ) }),
+                ))),
             });
         }
         Ok(())

@@ -204,6 +204,7 @@ impl Family for TrussGroup {
     const KIND: ElementKind = ElementKind::Truss;
     const SLOTS: usize = 2;
     const GROUP: EnergyGroup = EnergyGroup::Line;
+    const BY_LAYER: bool = true;
 
     fn build(bd: &mut Build) -> Result<Self> {
         let (m, mass) = (bd.model, &mut *bd.mass);

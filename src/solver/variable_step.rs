@@ -17,19 +17,14 @@ impl Solver {
         k: &mut stable::StiffeningCheck,
         dt_step: f64,
     ) -> Result<f64> {
-        let Some((dt_now, node, most)) = self.nodal_bound().solid_step(k) else {
+        let Some((dt_now, node, most)) = self.nodal_bound().variable_step(k) else {
             return Ok(dt_step);
         };
         let margin = self.stable.dt / self.stable.dt_stable;
         let dt = dt_step.min(margin * dt_now);
         if dt < MIN_STEP_FRACTION * self.stable.dt {
             let what = match most {
-                Some((kind, id, q)) => format!(
-                    "{} `{id}` (crushed to {:.3} of its volume and {:.3} of its length V/A_max)",
-                    kind.name(),
-                    q[0],
-                    q[1]
-                ),
+                Some(w) => w.describe(self.analysis.dt_safety).0,
                 None => "its elements".to_string(),
             };
             return Err(WeftError::Numerical {

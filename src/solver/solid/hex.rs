@@ -33,7 +33,7 @@
 //! unstable at 0.9 l/c within 20 steps. The damping row gets C_a = ρ V Q₂ c/(2 l) (the
 //! linear bulk viscosity, LS-DYNA's Q = Q₂c in Δt = l/(Q + √(Q² + c²))).
 //! The reference geometry sets them; a solid that is crushed shortens its l (the Taylor
-//! test), which the fixed step does not follow: [`HexGroup::add_stiffening`] lets the
+//! test), which the fixed step does not follow: [`Family::add_stiffening`] lets the
 //! run's stiffening check stop it, naming the element, before it goes unstable.
 
 use super::kernel::{self, BULK_Q1, BULK_Q2};
@@ -42,9 +42,9 @@ use crate::material::{Material, PointState};
 use crate::model::ElementKind;
 use crate::shape::hex8::{self, HexGeometry};
 use crate::solver::family::{
-    chunk_partials, Build, EnergyGroup, EnergyPartial, Family, ForceCtx, StiffCtx, CHUNK,
+    chunk_partials, Build, EnergyGroup, EnergyPartial, Family, ForceCtx, StateValues, StiffCtx,
+    Stiffened, CHUNK,
 };
-use crate::solver::output::SolidValues;
 use crate::solver::vec3::Vec3;
 
 /// Hexahedra, struct-of-arrays.
@@ -70,7 +70,7 @@ pub struct HexGroup {
     /// The element's Gershgorin row sums S_a at the reference [N/m] (module docs).
     pub rows: Vec<[f64; 8]>,
     /// The elements (indices into this group, which are the rows of the model's hex
-    /// table) whose state the run's output samples carry ([`HexGroup::sample_states`]);
+    /// table) whose state the run's output samples carry ([`Family::sample_states`]);
     /// empty (the default): none, and sampling costs nothing.
     pub output: Vec<u32>,
     partials: Vec<EnergyPartial>,
@@ -207,12 +207,15 @@ fn element_step(
     out.copy_from_slice(&f);
 }
 
-impl HexGroup {
+impl Family for HexGroup {
+    const KIND: ElementKind = ElementKind::Hex;
+    const SLOTS: usize = 8;
+    const GROUP: EnergyGroup = EnergyGroup::Solid;
+    const VARIABLE_STEP: bool = true;
     /// At an output sample step: the state at tⁿ of the elements in [`HexGroup::output`],
     /// in that order, into `rows` (σ, ε_p, T; an eroded element's σ as 0: its forces are
     /// zero from then on, while its point keeps the stress it eroded with).
-    pub fn sample_states(&self, rows: &mut Vec<SolidValues>) {
-        rows.clear();
+    fn sample_states(&self, rows: &mut Vec<StateValues>) {
         for &e in &self.output {
             let st = &self.state[e as usize];
             let s = if st.eroded { [0.0; 6] } else { st.stress };
@@ -228,17 +231,11 @@ impl HexGroup {
             ]);
         }
     }
-
     /// For the stiffening check of the fixed step ([`crate::solver::stable`]): each
     /// element's rows S_a at its current shape less the reference ones it was given,
     /// added to its nodes where they have grown (a crushed element: |b|²V grows as it
     /// flattens); `most` gets (added, kind, id, [V/V₀, l/l₀, 0]).
-    pub fn add_stiffening(
-        &self,
-        x: &[Vec3],
-        extra: &mut [f64],
-        most: &mut [Option<(f64, ElementKind, i64, [f64; 3])>],
-    ) {
+    fn add_stiffening(&self, x: &[Vec3], extra: &mut [f64], most: &mut [Option<Stiffened>]) {
         use rayon::prelude::*;
         let grown: Vec<([f64; 8], [f64; 3])> = (0..self.nodes.len())
             .into_par_iter()
@@ -264,18 +261,31 @@ impl HexGroup {
                 }
                 let n = n as usize;
                 extra[n] += add[a];
-                if most[n].is_none_or(|m| add[a] > m.0) {
-                    most[n] = Some((add[a], ElementKind::Hex, self.id[e], *q));
+                if most[n].is_none_or(|m| add[a] > m.added) {
+                    most[n] = Some(Stiffened {
+                        added: add[a],
+                        id: self.id[e],
+                        q: *q,
+                        describe: Self::describe_stiffening,
+                    });
                 }
             }
         }
     }
-}
-
-impl Family for HexGroup {
-    const KIND: ElementKind = ElementKind::Hex;
-    const SLOTS: usize = 8;
-    const GROUP: EnergyGroup = EnergyGroup::Solid;
+    fn describe_stiffening(id: i64, q: [f64; 3], dt_safety: f64) -> (String, Option<String>) {
+        (
+            format!(
+                "hex `{id}` has been compressed to {:.3} of its volume and {:.3} of its length V/A_max",
+                q[0], q[1]
+            ),
+            Some(format!(
+                "the stable step is set once, from the undeformed model, and a crushed solid needs a smaller one: lower dt_safety (now {dt_safety}) to run on"
+            )),
+        )
+    }
+    fn set_state_output(&mut self, elements: &[u32]) {
+        self.output = elements.to_vec();
+    }
 
     fn build(bd: &mut Build) -> Result<Self> {
         let (m, mass) = (bd.model, &mut *bd.mass);
