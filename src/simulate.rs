@@ -9,8 +9,8 @@ use serde::Serialize;
 
 use crate::element_results::{ElementResults, WithElementResults};
 use crate::error::{Result, WeftError};
-use crate::model::io::read_model;
-use crate::model::{ElementKind, Model};
+use crate::model::io::read_tables;
+use crate::model::{ElementKind, Model, ValidatedModel};
 use crate::solver::output::ParquetSink;
 use crate::solver::{RunStats, Solver};
 use crate::table::{batch, write_table, Col, Provenance};
@@ -122,9 +122,10 @@ fn check_overrides(m: &Model, c: &Config) -> Result<()> {
 
 /// Human-readable name of the element controlling the step.
 pub fn controlling_name(s: &Solver) -> String {
-    match s.stable.element {
-        Some((k, id)) => format!("{} {id} (node {})", k.name(), s.node_id[s.stable.node]),
-        None => format!("node {}", s.node_id[s.stable.node]),
+    let (step, ids) = (s.time_step(), s.node_ids());
+    match step.element {
+        Some((k, id)) => format!("{} {id} (node {})", k.name(), ids[step.node]),
+        None => format!("node {}", ids[step.node]),
     }
 }
 
@@ -135,52 +136,19 @@ pub const DEFAULT_MAX_STEPS: u64 = 1_000_000_000;
 /// Run the stage. `progress` receives the fraction of simulated time done.
 pub fn run(c: &Config, progress: &mut (dyn FnMut(f64) + Send)) -> Result<Report> {
     let t_setup = Instant::now();
-    let mut m = read_model(&c.model)?;
-    check_overrides(&m, c)?;
-    apply_overrides(&mut m, c);
-    m.validate()?;
+    let m = read_with_overrides(c)?;
     let threads = c.threads.unwrap_or(0);
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
         .map_err(|e| WeftError::input(format!("cannot start {threads} threads: {e}")))?;
-    let mut prov = Provenance::new(
-        "simulate",
-        serde_json::to_value(c).expect("config serialises"),
-    );
-    for entry in std::fs::read_dir(&c.model).map_err(|e| WeftError::io(&c.model, e))? {
-        let p = entry.map_err(|e| WeftError::io(&c.model, e))?.path();
-        if p.extension().is_some_and(|x| x == "parquet") {
-            prov = prov.with_input(&p)?;
-        }
-    }
-    let mut solver = Solver::new(&m)?;
+    let prov = provenance(c)?;
+    let mut solver = Solver::from_validated(&m)?;
     if !c.static_solve {
-        let budget = c.max_steps.unwrap_or(DEFAULT_MAX_STEPS);
-        let steps = (m.analysis.end_time / solver.stable.dt).ceil();
-        if !(steps <= budget as f64) {
-            return Err(WeftError::input(format!(
-                "the run would take {steps:.3e} steps of {:.3e} s to reach the end time {:e} s: more than the budget of {budget} steps",
-                solver.stable.dt, m.analysis.end_time
-            ))
-            .hint(format!(
-                "the step is set by {} (stable step {:.3e} s): check its Young's modulus, density and size (or a link's stiffness and masses){}, or raise --max-steps",
-                controlling_name(&solver),
-                solver.stable.dt_stable,
-                // Mass damping shortens the step: Δt ≤ (2/ω)(√(1+ξ²) − ξ) ≈ 1/ξω for ξ ≫ 1.
-                if m.analysis.mass_damping * solver.stable.dt_stable > 0.1 {
-                    format!(
-                        ", and the mass damping α = {:e} 1/s (analysis.parquet, column mass_damping), which shortens the step to about 2/α when it is large",
-                        m.analysis.mass_damping
-                    )
-                } else {
-                    String::new()
-                }
-            )));
-        }
+        check_step_budget(c, &m, &solver)?;
     }
     let mut elements = (!c.element_results.is_empty())
-        .then(|| ElementResults::new(&m, &c.element_results, &solver.output_nodes))
+        .then(|| ElementResults::new(&m, &c.element_results, solver.output_nodes()))
         .transpose()?;
     if let Some(e) = &elements {
         // The selected hexahedra's states come from the run itself (path-dependent).
@@ -191,7 +159,7 @@ pub fn run(c: &Config, progress: &mut (dyn FnMut(f64) + Send)) -> Result<Report>
         return run_static(c, &m, &solver, &prov, t_setup, elements);
     }
     let setup = t_setup.elapsed();
-    let sink = ParquetSink::create(&c.out, solver.node_id.clone(), &prov)?;
+    let sink = ParquetSink::create(&c.out, solver.node_ids().to_vec(), &prov)?;
     let (sink, result) = match elements.as_mut() {
         Some(results) => {
             let mut w = WithElementResults {
@@ -222,19 +190,7 @@ pub fn run(c: &Config, progress: &mut (dyn FnMut(f64) + Send)) -> Result<Report>
     write_element_results(&c.out, elements, &prov)?;
     write_failures(&c.out, &m, &solver, &prov)?;
     stats.times.output += t_write.elapsed();
-    let sc = solver.scaling.clone().unwrap_or_default();
-    let report = Report {
-        dt: solver.stable.dt,
-        dt_stable: solver.stable.dt_stable,
-        controlling: controlling_name(&solver),
-        added_mass: sc.added_mass,
-        added_fraction: sc.added_fraction,
-        out: c.out.clone(),
-        contact: (!solver.op.surfaces.is_empty())
-            .then(|| solver.op.surfaces.report(&solver.node_id)),
-        ballistic: ballistic_line(&solver),
-        stats,
-    };
+    let report = Report::of(c, &solver, stats);
     let status = match &stopped {
         None => Status::Completed,
         Some(e) => Status::Stopped(e.to_string()),
@@ -250,11 +206,82 @@ pub fn run(c: &Config, progress: &mut (dyn FnMut(f64) + Send)) -> Result<Report>
     Ok(report)
 }
 
+/// The model folder's tables with the command line's overrides, validated once.
+fn read_with_overrides(c: &Config) -> Result<ValidatedModel> {
+    let mut m = read_tables(&c.model)?;
+    check_overrides(&m, c)?;
+    apply_overrides(&mut m, c);
+    m.validated().map_err(|e| e.in_file(&c.model))
+}
+
+/// The run's provenance: its settings and every table of the model folder.
+fn provenance(c: &Config) -> Result<Provenance> {
+    let mut prov = Provenance::new(
+        "simulate",
+        serde_json::to_value(c).expect("config serialises"),
+    );
+    for entry in std::fs::read_dir(&c.model).map_err(|e| WeftError::io(&c.model, e))? {
+        let p = entry.map_err(|e| WeftError::io(&c.model, e))?.path();
+        if p.extension().is_some_and(|x| x == "parquet") {
+            prov = prov.with_input(&p)?;
+        }
+    }
+    Ok(prov)
+}
+
+/// Refuses an explicit run that would need more steps than the budget
+/// ([`DEFAULT_MAX_STEPS`] or `--max-steps`), naming the element that sets the step.
+fn check_step_budget(c: &Config, m: &Model, solver: &Solver) -> Result<()> {
+    let budget = c.max_steps.unwrap_or(DEFAULT_MAX_STEPS);
+    let step = solver.time_step();
+    let steps = (m.analysis.end_time / step.dt).ceil();
+    if steps <= budget as f64 {
+        return Ok(());
+    }
+    Err(WeftError::input(format!(
+        "the run would take {steps:.3e} steps of {:.3e} s to reach the end time {:e} s: more than the budget of {budget} steps",
+        step.dt, m.analysis.end_time
+    ))
+    .hint(format!(
+        "the step is set by {} (stable step {:.3e} s): check its Young's modulus, density and size (or a link's stiffness and masses){}, or raise --max-steps",
+        controlling_name(solver),
+        step.dt_stable,
+        // Mass damping shortens the step: Δt ≤ (2/ω)(√(1+ξ²) − ξ) ≈ 1/ξω for ξ ≫ 1.
+        if m.analysis.mass_damping * step.dt_stable > 0.1 {
+            format!(
+                ", and the mass damping α = {:e} 1/s (analysis.parquet, column mass_damping), which shortens the step to about 2/α when it is large",
+                m.analysis.mass_damping
+            )
+        } else {
+            String::new()
+        }
+    )))
+}
+
+impl Report {
+    /// The report of an explicit run of `solver` into `c.out`.
+    fn of(c: &Config, solver: &Solver, stats: RunStats) -> Report {
+        let sc = solver.mass_scaling().cloned().unwrap_or_default();
+        let surfaces = &solver.operator().surfaces;
+        Report {
+            dt: solver.time_step().dt,
+            dt_stable: solver.time_step().dt_stable,
+            controlling: controlling_name(solver),
+            added_mass: sc.added_mass,
+            added_fraction: sc.added_fraction,
+            out: c.out.clone(),
+            contact: (!surfaces.is_empty()).then(|| surfaces.report(solver.node_ids())),
+            ballistic: ballistic_line(solver),
+            stats,
+        }
+    }
+}
+
 /// The line the binary prints on failures and the outcome.
 fn ballistic_line(s: &Solver) -> Option<String> {
     use crate::solver::watch::Outcome;
-    let w = &s.watch;
-    if !s.failures.active && !(w.n_layers > 0 && w.axis().is_some()) {
+    let w = s.watch();
+    if !s.failure_log().active && !(w.n_layers > 0 && w.axis().is_some()) {
         return None;
     }
     let eroded = s
@@ -290,13 +317,13 @@ pub enum Status {
 /// can fail; otherwise a stale one from an earlier run into the same folder is removed.
 fn write_failures(out: &Path, m: &Model, s: &Solver, prov: &Provenance) -> Result<()> {
     let path = out.join("failures.parquet");
-    if !s.failures.active {
+    if !s.failure_log().active {
         if path.exists() {
             std::fs::remove_file(&path).map_err(|e| WeftError::io(&path, e))?;
         }
         return Ok(());
     }
-    let ev = &s.failures.events;
+    let ev = &s.failure_log().events;
     // Each failure's element row in its table: the family's index for trusses and
     // membranes, the id's row for links (their families split the link table).
     let row = |e: &crate::solver::failure::FailureEvent| -> Option<usize> {
@@ -385,8 +412,8 @@ fn run_static(
     mut elements: Option<ElementResults>,
 ) -> Result<Report> {
     let r = solver.solve_static(m)?;
-    let mut sink = ParquetSink::create(&c.out, solver.node_id.clone(), prov)?;
-    let nodes = &solver.output_nodes;
+    let mut sink = ParquetSink::create(&c.out, solver.node_ids().to_vec(), prov)?;
+    let nodes = solver.output_nodes();
     let u: Vec<[f64; 3]> = nodes.iter().map(|&i| r.u[i]).collect();
     let v = vec![[0.0; 3]; nodes.len()];
     crate::solver::Sink::history(&mut sink, 0.0, nodes, &u, &v)?;
@@ -395,7 +422,7 @@ fn run_static(
     }
     sink.finish_history_only()?;
     write_element_results(&c.out, elements, prov)?;
-    let elements = solver.op.el.len() - solver.op.el.point_mass.id.len();
+    let elements = solver.families().updated_elements();
     write_table(
         &c.out.join("summary.parquet"),
         &batch(vec![
@@ -403,9 +430,9 @@ fn run_static(
             Col::I64("dofs", vec![r.dofs as i64]),
             Col::I64("held_dofs", vec![r.held as i64]),
             Col::I64("nonzeros", vec![r.nonzeros as i64]),
-            Col::I64("nodes", vec![solver.x0.len() as i64]),
+            Col::I64("nodes", vec![solver.node_ids().len() as i64]),
             Col::I64("elements", vec![elements as i64]),
-            Col::F64("model_mass", vec![solver.physical_mass]),
+            Col::F64("model_mass", vec![solver.physical_mass()]),
             Col::F64(
                 "wall_time_setup",
                 vec![t_setup.elapsed().as_secs_f64() - r.assemble_seconds - r.solve_seconds],
@@ -423,7 +450,7 @@ fn run_static(
         max_balance_error_relative: 0.0,
         final_energies: Default::default(),
         elements,
-        nodes: solver.x0.len(),
+        nodes: solver.node_ids().len(),
     };
     eprintln!(
         "weft-simulate --static: {} equations ({} held without stiffness), {} non-zeros; assemble {:.3} s, solve {:.3} s",
@@ -461,28 +488,28 @@ pub fn write_summary(
 /// The summary's columns about the run itself: step, controlling element, masses, sizes,
 /// wall times, contact, throughput, balance.
 fn run_columns(r: &Report, s: &Solver, st: &RunStats) -> Vec<Col> {
-    let (kind, id) = match s.stable.element {
+    let (kind, id) = match s.time_step().element {
         Some((k, id)) => (k.name().to_string(), id),
         None => (String::new(), -1),
     };
-    let sc = s.scaling.clone();
+    let sc = s.mass_scaling().cloned();
     vec![
         Col::Str("analysis", vec!["explicit".into()]),
         Col::I64("steps", vec![st.steps as i64]),
         Col::F64("end_time", vec![st.end_time]),
         Col::F64("dt", vec![r.dt]),
         Col::F64("dt_stable", vec![r.dt_stable]),
-        Col::F64("dt_min", vec![s.stable.dt_min]),
+        Col::F64("dt_min", vec![s.time_step().dt_min]),
         Col::Str("controlling_kind", vec![kind]),
         Col::I64("controlling_element", vec![id]),
-        Col::I64("controlling_node", vec![s.node_id[s.stable.node]]),
+        Col::I64("controlling_node", vec![s.node_ids()[s.time_step().node]]),
         Col::OptF64(
             "dt_stable_unscaled",
             vec![sc.as_ref().map(|x| x.dt_stable_unscaled)],
         ),
         Col::F64("added_mass", vec![r.added_mass]),
         Col::F64("added_mass_fraction", vec![r.added_fraction]),
-        Col::F64("model_mass", vec![s.physical_mass]),
+        Col::F64("model_mass", vec![s.physical_mass()]),
         Col::I64("nodes", vec![st.nodes as i64]),
         Col::I64("elements", vec![st.elements as i64]),
         Col::I64("threads", vec![st.threads as i64]),
@@ -528,7 +555,7 @@ fn run_columns(r: &Report, s: &Solver, st: &RunStats) -> Vec<Col> {
 /// yarns, back-face deflection peak and energy absorbed (docs/tables.md).
 fn ballistic_columns(s: &Solver, m: &Model, status: &Status) -> Vec<Col> {
     use crate::solver::watch::Outcome;
-    let w = &s.watch;
+    let w = s.watch();
     let p = m.projectiles.first();
     let speed = |v: &[f64; 3]| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
     let (outcome, perforated, residual, when) = match (p, w.outcome) {

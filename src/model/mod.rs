@@ -28,5 +28,5 @@ pub use types::{
     Analysis, Curve, ElementBlock, Load, Model, Part, ProjectileShape, ProjectileSpec,
     SymmetryPlane, Tie, TimeLaw,
 };
-pub use validate::validate_part;
+pub use validate::{validate_part, ValidatedModel};
 pub use yarn::YarnWindow;

@@ -10,7 +10,34 @@ use super::types::{Analysis, ElementBlock, Model, Part, TimeLaw};
 use super::yarn::HALF;
 use crate::error::{Result, WeftError};
 
+/// A model that has passed [`Model::validate`]: only [`Model::validated`] makes one, and
+/// it gives the model out read-only (to change it, take it back with
+/// [`ValidatedModel::into_model`] and validate again), so a stage that holds one need
+/// not check the model again ([`crate::solver::Solver::from_validated`]).
+#[derive(Debug, Clone)]
+pub struct ValidatedModel(Model);
+
+impl std::ops::Deref for ValidatedModel {
+    type Target = Model;
+    fn deref(&self) -> &Model {
+        &self.0
+    }
+}
+
+impl ValidatedModel {
+    /// The model, to change (it must be validated again).
+    pub fn into_model(self) -> Model {
+        self.0
+    }
+}
+
 impl Model {
+    /// The model, checked ([`Model::validate`]).
+    pub fn validated(self) -> Result<ValidatedModel> {
+        self.validate()?;
+        Ok(ValidatedModel(self))
+    }
+
     /// Check ids, references and properties. Errors name the part, element or node and
     /// the value (rows refer to the tables' row order).
     pub fn validate(&self) -> Result<()> {

@@ -24,6 +24,7 @@ use std::path::{Path, PathBuf};
 
 use crate::error::{Result, WeftError};
 use crate::model::types::Model;
+use crate::model::validate::ValidatedModel;
 use crate::table::Provenance;
 use codec::{Codec, Reading, Writing};
 
@@ -127,6 +128,18 @@ pub fn table_files() -> impl Iterator<Item = &'static str> {
 
 /// Read and validate a model folder.
 pub fn read_model(dir: &Path) -> Result<Model> {
+    read_validated(dir).map(ValidatedModel::into_model)
+}
+
+/// Read and validate a model folder, keeping the proof that it is valid.
+pub fn read_validated(dir: &Path) -> Result<ValidatedModel> {
+    read_tables(dir)?.validated().map_err(|e| e.in_file(dir))
+}
+
+/// Read a model folder's tables (each table's own checks) without the whole model's:
+/// for a stage that changes the model before it validates it once
+/// ([`Model::validated`]).
+pub fn read_tables(dir: &Path) -> Result<Model> {
     let nodes_path = dir.join("nodes.parquet");
     if !nodes_path.exists() {
         return Err(WeftError::input(format!(
@@ -136,16 +149,10 @@ pub fn read_model(dir: &Path) -> Result<Model> {
         .expected("a folder of model tables (docs/tables.md)")
         .hint("create one with `weft-weave rod --out DIR`"));
     }
-    read_model_inner(dir).map_err(|e| e.in_file(dir))
-}
-
-/// Every table in turn, then the whole model's checks.
-fn read_model_inner(dir: &Path) -> Result<Model> {
     let mut r = Reading::new(dir);
     for table in TABLES {
-        (table.read)(&mut r)?;
+        (table.read)(&mut r).map_err(|e| e.in_file(dir))?;
     }
-    r.model.validate()?;
     Ok(r.model)
 }
 
