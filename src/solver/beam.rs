@@ -174,9 +174,9 @@ pub fn rotate(r: &Mat3, phi: &[f64; 3]) -> Mat3 {
 // ---------------------------------------------------------------------------------------
 // The beam family, which creates the rotational nodes ([`Rotations`]) of its ends.
 
-use rayon::prelude::*;
-
-use super::family::{Build, EnergyGroup, EnergyPartial, Family, ForceCtx, StiffCtx, CHUNK};
+use super::family::{
+    for_chunks_of, Build, EnergyGroup, EnergyPartial, Family, ForceCtx, Per, StiffCtx, CHUNK,
+};
 pub use super::rotations::Rotations;
 use crate::error::{Result, WeftError};
 use crate::model::ElementKind;
@@ -267,40 +267,33 @@ impl Family for BeamGroup {
     fn forces(&mut self, ctx: &ForceCtx, fe: &mut [[f64; 3]]) {
         let (x, rr) = (ctx.x, ctx.rot_r);
         let (nodes, rot, props) = (&self.nodes, &self.rot, &self.props);
-        let body = |(ci, (out, mo)): (usize, (&mut [[f64; 3]], &mut [[f64; 3]]))| {
-            let e0 = ci * CHUNK;
-            for (j, (f, m)) in out
-                .chunks_exact_mut(2)
-                .zip(mo.chunks_exact_mut(2))
-                .enumerate()
-            {
-                let e = e0 + j;
-                let [a, b] = nodes[e];
-                let [ra, rb] = rot[e];
-                let r = forces(
-                    &x[a as usize],
-                    &x[b as usize],
-                    &rr[ra as usize],
-                    &rr[rb as usize],
-                    &props[e],
-                );
-                f[0] = r[0];
-                f[1] = r[1];
-                m[0] = r[2];
-                m[1] = r[3];
-            }
-        };
-        if self.id.len() <= CHUNK {
-            fe.chunks_mut(2 * CHUNK)
-                .zip(self.moments.chunks_mut(2 * CHUNK))
-                .enumerate()
-                .for_each(body);
-        } else {
-            fe.par_chunks_mut(2 * CHUNK)
-                .zip(self.moments.par_chunks_mut(2 * CHUNK))
-                .enumerate()
-                .for_each(body);
-        }
+        for_chunks_of(
+            self.id.len(),
+            (Per(fe, 2), Per(&mut self.moments[..], 2)),
+            |ci, (out, mo)| {
+                let e0 = ci * CHUNK;
+                for (j, (f, m)) in out
+                    .chunks_exact_mut(2)
+                    .zip(mo.chunks_exact_mut(2))
+                    .enumerate()
+                {
+                    let e = e0 + j;
+                    let [a, b] = nodes[e];
+                    let [ra, rb] = rot[e];
+                    let r = forces(
+                        &x[a as usize],
+                        &x[b as usize],
+                        &rr[ra as usize],
+                        &rr[rb as usize],
+                        &props[e],
+                    );
+                    f[0] = r[0];
+                    f[1] = r[1];
+                    m[0] = r[2];
+                    m[1] = r[3];
+                }
+            },
+        );
     }
     /// Row sums of M^{-1/2} K M^{-1/2}. A translational row carries the axial and
     /// bending-shear terms and the coupling 12EI/L² to the rotations (scaled by √(m/J)

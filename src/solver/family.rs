@@ -442,23 +442,94 @@ macro_rules! families {
     };
 }
 
+/// Per-element slices that travel together through the chunked loops of
+/// [`for_chunks_of`]: [`Per`] (one slice, `per` values per element) and tuples of them.
+/// Each chunk holds the same `CHUNK` elements of every slice, so a family's kernel sees
+/// its elements' force slots, state, fates and work side by side.
+pub trait Chunked: Send + Sized {
+    type Item: Send;
+    type Serial: Iterator<Item = Self::Item>;
+    type Parallel: rayon::iter::IndexedParallelIterator<Item = Self::Item>;
+    fn serial(self) -> Self::Serial;
+    fn parallel(self) -> Self::Parallel;
+}
+
+/// A per-element slice with `.1` values per element (a family's force slots: `SLOTS`;
+/// its per-element state: 1), split into chunks of `CHUNK` elements.
+pub struct Per<'a, T>(pub &'a mut [T], pub usize);
+
+impl<'a, T: Send> Chunked for Per<'a, T> {
+    type Item = &'a mut [T];
+    type Serial = std::slice::ChunksMut<'a, T>;
+    type Parallel = rayon::slice::ChunksMut<'a, T>;
+    fn serial(self) -> Self::Serial {
+        self.0.chunks_mut(self.1 * CHUNK)
+    }
+    fn parallel(self) -> Self::Parallel {
+        use rayon::prelude::*;
+        self.0.par_chunks_mut(self.1 * CHUNK)
+    }
+}
+
+/// One value per chunk (a chunk's partial sums), beside the chunks of [`Per`] slices.
+pub struct Each<'a, T>(pub &'a mut [T]);
+
+impl<'a, T: Send> Chunked for Each<'a, T> {
+    type Item = &'a mut T;
+    type Serial = std::slice::IterMut<'a, T>;
+    type Parallel = rayon::slice::IterMut<'a, T>;
+    fn serial(self) -> Self::Serial {
+        self.0.iter_mut()
+    }
+    fn parallel(self) -> Self::Parallel {
+        use rayon::prelude::*;
+        self.0.par_iter_mut()
+    }
+}
+
+impl<A: Chunked, B: Chunked> Chunked for (A, B) {
+    type Item = (A::Item, B::Item);
+    type Serial = std::iter::Zip<A::Serial, B::Serial>;
+    type Parallel = rayon::iter::Zip<A::Parallel, B::Parallel>;
+    fn serial(self) -> Self::Serial {
+        self.0.serial().zip(self.1.serial())
+    }
+    fn parallel(self) -> Self::Parallel {
+        use rayon::prelude::*;
+        self.0.parallel().zip(self.1.parallel())
+    }
+}
+
+/// Runs `body(chunk index, chunks)` over the `CHUNK`-element chunks of the per-element
+/// slices `slices` ([`Chunked`]: a [`Per`], or pairs of them, nested for more), in
+/// parallel when there are more than `CHUNK` elements (`n_elements`), in order on the
+/// calling thread otherwise. Each chunk is written by one call only, so the results do
+/// not depend on the thread count.
+#[inline]
+pub fn for_chunks_of<S, F>(n_elements: usize, slices: S, body: F)
+where
+    S: Chunked,
+    F: Fn(usize, S::Item) + Send + Sync,
+{
+    use rayon::prelude::*;
+    if n_elements <= CHUNK {
+        slices.serial().enumerate().for_each(|(ci, c)| body(ci, c));
+    } else {
+        slices
+            .parallel()
+            .enumerate()
+            .for_each(|(ci, c)| body(ci, c));
+    }
+}
+
 /// Runs `body(chunk index, chunk)` over `CHUNK`-element chunks of `out` (`per` slots
-/// per element), in parallel when there is more than one chunk.
+/// per element): [`for_chunks_of`] with one slice.
 #[inline]
 pub fn for_chunks<T: Send, F>(out: &mut [T], per: usize, n_elements: usize, body: F)
 where
     F: Fn(usize, &mut [T]) + Send + Sync,
 {
-    use rayon::prelude::*;
-    if n_elements <= CHUNK {
-        out.chunks_mut(per * CHUNK)
-            .enumerate()
-            .for_each(|(ci, o)| body(ci, o));
-    } else {
-        out.par_chunks_mut(per * CHUNK)
-            .enumerate()
-            .for_each(|(ci, o)| body(ci, o));
-    }
+    for_chunks_of(n_elements, Per(out, per), body);
 }
 
 /// Fills `partials` (one per `CHUNK` elements) with `f(element range)`, in parallel.

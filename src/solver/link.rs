@@ -363,11 +363,10 @@ pub fn framed_elastic_forces(
 // The link families: links in global axes (two force slots), and links in a local frame
 // (six: the frame nodes take the reaction of the turning frame).
 
-use rayon::prelude::*;
-
-use super::failure::{taken_energy, Criterion, Erosion, Failure, FailureLaw, Fate};
+use super::failure::{taken_energy, Criterion, Erosion, Failure, FailureLaw};
 use super::family::{
-    chunk_partials, Build, EnergyGroup, EnergyPartial, Family, ForceCtx, StiffCtx, CHUNK,
+    chunk_partials, for_chunks_of, Build, EnergyGroup, EnergyPartial, Family, ForceCtx, Per,
+    StiffCtx, CHUNK,
 };
 use crate::error::Result;
 use crate::model::{ElementKind, Model, PartProps};
@@ -489,88 +488,77 @@ impl LinkGroup {
             &*any,
         );
         let n = nodes.len();
-        let body = |(ci, ((out, st), fates)): (
-            usize,
-            ((&mut [[f64; 3]], &mut [LinkState]), &mut [Fate]),
-        )| {
-            let e0 = ci * CHUNK;
-            for (j, ((pair, s), fate)) in out
-                .chunks_exact_mut(2)
-                .zip(st.iter_mut())
-                .zip(fates.iter_mut())
-                .enumerate()
-            {
-                let e = e0 + j;
-                if fate.eroded {
-                    pair[0] = [0.0; 3];
-                    pair[1] = [0.0; 3];
-                    continue;
-                }
-                let [a, b] = nodes[e];
-                let (a, b) = (a as usize, b as usize);
-                let d = rel_disp(&x[a], &x[b], &d0[e]);
-                let lw = law_of(law, e);
-                let opening = norm(&d);
-                let broken = if opening >= break_opening[e] {
-                    Some((Criterion::Opening, opening, break_opening[e]))
-                } else {
-                    None
-                };
-                let dd = [v[b][0] - v[a][0], v[b][1] - v[a][1], v[b][2] - v[a][2]];
-                let broken = broken.or_else(|| {
-                    let mut trial = *s;
-                    let (fs, _) = force_update_parts(&d, &dd, &props[e], lw, &mut trial, dt_prev);
-                    let f = norm(&fs);
-                    (f >= force_limit[e].strain).then_some((
-                        Criterion::Force,
-                        f,
-                        force_limit[e].strain,
-                    ))
-                });
-                if let Some((criterion, value, limit)) = broken {
-                    // Its stored energy, with the half step of its spring's work (see
-                    // `failure::taken_energy`).
-                    let f2 = elastic_force_law(&d, &props[e], lw, &s.slip);
-                    let w = taken_energy(
-                        energy_law(&d, &props[e], lw, &s.slip),
-                        dt_prev,
-                        &[v[a], v[b]],
-                        &[[-f2[0], -f2[1], -f2[2]], f2],
-                    );
-                    fate.eroded = true;
-                    fate.energy = w;
-                    fate.fresh = Some(Failure {
-                        kind: ElementKind::Link,
-                        element: e,
-                        criterion,
-                        value,
-                        limit,
-                        eroded: true,
-                        energy: w,
+        for_chunks_of(
+            n,
+            ((Per(fe, 2), Per(&mut state[..], 1)), Per(&mut fate[..], 1)),
+            |ci, ((out, st), fates)| {
+                let e0 = ci * CHUNK;
+                for (j, ((pair, s), fate)) in out
+                    .chunks_exact_mut(2)
+                    .zip(st.iter_mut())
+                    .zip(fates.iter_mut())
+                    .enumerate()
+                {
+                    let e = e0 + j;
+                    if fate.eroded {
+                        pair[0] = [0.0; 3];
+                        pair[1] = [0.0; 3];
+                        continue;
+                    }
+                    let [a, b] = nodes[e];
+                    let (a, b) = (a as usize, b as usize);
+                    let d = rel_disp(&x[a], &x[b], &d0[e]);
+                    let lw = law_of(law, e);
+                    let opening = norm(&d);
+                    let broken = if opening >= break_opening[e] {
+                        Some((Criterion::Opening, opening, break_opening[e]))
+                    } else {
+                        None
+                    };
+                    let dd = [v[b][0] - v[a][0], v[b][1] - v[a][1], v[b][2] - v[a][2]];
+                    let broken = broken.or_else(|| {
+                        let mut trial = *s;
+                        let (fs, _) =
+                            force_update_parts(&d, &dd, &props[e], lw, &mut trial, dt_prev);
+                        let f = norm(&fs);
+                        (f >= force_limit[e].strain).then_some((
+                            Criterion::Force,
+                            f,
+                            force_limit[e].strain,
+                        ))
                     });
-                    any.store(true, std::sync::atomic::Ordering::Relaxed);
-                    pair[0] = [0.0; 3];
-                    pair[1] = [0.0; 3];
-                    continue;
+                    if let Some((criterion, value, limit)) = broken {
+                        // Its stored energy, with the half step of its spring's work (see
+                        // `failure::taken_energy`).
+                        let f2 = elastic_force_law(&d, &props[e], lw, &s.slip);
+                        let w = taken_energy(
+                            energy_law(&d, &props[e], lw, &s.slip),
+                            dt_prev,
+                            &[v[a], v[b]],
+                            &[[-f2[0], -f2[1], -f2[2]], f2],
+                        );
+                        fate.eroded = true;
+                        fate.energy = w;
+                        fate.fresh = Some(Failure {
+                            kind: ElementKind::Link,
+                            element: e,
+                            criterion,
+                            value,
+                            limit,
+                            eroded: true,
+                            energy: w,
+                        });
+                        any.store(true, std::sync::atomic::Ordering::Relaxed);
+                        pair[0] = [0.0; 3];
+                        pair[1] = [0.0; 3];
+                        continue;
+                    }
+                    let f2 = force_update_law(&d, &dd, &props[e], lw, s, dt_prev);
+                    pair[0] = [-f2[0], -f2[1], -f2[2]];
+                    pair[1] = f2;
                 }
-                let f2 = force_update_law(&d, &dd, &props[e], lw, s, dt_prev);
-                pair[0] = [-f2[0], -f2[1], -f2[2]];
-                pair[1] = f2;
-            }
-        };
-        if n <= CHUNK {
-            fe.chunks_mut(2 * CHUNK)
-                .zip(state.chunks_mut(CHUNK))
-                .zip(fate.chunks_mut(CHUNK))
-                .enumerate()
-                .for_each(body);
-        } else {
-            fe.par_chunks_mut(2 * CHUNK)
-                .zip(state.par_chunks_mut(CHUNK))
-                .zip(fate.par_chunks_mut(CHUNK))
-                .enumerate()
-                .for_each(body);
-        }
+            },
+        );
     }
 }
 
@@ -641,34 +629,27 @@ impl Family for LinkGroup {
         // best of 6: 5.8·10⁷ against 6.2·10⁷ updates/s before, within that machine's
         // noise).
         let plain = law.is_empty();
-        let body = |(ci, (out, st)): (usize, (&mut [[f64; 3]], &mut [LinkState]))| {
-            let e0 = ci * CHUNK;
-            for (j, (pair, s)) in out.chunks_exact_mut(2).zip(st.iter_mut()).enumerate() {
-                let e = e0 + j;
-                let [a, b] = nodes[e];
-                let (a, b) = (a as usize, b as usize);
-                let d = rel_disp(&x[a], &x[b], &d0[e]);
-                let dd = [v[b][0] - v[a][0], v[b][1] - v[a][1], v[b][2] - v[a][2]];
-                let f2 = if plain {
-                    force_update(&d, &dd, &props[e], s, dt_prev)
-                } else {
-                    force_update_law(&d, &dd, &props[e], &law[e], s, dt_prev)
-                };
-                pair[0] = [-f2[0], -f2[1], -f2[2]];
-                pair[1] = f2;
-            }
-        };
-        if self.id.len() <= CHUNK {
-            fe.chunks_mut(2 * CHUNK)
-                .zip(self.state.chunks_mut(CHUNK))
-                .enumerate()
-                .for_each(body);
-        } else {
-            fe.par_chunks_mut(2 * CHUNK)
-                .zip(self.state.par_chunks_mut(CHUNK))
-                .enumerate()
-                .for_each(body);
-        }
+        for_chunks_of(
+            self.id.len(),
+            (Per(fe, 2), Per(&mut self.state[..], 1)),
+            |ci, (out, st)| {
+                let e0 = ci * CHUNK;
+                for (j, (pair, s)) in out.chunks_exact_mut(2).zip(st.iter_mut()).enumerate() {
+                    let e = e0 + j;
+                    let [a, b] = nodes[e];
+                    let (a, b) = (a as usize, b as usize);
+                    let d = rel_disp(&x[a], &x[b], &d0[e]);
+                    let dd = [v[b][0] - v[a][0], v[b][1] - v[a][1], v[b][2] - v[a][2]];
+                    let f2 = if plain {
+                        force_update(&d, &dd, &props[e], s, dt_prev)
+                    } else {
+                        force_update_law(&d, &dd, &props[e], &law[e], s, dt_prev)
+                    };
+                    pair[0] = [-f2[0], -f2[1], -f2[2]];
+                    pair[1] = f2;
+                }
+            },
+        );
     }
     fn stiffness_sums(&self, ctx: &StiffCtx, s: &mut [f64], c: &mut [f64], _r: &mut [f64]) {
         let w = |other: u32| {
@@ -861,7 +842,7 @@ impl Family for FramedLinkGroup {
         let state = &mut self.state;
         let n = nodes.len();
         // The state is advanced per link: split it by chunks alongside the slots.
-        let body = |(ci, (out, st)): (usize, (&mut [[f64; 3]], &mut [LinkState]))| {
+        for_chunks_of(n, (Per(fe, 6), Per(&mut state[..], 1)), |ci, (out, st)| {
             let e0 = ci * CHUNK;
             for (j, (six, s)) in out.chunks_exact_mut(6).zip(st.iter_mut()).enumerate() {
                 let e = e0 + j;
@@ -871,18 +852,7 @@ impl Family for FramedLinkGroup {
                 let f = framed_force_update(&xe, &ve, &d0[e], &props[e], &law[e], s, dt_prev);
                 six.copy_from_slice(&f);
             }
-        };
-        if n <= CHUNK {
-            fe.chunks_mut(6 * CHUNK)
-                .zip(state.chunks_mut(CHUNK))
-                .enumerate()
-                .for_each(body);
-        } else {
-            fe.par_chunks_mut(6 * CHUNK)
-                .zip(state.par_chunks_mut(CHUNK))
-                .enumerate()
-                .for_each(body);
-        }
+        });
     }
     fn stiffness_sums(&self, ctx: &StiffCtx, s: &mut [f64], c: &mut [f64], _r: &mut [f64]) {
         let w = |other: u32| {

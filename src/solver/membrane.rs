@@ -450,10 +450,10 @@ pub fn max_stiffness<const N: usize>(
 // The membrane families (triangles and quads).
 
 use super::collapse::{limit as limit_step, CollapseRef};
-use super::failure::{fibre_strain, taken_energy, Criterion, Erosion, Failure, FailureLaw, Fate};
+use super::failure::{fibre_strain, taken_energy, Criterion, Erosion, Failure, FailureLaw};
 use super::family::{
-    chunk_partials, for_chunks, Build, EnergyGroup, EnergyPartial, Family, ForceCtx, StiffCtx,
-    Stiffened, CHUNK,
+    chunk_partials, for_chunks, for_chunks_of, Build, EnergyGroup, EnergyPartial, Family, ForceCtx,
+    Per, StiffCtx, Stiffened, CHUNK,
 };
 use super::vec3::Vec3;
 use crate::model::ElementKind;
@@ -862,7 +862,6 @@ impl<const N: usize> MembraneGroup<N> {
     /// fail has. The strain energy a failure takes (the element's, or what the failed
     /// direction held) is kept in its fate.
     fn forces_with_failure(&mut self, ctx: &ForceCtx, fe: &mut [[f64; 3]]) {
-        use rayon::prelude::*;
         let (x, v) = (ctx.x, ctx.v);
         let MembraneGroup {
             nodes,
@@ -886,100 +885,96 @@ impl<const N: usize> MembraneGroup<N> {
             &*collapse,
             &*any,
         );
-        let body = |(ci, (out, fates)): (usize, (&mut [[f64; 3]], &mut [Fate]))| {
-            let e0 = ci * CHUNK;
-            for (j, (el, fate)) in out.chunks_exact_mut(N).zip(fates.iter_mut()).enumerate() {
-                let e = e0 + j;
-                if fate.eroded {
-                    el.fill([0.0; 3]);
-                    continue;
-                }
-                let ns = &nodes[e];
-                let xe: [[f64; 3]; N] = std::array::from_fn(|a| x[ns[a] as usize]);
-                let lw = &failure[e];
-                let with_rate = lw.dir.iter().any(|d| d.rate_coefficient != 0.0);
-                let ve: [[f64; 3]; N] = if with_rate {
-                    std::array::from_fn(|a| v[ns[a] as usize])
-                } else {
-                    [[0.0; 3]; N]
-                };
-                let (eps, rate) = fibre_strains(&xe, &ve, &reference[e], with_rate);
-                let eps: [f64; 2] = std::array::from_fn(|i| {
-                    lw.dir[i].filter(eps[i], ctx.dt_prev, &mut fate.filtered[i])
-                });
-                let (now, limit) = failing(lw, eps, rate, fate.dirs);
-                // Collapsed: its own stable step below half the run's
-                // ([`super::collapse`]).
-                let collapsed = collapse.get(e).and_then(|c| c.below(&xe, ctx.dt_prev));
-                let before = fate.dirs;
-                let mat_before = if before == 0 {
-                    material[e]
-                } else {
-                    material[e].with_failed(before)
-                };
-                if now != 0 || collapsed.is_some() {
-                    let (w0, h0) = energy(&xe, &reference[e], &mat_before, thickness[e], k_hg[e]);
-                    let dirs = before | now;
-                    let can = (lw.dir[0].can_fail() as u8) | ((lw.dir[1].can_fail() as u8) << 1);
-                    let eroded = collapsed.is_some() || !lw.all_directions || dirs & can == can;
-                    // The energy and the forces that leave: all of them, or what the
-                    // failed direction carried (see `failure::taken_energy`).
-                    let f0 = forces(&xe, &reference[e], &mat_before, thickness[e], k_hg[e]);
-                    let vn: [[f64; 3]; N] = std::array::from_fn(|a| v[ns[a] as usize]);
-                    let taken = if eroded {
-                        taken_energy(w0 + h0, ctx.dt_prev, &vn, &f0)
-                    } else {
-                        let mat1 = material[e].with_failed(dirs);
-                        let (w1, _) = energy(&xe, &reference[e], &mat1, thickness[e], k_hg[e]);
-                        let f1 = forces(&xe, &reference[e], &mat1, thickness[e], k_hg[e]);
-                        let df: [[f64; 3]; N] =
-                            std::array::from_fn(|a| std::array::from_fn(|c| f0[a][c] - f1[a][c]));
-                        taken_energy(w0 - w1, ctx.dt_prev, &vn, &df)
-                    };
-                    // The first direction that failed now names the criterion, else the
-                    // collapse: the element's step against the run's.
-                    let (criterion, value, limit) = match (now, collapsed) {
-                        (0, Some(step)) => (Criterion::TimeStep, step, limit_step(ctx.dt_prev)),
-                        _ if now & 1 != 0 => (Criterion::Direction1, eps[0], limit[0]),
-                        _ => (Criterion::Direction2, eps[1], limit[1]),
-                    };
-                    fate.dirs = dirs;
-                    fate.eroded = eroded;
-                    fate.energy += taken;
-                    fate.fresh = Some(Failure {
-                        kind: Self::KIND,
-                        element: e,
-                        criterion,
-                        value,
-                        limit,
-                        eroded,
-                        energy: taken,
-                    });
-                    any.store(true, std::sync::atomic::Ordering::Relaxed);
-                    if eroded {
+        for_chunks_of(
+            nodes.len(),
+            (Per(fe, N), Per(&mut fate[..], 1)),
+            |ci, (out, fates)| {
+                let e0 = ci * CHUNK;
+                for (j, (el, fate)) in out.chunks_exact_mut(N).zip(fates.iter_mut()).enumerate() {
+                    let e = e0 + j;
+                    if fate.eroded {
                         el.fill([0.0; 3]);
                         continue;
                     }
+                    let ns = &nodes[e];
+                    let xe: [[f64; 3]; N] = std::array::from_fn(|a| x[ns[a] as usize]);
+                    let lw = &failure[e];
+                    let with_rate = lw.dir.iter().any(|d| d.rate_coefficient != 0.0);
+                    let ve: [[f64; 3]; N] = if with_rate {
+                        std::array::from_fn(|a| v[ns[a] as usize])
+                    } else {
+                        [[0.0; 3]; N]
+                    };
+                    let (eps, rate) = fibre_strains(&xe, &ve, &reference[e], with_rate);
+                    let eps: [f64; 2] = std::array::from_fn(|i| {
+                        lw.dir[i].filter(eps[i], ctx.dt_prev, &mut fate.filtered[i])
+                    });
+                    let (now, limit) = failing(lw, eps, rate, fate.dirs);
+                    // Collapsed: its own stable step below half the run's
+                    // ([`super::collapse`]).
+                    let collapsed = collapse.get(e).and_then(|c| c.below(&xe, ctx.dt_prev));
+                    let before = fate.dirs;
+                    let mat_before = if before == 0 {
+                        material[e]
+                    } else {
+                        material[e].with_failed(before)
+                    };
+                    if now != 0 || collapsed.is_some() {
+                        let (w0, h0) =
+                            energy(&xe, &reference[e], &mat_before, thickness[e], k_hg[e]);
+                        let dirs = before | now;
+                        let can =
+                            (lw.dir[0].can_fail() as u8) | ((lw.dir[1].can_fail() as u8) << 1);
+                        let eroded = collapsed.is_some() || !lw.all_directions || dirs & can == can;
+                        // The energy and the forces that leave: all of them, or what the
+                        // failed direction carried (see `failure::taken_energy`).
+                        let f0 = forces(&xe, &reference[e], &mat_before, thickness[e], k_hg[e]);
+                        let vn: [[f64; 3]; N] = std::array::from_fn(|a| v[ns[a] as usize]);
+                        let taken = if eroded {
+                            taken_energy(w0 + h0, ctx.dt_prev, &vn, &f0)
+                        } else {
+                            let mat1 = material[e].with_failed(dirs);
+                            let (w1, _) = energy(&xe, &reference[e], &mat1, thickness[e], k_hg[e]);
+                            let f1 = forces(&xe, &reference[e], &mat1, thickness[e], k_hg[e]);
+                            let df: [[f64; 3]; N] = std::array::from_fn(|a| {
+                                std::array::from_fn(|c| f0[a][c] - f1[a][c])
+                            });
+                            taken_energy(w0 - w1, ctx.dt_prev, &vn, &df)
+                        };
+                        // The first direction that failed now names the criterion, else the
+                        // collapse: the element's step against the run's.
+                        let (criterion, value, limit) = match (now, collapsed) {
+                            (0, Some(step)) => (Criterion::TimeStep, step, limit_step(ctx.dt_prev)),
+                            _ if now & 1 != 0 => (Criterion::Direction1, eps[0], limit[0]),
+                            _ => (Criterion::Direction2, eps[1], limit[1]),
+                        };
+                        fate.dirs = dirs;
+                        fate.eroded = eroded;
+                        fate.energy += taken;
+                        fate.fresh = Some(Failure {
+                            kind: Self::KIND,
+                            element: e,
+                            criterion,
+                            value,
+                            limit,
+                            eroded,
+                            energy: taken,
+                        });
+                        any.store(true, std::sync::atomic::Ordering::Relaxed);
+                        if eroded {
+                            el.fill([0.0; 3]);
+                            continue;
+                        }
+                    }
+                    let mat = if fate.dirs == 0 {
+                        material[e]
+                    } else {
+                        material[e].with_failed(fate.dirs)
+                    };
+                    let f = forces(&xe, &reference[e], &mat, thickness[e], k_hg[e]);
+                    el.copy_from_slice(&f);
                 }
-                let mat = if fate.dirs == 0 {
-                    material[e]
-                } else {
-                    material[e].with_failed(fate.dirs)
-                };
-                let f = forces(&xe, &reference[e], &mat, thickness[e], k_hg[e]);
-                el.copy_from_slice(&f);
-            }
-        };
-        if nodes.len() <= CHUNK {
-            fe.chunks_mut(N * CHUNK)
-                .zip(fate.chunks_mut(CHUNK))
-                .enumerate()
-                .for_each(body);
-        } else {
-            fe.par_chunks_mut(N * CHUNK)
-                .zip(fate.par_chunks_mut(CHUNK))
-                .enumerate()
-                .for_each(body);
-        }
+            },
+        );
     }
 }

@@ -58,10 +58,9 @@
 //! with its yarns in contact), to the same check as the membranes' stiffening, which
 //! stops the run naming the link.
 
-use rayon::prelude::*;
-
 use super::family::{
-    chunk_partials, Build, EnergyGroup, EnergyPartial, Family, ForceCtx, StiffCtx, Stiffened, CHUNK,
+    chunk_partials, for_chunks_of, Build, EnergyGroup, EnergyPartial, Family, ForceCtx, Per,
+    StiffCtx, Stiffened, CHUNK,
 };
 use super::link::{
     bound_stiffness, energy_law, force_update_parts, frame_kin, framed_node_forces, link_props,
@@ -723,26 +722,20 @@ impl Family for SlidingLinkGroup {
         let (x, v, dt_prev) = (ctx.x, ctx.v, ctx.dt_prev);
         let (nodes, geom, props, law) = (&self.nodes, &self.geom, &self.props, &self.law);
         let n = nodes.len();
-        let body = |(ci, (out, st)): (usize, (&mut [Vec3], &mut [SlidingState]))| {
-            let e0 = ci * CHUNK;
-            for (j, (slots, s)) in out.chunks_exact_mut(2 * WIN).zip(st.iter_mut()).enumerate() {
-                let e = e0 + j;
-                let xe = Self::gather(x, &nodes[e]);
-                let ve = Self::gather(v, &nodes[e]);
-                force_update(&xe, &ve, &geom[e], &props[e], &law[e], s, dt_prev, slots);
-            }
-        };
-        if n <= CHUNK {
-            fe.chunks_mut(2 * WIN * CHUNK)
-                .zip(self.state.chunks_mut(CHUNK))
-                .enumerate()
-                .for_each(body);
-        } else {
-            fe.par_chunks_mut(2 * WIN * CHUNK)
-                .zip(self.state.par_chunks_mut(CHUNK))
-                .enumerate()
-                .for_each(body);
-        }
+        for_chunks_of(
+            n,
+            (Per(fe, 2 * WIN), Per(&mut self.state[..], 1)),
+            |ci, (out, st)| {
+                let e0 = ci * CHUNK;
+                for (j, (slots, s)) in out.chunks_exact_mut(2 * WIN).zip(st.iter_mut()).enumerate()
+                {
+                    let e = e0 + j;
+                    let xe = Self::gather(x, &nodes[e]);
+                    let ve = Self::gather(v, &nodes[e]);
+                    force_update(&xe, &ve, &geom[e], &props[e], &law[e], s, dt_prev, slots);
+                }
+            },
+        );
     }
     fn stiffness_sums(&self, _ctx: &StiffCtx, s: &mut [f64], c: &mut [f64], _r: &mut [f64]) {
         // The rows at the reference anchors, made at build (`base`); the two-node links'

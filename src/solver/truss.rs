@@ -82,10 +82,10 @@ pub fn strain_and_rate(
     ((l - l0) / l0, rate)
 }
 
-use super::failure::{taken_energy, Criterion, Erosion, Failure, FailureLaw, Fate};
+use super::failure::{taken_energy, Criterion, Erosion, Failure, FailureLaw};
 use super::family::{
-    chunk_partials, for_chunks, Build, EnergyGroup, EnergyPartial, Family, ForceCtx, StiffCtx,
-    CHUNK,
+    chunk_partials, for_chunks, for_chunks_of, Build, EnergyGroup, EnergyPartial, Family, ForceCtx,
+    Per, StiffCtx, CHUNK,
 };
 use super::vec3::dot;
 use crate::error::Result;
@@ -124,7 +124,6 @@ impl TrussGroup {
     /// reached its limit fails (no force from this step on; its strain energy is kept
     /// in its fate), the others as [`force`].
     fn forces_with_failure(&mut self, ctx: &ForceCtx, fe: &mut [[f64; 3]]) {
-        use rayon::prelude::*;
         let (x, v) = (ctx.x, ctx.v);
         let TrussGroup {
             nodes,
@@ -137,66 +136,59 @@ impl TrussGroup {
         let Erosion { law, fate, any, .. } = erosion;
         let (nodes, k, l0, tension_only, law, any) =
             (&*nodes, &*k, &*l0, &*tension_only, &*law, &*any);
-        let body = |(ci, (out, fates)): (usize, (&mut [[f64; 3]], &mut [Fate]))| {
-            let e0 = ci * CHUNK;
-            for (j, (pair, fate)) in out.chunks_exact_mut(2).zip(fates.iter_mut()).enumerate() {
-                let e = e0 + j;
-                if fate.eroded {
-                    pair[0] = [0.0; 3];
-                    pair[1] = [0.0; 3];
-                    continue;
-                }
-                let [a, b] = nodes[e];
-                let (a, b) = (a as usize, b as usize);
-                let lw = &law[e];
-                if lw.can_fail() {
-                    let (eps, rate) = strain_and_rate(&x[a], &x[b], &v[a], &v[b], l0[e]);
-                    let eps = lw.filter(eps, ctx.dt_prev, &mut fate.filtered[0]);
-                    let limit = lw.threshold(rate);
-                    if eps >= limit {
-                        // Its strain energy, and the half step of work its force would
-                        // have done (the central difference's trapezoid): what the
-                        // failure takes (see `failure::taken_energy`).
-                        let f2 = force(&x[a], &x[b], k[e], l0[e], tension_only[e]);
-                        let w = taken_energy(
-                            energy(&x[a], &x[b], k[e], l0[e], tension_only[e]),
-                            ctx.dt_prev,
-                            &[v[a], v[b]],
-                            &[[-f2[0], -f2[1], -f2[2]], f2],
-                        );
-                        fate.eroded = true;
-                        fate.energy = w;
-                        fate.fresh = Some(Failure {
-                            kind: ElementKind::Truss,
-                            element: e,
-                            criterion: Criterion::Axial,
-                            value: eps,
-                            limit,
-                            eroded: true,
-                            energy: w,
-                        });
-                        any.store(true, std::sync::atomic::Ordering::Relaxed);
+        for_chunks_of(
+            nodes.len(),
+            (Per(fe, 2), Per(&mut fate[..], 1)),
+            |ci, (out, fates)| {
+                let e0 = ci * CHUNK;
+                for (j, (pair, fate)) in out.chunks_exact_mut(2).zip(fates.iter_mut()).enumerate() {
+                    let e = e0 + j;
+                    if fate.eroded {
                         pair[0] = [0.0; 3];
                         pair[1] = [0.0; 3];
                         continue;
                     }
+                    let [a, b] = nodes[e];
+                    let (a, b) = (a as usize, b as usize);
+                    let lw = &law[e];
+                    if lw.can_fail() {
+                        let (eps, rate) = strain_and_rate(&x[a], &x[b], &v[a], &v[b], l0[e]);
+                        let eps = lw.filter(eps, ctx.dt_prev, &mut fate.filtered[0]);
+                        let limit = lw.threshold(rate);
+                        if eps >= limit {
+                            // Its strain energy, and the half step of work its force would
+                            // have done (the central difference's trapezoid): what the
+                            // failure takes (see `failure::taken_energy`).
+                            let f2 = force(&x[a], &x[b], k[e], l0[e], tension_only[e]);
+                            let w = taken_energy(
+                                energy(&x[a], &x[b], k[e], l0[e], tension_only[e]),
+                                ctx.dt_prev,
+                                &[v[a], v[b]],
+                                &[[-f2[0], -f2[1], -f2[2]], f2],
+                            );
+                            fate.eroded = true;
+                            fate.energy = w;
+                            fate.fresh = Some(Failure {
+                                kind: ElementKind::Truss,
+                                element: e,
+                                criterion: Criterion::Axial,
+                                value: eps,
+                                limit,
+                                eroded: true,
+                                energy: w,
+                            });
+                            any.store(true, std::sync::atomic::Ordering::Relaxed);
+                            pair[0] = [0.0; 3];
+                            pair[1] = [0.0; 3];
+                            continue;
+                        }
+                    }
+                    let f2 = force(&x[a], &x[b], k[e], l0[e], tension_only[e]);
+                    pair[0] = [-f2[0], -f2[1], -f2[2]];
+                    pair[1] = f2;
                 }
-                let f2 = force(&x[a], &x[b], k[e], l0[e], tension_only[e]);
-                pair[0] = [-f2[0], -f2[1], -f2[2]];
-                pair[1] = f2;
-            }
-        };
-        if nodes.len() <= CHUNK {
-            fe.chunks_mut(2 * CHUNK)
-                .zip(fate.chunks_mut(CHUNK))
-                .enumerate()
-                .for_each(body);
-        } else {
-            fe.par_chunks_mut(2 * CHUNK)
-                .zip(fate.par_chunks_mut(CHUNK))
-                .enumerate()
-                .for_each(body);
-        }
+            },
+        );
     }
 }
 

@@ -42,8 +42,8 @@ use crate::material::{Material, PointState};
 use crate::model::ElementKind;
 use crate::shape::hex8::{self, HexGeometry};
 use crate::solver::family::{
-    chunk_partials, Build, EnergyGroup, EnergyPartial, Family, ForceCtx, StateValues, StiffCtx,
-    Stiffened, CHUNK,
+    chunk_partials, for_chunks_of, Build, EnergyGroup, EnergyPartial, Family, ForceCtx, Per,
+    StateValues, StiffCtx, Stiffened, CHUNK,
 };
 use crate::solver::vec3::Vec3;
 
@@ -341,7 +341,6 @@ impl Family for HexGroup {
         self.rows[e].iter().fold(0.0, |a: f64, &r| a.max(r))
     }
     fn forces(&mut self, ctx: &ForceCtx, fe: &mut [Vec3]) {
-        use rayon::prelude::*;
         let HexGroup {
             nodes,
             material,
@@ -355,14 +354,11 @@ impl Family for HexGroup {
         let (nodes, material, materials, q_hg) = (&*nodes, &*material, &*materials, &*q_hg);
         // Each chunk of force slots travels with its elements' state, previous forces
         // and work.
-        type Chunk<'a> = (
-            usize,
-            (
-                ((&'a mut [Vec3], &'a mut [PointState]), &'a mut [Previous]),
-                &'a mut [[f64; 3]],
-            ),
+        let slices = (
+            (Per(fe, 8), Per(&mut state[..], 1)),
+            (Per(&mut previous[..], 1), Per(&mut work[..], 1)),
         );
-        let body = |(ci, (((out, st), pv), wk)): Chunk| {
+        for_chunks_of(nodes.len(), slices, |ci, ((out, st), (pv, wk))| {
             let e0 = ci * CHUNK;
             for (j, slots) in out.chunks_exact_mut(8).enumerate() {
                 let e = e0 + j;
@@ -381,22 +377,7 @@ impl Family for HexGroup {
                     slots,
                 );
             }
-        };
-        if nodes.len() <= CHUNK {
-            fe.chunks_mut(8 * CHUNK)
-                .zip(state.chunks_mut(CHUNK))
-                .zip(previous.chunks_mut(CHUNK))
-                .zip(work.chunks_mut(CHUNK))
-                .enumerate()
-                .for_each(body);
-        } else {
-            fe.par_chunks_mut(8 * CHUNK)
-                .zip(state.par_chunks_mut(CHUNK))
-                .zip(previous.par_chunks_mut(CHUNK))
-                .zip(work.par_chunks_mut(CHUNK))
-                .enumerate()
-                .for_each(body);
-        }
+        });
     }
     fn stiffness_sums(&self, _ctx: &StiffCtx, s: &mut [f64], c: &mut [f64], _r: &mut [f64]) {
         for (e, ns) in self.nodes.iter().enumerate() {
