@@ -194,6 +194,19 @@ pub struct Fate {
     pub filtered: [f64; 2],
 }
 
+impl Fate {
+    /// Books a failure found by a force pass: the element is eroded when the failure
+    /// says so, keeps the energy it took, holds it until it is collected, and sets the
+    /// family's flag `any` (its [`Erosion::any`]).
+    #[inline]
+    pub fn fail(&mut self, failure: Failure, any: &std::sync::atomic::AtomicBool) {
+        self.eroded = failure.eroded;
+        self.energy += failure.energy;
+        self.fresh = Some(failure);
+        any.store(true, std::sync::atomic::Ordering::Relaxed);
+    }
+}
+
 /// The erosion state of a family: its elements' failure laws and fates. Empty (and
 /// `active` false) when none of its elements can fail: the family then runs its loops
 /// as they were.

@@ -166,9 +166,7 @@ impl TrussGroup {
                                 &[v[a], v[b]],
                                 &[[-f2[0], -f2[1], -f2[2]], f2],
                             );
-                            fate.eroded = true;
-                            fate.energy = w;
-                            fate.fresh = Some(Failure {
+                            let failure = Failure {
                                 kind: ElementKind::Truss,
                                 element: e,
                                 criterion: Criterion::Axial,
@@ -176,8 +174,8 @@ impl TrussGroup {
                                 limit,
                                 eroded: true,
                                 energy: w,
-                            });
-                            any.store(true, std::sync::atomic::Ordering::Relaxed);
+                            };
+                            fate.fail(failure, any);
                             pair[0] = [0.0; 3];
                             pair[1] = [0.0; 3];
                             continue;
