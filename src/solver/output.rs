@@ -241,17 +241,16 @@ pub fn history_schema() -> SchemaRef {
 
 const FLUSH_ROWS: usize = 1 << 18;
 
-/// Streams `history.parquet` and collects `energy.parquet`; nothing appears under the
-/// final names until [`ParquetSink::finish`].
+/// Streams `history.parquet`, and keeps the energies, the projectiles and the layers as
+/// the [`MemorySink`] does (`rest`, its history unused) for `energy.parquet`,
+/// `projectile.parquet` and `ballistic.parquet`; nothing appears under the final names
+/// until [`ParquetSink::finish`].
 pub struct ParquetSink {
     node_id: Vec<i64>,
     hist: AtomicTableWriter,
     cols: [Vec<f64>; 7],
     ids: Vec<i64>,
-    energy_t: Vec<f64>,
-    energy: Vec<Energies>,
-    projectile: Vec<(f64, i64, [f64; 9])>,
-    layers: Vec<(f64, Vec<LayerValues>)>,
+    rest: MemorySink,
 }
 
 impl ParquetSink {
@@ -261,19 +260,17 @@ impl ParquetSink {
             hist: AtomicTableWriter::create(&out.join("history.parquet"), history_schema(), prov)?,
             cols: Default::default(),
             ids: Vec::new(),
-            energy_t: Vec::new(),
-            energy: Vec::new(),
-            projectile: Vec::new(),
-            layers: Vec::new(),
+            rest: MemorySink::default(),
         })
     }
 
     /// `ballistic.parquet`: one row per output time and layer (see [`super::watch`]).
     fn ballistic_table(&self) -> Option<arrow_array::RecordBatch> {
-        if self.layers.is_empty() {
+        if self.rest.layers.is_empty() {
             return None;
         }
         let rows: Vec<(f64, usize, &LayerValues)> = self
+            .rest
             .layers
             .iter()
             .flat_map(|(t, ls)| ls.iter().enumerate().map(move |(l, r)| (*t, l + 1, r)))
@@ -333,7 +330,7 @@ impl ParquetSink {
     /// Write the energy table and move both tables into place.
     pub fn finish(mut self, out: &Path, prov: &Provenance) -> Result<()> {
         self.flush()?;
-        let e = &self.energy;
+        let e = &self.rest.energy;
         let col = |f: fn(&Energies) -> f64| e.iter().map(f).collect::<Vec<_>>();
         // The written relative error is taken against the whole run's energy scale (its
         // last, largest value), so that the first samples, where the scale so far is
@@ -350,7 +347,7 @@ impl ParquetSink {
             })
             .collect();
         let eb = batch(vec![
-            Col::F64("t", self.energy_t.clone()),
+            Col::F64("t", self.rest.energy_t.clone()),
             Col::F64("kinetic", col(|x| x.kinetic)),
             Col::F64("internal", col(|x| x.internal)),
             Col::F64("damping", col(|x| x.damping)),
@@ -366,8 +363,8 @@ impl ParquetSink {
         let mut ew = AtomicTableWriter::create(&out.join("energy.parquet"), eb.schema(), prov)?;
         ew.write(&eb)?;
         let mut pw = None;
-        if !self.projectile.is_empty() {
-            let p = &self.projectile;
+        if !self.rest.projectile.is_empty() {
+            let p = &self.rest.projectile;
             let c = |k: usize| p.iter().map(|r| r.2[k]).collect::<Vec<_>>();
             let pb = batch(vec![
                 Col::F64("t", p.iter().map(|r| r.0).collect()),
@@ -410,12 +407,10 @@ impl ParquetSink {
 
 impl Sink for ParquetSink {
     fn projectile(&mut self, t: f64, id: i64, s: &[f64; 9]) -> Result<()> {
-        self.projectile.push((t, id, *s));
-        Ok(())
+        self.rest.projectile(t, id, s)
     }
     fn layers(&mut self, t: f64, rows: &[LayerValues]) -> Result<()> {
-        self.layers.push((t, rows.to_vec()));
-        Ok(())
+        self.rest.layers(t, rows)
     }
     fn history(&mut self, t: f64, nodes: &[usize], u: &[[f64; 3]], v: &[[f64; 3]]) -> Result<()> {
         for (j, &i) in nodes.iter().enumerate() {
@@ -432,8 +427,6 @@ impl Sink for ParquetSink {
         Ok(())
     }
     fn energy(&mut self, t: f64, e: &Energies) -> Result<()> {
-        self.energy_t.push(t);
-        self.energy.push(*e);
-        Ok(())
+        self.rest.energy(t, e)
     }
 }
