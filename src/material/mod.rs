@@ -30,8 +30,8 @@
 //! Erosion: when ε_p ≥ `erosion_plastic_strain` the point is flagged `eroded` (the family
 //! deletes the element); an eroded point carries no stress in later updates.
 //!
-//! Adding a law is one file implementing [`MaterialLaw`] and one line in the `laws!`
-//! invocation below (docs/howto/element_family.md, "Add a material law").
+//! Adding a law is one file implementing [`MaterialLaw`], its `mod` line and its line in
+//! the `laws!` invocation below (docs/howto/element_family.md, "Add a material law").
 
 pub mod elastic;
 pub mod j2;
