@@ -179,7 +179,7 @@ fn patch(kind: ElementKind) -> Model {
 }
 
 /// Mutation tried (2026-11-23): the ν₁₂E₂ coupling terms of the material matrix set to
-/// 0 in `solver/membrane.rs`: this test fails (its stiffness matrix is written out by
+/// 0 in `solver/membrane/kernel.rs`: this test fails (its stiffness matrix is written out by
 /// hand here, not taken from the code).
 #[test]
 fn patch_test_reproduces_a_uniform_strain_exactly() {

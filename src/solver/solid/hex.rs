@@ -212,7 +212,7 @@ impl Family for HexGroup {
     const SLOTS: usize = 8;
     const GROUP: EnergyGroup = EnergyGroup::Solid;
     const VARIABLE_STEP: bool = true;
-    /// At an output sample step: the state at tⁿ of the elements in [`HexGroup::output`],
+    /// At an output sample step: the state at tⁿ of the elements in `output`,
     /// in that order, into `rows` (σ, ε_p, T; an eroded element's σ as 0: its forces are
     /// zero from then on, while its point keeps the stress it eroded with).
     fn sample_states(&self, rows: &mut Vec<StateValues>) {
