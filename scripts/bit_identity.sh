@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Bit-identity check between two builds of weft: runs every generator at its defaults
-# (and simulates each model) and the shipped pipelines with each build, then compares
+# (and simulates each model, the hexahedra's Taylor rod among them) and the shipped pipelines with each build, then compares
 # every Parquet table they write (models, results, fits, errors, wave speeds, figures'
 # data) value by value, ignoring the Parquet metadata (provenance names the tool version
 # and paths) and the wall-time columns.
@@ -37,7 +37,7 @@ bins() { # $1: folder or revision -> prints a folder of binaries
 run_all() { # $1: binaries, $2: output folder
   local b="$1" o="$2"
   mkdir -p "$o"
-  for g in rod girder membrane combined woven-reduced woven; do
+  for g in rod girder membrane combined woven-reduced woven taylor; do
     "$b/weft-weave" "$g" --out "$o/models/$g" >/dev/null 2>&1
     if [ "$g" != woven ] || [ "$full" = 1 ]; then
       "$b/weft-simulate" --quiet --model "$o/models/$g" --out "$o/gen/$g" --threads 2 >/dev/null 2>&1
