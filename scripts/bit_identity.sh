@@ -2,8 +2,8 @@
 # Bit-identity check between two builds of weft: runs every generator at its defaults
 # (and simulates each model, the hexahedra's Taylor rod among them) and the shipped
 # pipelines with each build, then compares every Parquet table they write (models,
-# results, fits, errors, wave speeds, figures' data) value by value, ignoring the Parquet metadata (provenance names the tool version
-# and paths) and the wall-time columns.
+# results, fits, errors, wave speeds, figures' data) value by value, ignoring the Parquet
+# metadata (provenance names the tool version and paths) and the wall-time columns.
 #
 #   scripts/bit_identity.sh [--full] BEFORE AFTER
 #
