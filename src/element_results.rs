@@ -49,7 +49,7 @@ use std::path::Path;
 
 use crate::error::{Result, WeftError};
 use crate::material;
-use crate::model::{ElementKind, Model};
+use crate::model::{ElementBlock, ElementKind, Model};
 use crate::solver::membrane::{self, Material, Reference};
 use crate::solver::output::StateValues;
 use crate::solver::{truss, Energies, Sink};
@@ -139,29 +139,84 @@ pub const COLUMNS: [&str; 19] = [
     "von_mises_stress",
 ];
 
+/// Whether each part of `m` is among `parts` (`all`: every one); an unknown name is
+/// refused with the model's part names.
+fn chosen_parts(m: &Model, parts: &[String]) -> Result<Vec<bool>> {
+    let mut chosen = vec![false; m.parts.len()];
+    for name in parts {
+        if name == "all" {
+            chosen.iter_mut().for_each(|c| *c = true);
+            continue;
+        }
+        let i = m.part_index(name).ok_or_else(|| {
+            WeftError::input(format!("--element-results: no part `{name}`")).expected(format!(
+                "`all` or a part of the model: {}",
+                m.parts
+                    .iter()
+                    .map(|p| format!("`{}`", p.name))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ))
+        })?;
+        chosen[i] = true;
+    }
+    Ok(chosen)
+}
+
+impl Item {
+    /// What the quantities of element `e` of block `b` (kind `kind`, nodes `nodes`) need
+    /// (module docs); not for point masses and hexahedra, which take no history.
+    fn of(
+        m: &Model,
+        kind: ElementKind,
+        b: &ElementBlock,
+        e: usize,
+        nodes: &[usize],
+    ) -> Result<Item> {
+        let p = &m.parts[b.part[e]].props;
+        let sub = |a: usize, b: usize| -> [f64; 3] {
+            std::array::from_fn(|d| m.coords[b][d] - m.coords[a][d])
+        };
+        let norm = |v: [f64; 3]| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+        Ok(match kind {
+            ElementKind::Truss => {
+                let l = norm(sub(nodes[0], nodes[1]));
+                let l0 = l / (1.0 + p.prestrain.unwrap_or(0.0));
+                let ea = p.youngs_modulus.unwrap_or(0.0) * b.truss_area(&m.parts, e);
+                Item::Truss {
+                    nodes: [nodes[0], nodes[1]],
+                    k: ea / l0,
+                    l0,
+                    tension_only: p.tension_only.unwrap_or(false),
+                }
+            }
+            ElementKind::Beam => Item::Beam {
+                nodes: [nodes[0], nodes[1]],
+                l0: norm(sub(nodes[0], nodes[1])),
+                ea: p.youngs_modulus.unwrap_or(0.0)
+                    * p.width.unwrap_or(0.0)
+                    * p.height.unwrap_or(0.0),
+            },
+            ElementKind::Link => Item::Link {
+                nodes: [nodes[0], nodes[1]],
+                d0: sub(nodes[0], nodes[1]),
+                k: [p.kx, p.ky, p.kz].map(|v| v.unwrap_or(0.0)),
+                c: [p.cx, p.cy, p.cz].map(|v| v.unwrap_or(0.0)),
+                slider: p.slip_force.is_some() || p.sliding == Some(true),
+            },
+            ElementKind::Tri => Item::Tri(Box::new(membrane_item(m, b, e, nodes)?)),
+            ElementKind::Quad => Item::Quad(Box::new(membrane_item(m, b, e, nodes)?)),
+            ElementKind::PointMass | ElementKind::Hex => unreachable!("no history for {kind:?}"),
+        })
+    }
+}
+
 impl ElementResults {
     /// Select the elements of the named parts (`all`: every part) of a validated model;
     /// `output_nodes` are the history's nodes, which must hold every node of those
     /// elements.
     pub fn new(m: &Model, parts: &[String], output_nodes: &[usize]) -> Result<ElementResults> {
-        let mut chosen = vec![false; m.parts.len()];
-        for name in parts {
-            if name == "all" {
-                chosen.iter_mut().for_each(|c| *c = true);
-                continue;
-            }
-            let i = m.part_index(name).ok_or_else(|| {
-                WeftError::input(format!("--element-results: no part `{name}`")).expected(format!(
-                    "`all` or a part of the model: {}",
-                    m.parts
-                        .iter()
-                        .map(|p| format!("`{}`", p.name))
-                        .collect::<Vec<_>>()
-                        .join(", ")
-                ))
-            })?;
-            chosen[i] = true;
-        }
+        let chosen = chosen_parts(m, parts)?;
         let mut slot = vec![usize::MAX; m.num_nodes()];
         for (j, &i) in output_nodes.iter().enumerate() {
             slot[i] = j;
@@ -184,10 +239,6 @@ impl ElementResults {
             hex_part_id: vec![],
             rows: Rows::default(),
         };
-        let sub = |a: usize, b: usize| -> [f64; 3] {
-            std::array::from_fn(|d| m.coords[b][d] - m.coords[a][d])
-        };
-        let norm = |v: [f64; 3]| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
         for (&kind, b) in &m.elements {
             let npe = kind.nodes_per_element();
             for e in 0..b.len() {
@@ -212,37 +263,7 @@ impl ElementResults {
                     ))
                     .hint("write every node: weft-simulate --all-nodes (or add the part's nodes to a --history-set)"));
                 }
-                let p = &part.props;
-                let item = match kind {
-                    ElementKind::Truss => {
-                        let l = norm(sub(nodes[0], nodes[1]));
-                        let l0 = l / (1.0 + p.prestrain.unwrap_or(0.0));
-                        let ea = p.youngs_modulus.unwrap_or(0.0) * b.truss_area(&m.parts, e);
-                        Item::Truss {
-                            nodes: [nodes[0], nodes[1]],
-                            k: ea / l0,
-                            l0,
-                            tension_only: p.tension_only.unwrap_or(false),
-                        }
-                    }
-                    ElementKind::Beam => Item::Beam {
-                        nodes: [nodes[0], nodes[1]],
-                        l0: norm(sub(nodes[0], nodes[1])),
-                        ea: p.youngs_modulus.unwrap_or(0.0)
-                            * p.width.unwrap_or(0.0)
-                            * p.height.unwrap_or(0.0),
-                    },
-                    ElementKind::Link => Item::Link {
-                        nodes: [nodes[0], nodes[1]],
-                        d0: sub(nodes[0], nodes[1]),
-                        k: [p.kx, p.ky, p.kz].map(|v| v.unwrap_or(0.0)),
-                        c: [p.cx, p.cy, p.cz].map(|v| v.unwrap_or(0.0)),
-                        slider: p.slip_force.is_some() || p.sliding == Some(true),
-                    },
-                    ElementKind::Tri => Item::Tri(Box::new(membrane_item(m, b, e, nodes)?)),
-                    ElementKind::Quad => Item::Quad(Box::new(membrane_item(m, b, e, nodes)?)),
-                    ElementKind::PointMass | ElementKind::Hex => unreachable!("skipped above"),
-                };
+                let item = Item::of(m, kind, b, e, nodes)?;
                 r.id.push(b.id[e]);
                 r.part_id.push(part.id);
                 r.kind.push(kind.name());
