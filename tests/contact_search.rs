@@ -1,71 +1,61 @@
-//! The tiled contact search (`solver::contact::surface::tiled`, issue 39 step 3) against
-//! the global one, on the solver's own trajectories.
+//! The contact's step against each of its sides built alone, on the solver's own
+//! trajectories.
 //!
-//! Independent reasoning: both searches are exact (each slave's list holds every face it
-//! can penetrate, in ascending order, and a slave is skipped only when no candidate can
-//! pass the filters), so every force, energy and state must be the same bits; a missed
-//! or a spurious pair, or a changed order, shows as a difference. Two checks:
-//! - the oracle (`SurfaceContact::oracle`): at every force evaluation of the tiled run,
-//!   the sides as they were before its narrow phase get fresh global lists at the same
+//! Independent reasoning: a step of the surface contact shares each master surface's
+//! thickness boxes and broad-phase grid among the sides that have it (the grid inflated
+//! by the largest reach among them, each side filtering by its own), computes on lazy
+//! steps only the boxes its narrow phases can read (`boxes::stamp_sides`), skips the
+//! slaves that no candidate can reach yet (`Side::margin`) and runs every side's chunks
+//! in one parallel loop. None of that may change a bit: each side's lists hold every
+//! face its slaves can penetrate in ascending order, and a slave is skipped only when no
+//! candidate can pass the filters. Two checks:
+//! - the oracle (`SurfaceContact::oracle`, set on the solver's contact before the run):
+//!   at every force evaluation, the sides as they were before the step's narrow phase
+//!   get fresh lists of their own (a grid of their own, at their own reach) at the same
 //!   positions and a narrow phase that skips nothing, and every slave's contact, state
 //!   and reaction shares, and every chunk's energies and penetrated count, must equal
-//!   the tiled run's bit for bit (it panics, naming the step and the node, otherwise);
-//! - whole runs: the tiled run's displacements, energies and projectile on 1 and 3
-//!   threads equal the global search's on 1 thread. The oracle's run computes every
-//!   face's thickness box at every step; the global run, at the steps where the sides of
-//!   a master surface skipped most of their slaves, only the boxes their narrow phases
-//!   can read (`Side::stamp_needed`): the equality checks that too.
+//!   the step's bit for bit (it panics, naming the step and the node, otherwise);
+//! - whole runs: the displacements, energies and projectile of the run under the oracle
+//!   on 1 and 3 threads equal those of the plain run on 1 thread. The oracle's run
+//!   computes every face's thickness box at every step; the plain run, at the steps where
+//!   the sides of a master surface skipped most of their slaves, only the boxes their
+//!   narrow phases can read: the equality checks that too.
 //!
 //! Models: a band patch, a chain patch, two chain layers (contact between the layers),
 //! a chain patch whose yarns fail and are perforated (erosion, the deepest-face law, the
 //! erosion probe), and a chain patch struck by a deformable bullet (a solid's boundary
-//! faces as the master surface). The sides that share a master surface (its boxes and
-//! broad-phase grid) are checked with the oracle on the global search too, with slaves
-//! of two thicknesses on each surface.
+//! faces as the master surface); and two chain layers whose master surfaces each serve
+//! sides of two reaches.
+//!
+//! (Until 2491c90 the oracle also checked a second, tiled search against this one; that
+//! search is retired, see docs/benchmarks.md.)
 
 use weft::generate::bullet::BulletParams;
 use weft::generate::woven::{woven, WovenBandParams, YarnFailure, YarnModel};
 use weft::model::Model;
-use weft::solver::contact::surface::{with_search, ContactReport, Search, SearchChoice};
-use weft::solver::run_in_memory;
+use weft::solver::contact::surface::ContactReport;
+use weft::solver::output::MemorySink;
+use weft::solver::Solver;
 
 /// What a run gives, printed exactly (`{:?}` of an f64 round-trips, so equal strings are
-/// equal bits), and its contact report.
-fn run(m: &Model, threads: usize, search: Search, oracle: bool) -> (String, ContactReport) {
-    run_with(m, threads, search, oracle, 2.0)
-}
-
-/// [`run`] with the tiles' width cap W + `slack` U (0: a re-grid whenever a box widens).
-fn run_with(
-    m: &Model,
-    threads: usize,
-    search: Search,
-    oracle: bool,
-    slack: f64,
-) -> (String, ContactReport) {
+/// equal bits), and its contact report; `oracle`: every force evaluation checked against
+/// each side alone.
+fn run(m: &Model, threads: usize, oracle: bool) -> (String, ContactReport) {
     rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
         .unwrap()
         .install(|| {
-            // Tiles of one cell and a hysteresis of one skin: many tiles and many changes
-            // of cell on these small models.
-            let choice = SearchChoice {
-                oracle,
-                tile_cells: 1,
-                tile_u_per_skin: 1.0,
-                tile_width_slack: slack,
-                ..SearchChoice::new(search)
-            };
-            with_search(choice, || {
-                let (s, out, _) = run_in_memory(m).unwrap();
-                let rep = s.op.surfaces.report(&s.node_id);
-                let text = format!(
-                    "{:?}\n{:?}\n{:?}\n{:?}",
-                    out.u, out.energy, out.projectile, out.layers
-                );
-                (text, rep)
-            })
+            let mut s = Solver::new(m).unwrap();
+            s.op.surfaces.oracle = oracle;
+            let mut out = MemorySink::default();
+            s.run(&mut out, &mut |_| {}).unwrap();
+            let rep = s.op.surfaces.report(&s.node_id);
+            let text = format!(
+                "{:?}\n{:?}\n{:?}\n{:?}",
+                out.u, out.energy, out.projectile, out.layers
+            );
+            (text, rep)
         })
 }
 
@@ -87,7 +77,7 @@ fn failing() -> YarnFailure {
 }
 
 #[test]
-fn the_tiled_search_finds_the_global_searchs_pairs_and_bits() {
+fn every_step_equals_each_side_built_alone() {
     let bands = params(10, YarnModel::Band, 8e-6);
     let chains = params(14, YarnModel::Chain, 1.5e-5);
     let layers = WovenBandParams {
@@ -112,55 +102,35 @@ fn the_tiled_search_finds_the_global_searchs_pairs_and_bits() {
         ("bullet", bullet),
     ] {
         let (m, _) = woven(&p).unwrap();
-        let (want, global) = run(&m, 1, Search::Global, false);
+        let (want, plain) = run(&m, 1, false);
         for threads in [1, 3] {
-            let (got, tiled) = run(&m, threads, Search::Tiles, true);
-            let t = tiled.tiles.expect("the tiled search's statistics");
+            let (got, checked) = run(&m, threads, true);
             println!(
-                "{name}, {threads} thread(s): {} global builds, {} side-steps with only the needed boxes; {} tiles, {} tile builds at {} steps ({} by a change of cell), {} penetrated",
-                global.builds, global.lazy_boxes, t.tiles, t.tile_builds, t.steps_with_builds, t.marked, tiled.penetrated
+                "{name}, {threads} thread(s): {} builds, {} side-steps with only the needed boxes, {:.3} of the slave-steps skipped, {} penetrated",
+                plain.builds,
+                plain.lazy_boxes,
+                plain.skipped as f64 / plain.slave_steps.max(1) as f64,
+                checked.penetrated
             );
             assert!(got == want, "{name}, {threads} threads: the runs differ");
             assert_eq!(
-                tiled.penetrated, global.penetrated,
+                checked.penetrated, plain.penetrated,
                 "{name}: pairs penetrated"
             );
             assert_eq!(
-                tiled.friction_work.to_bits(),
-                global.friction_work.to_bits()
+                checked.friction_work.to_bits(),
+                plain.friction_work.to_bits()
             );
-            // The global run computed only the needed boxes at some steps (the tiled run
-            // with the oracle computes every box): the two agree.
+            assert_eq!(checked.builds, plain.builds, "{name}: builds");
+            // The plain run skipped slaves, and computed only the needed boxes at some
+            // steps (the run under the oracle computes every box): the two agree.
+            assert!(plain.skipped > 0, "{name}: no slave skipped");
             assert!(
-                name != "two layers" || global.lazy_boxes > 0,
+                name != "two layers" || plain.lazy_boxes > 0,
                 "{name}: no step with only the needed boxes"
-            );
-            // The tiled search rebuilt tiles after the setup, and not all at once.
-            assert!(
-                t.tile_builds > t.tiles as u64,
-                "{name}: no tile rebuilt after the setup"
             );
         }
     }
-}
-
-/// The tiled search's re-grid (new cells when a face's box passes the width cap, every
-/// tile rebuilt) keeps the bits: with no slack in the cap the band patch re-grids
-/// whenever a box widens, and the run must still equal the global search's, under the
-/// oracle.
-#[test]
-fn a_regrid_keeps_the_global_searchs_bits() {
-    let (m, _) = woven(&params(10, YarnModel::Band, 4e-6)).unwrap();
-    let (want, _) = run(&m, 1, Search::Global, false);
-    let (got, tiled) = run_with(&m, 2, Search::Tiles, true, 0.0);
-    let t = tiled.tiles.expect("the tiled search's statistics");
-    println!("{} re-grids, {} tile builds", t.regrids, t.tile_builds);
-    assert!(
-        t.regrids > 3,
-        "the cap must be passed: {} re-grids",
-        t.regrids
-    );
-    assert!(got == want, "the runs differ");
 }
 
 /// Sides that have the same master surface share its thickness boxes and its broad-phase
@@ -189,7 +159,7 @@ fn sides_sharing_a_master_surface_find_what_each_alone_would() {
         let t = d.slave_thickness.expect("chains have a slave thickness");
         d.slave_thickness = Some(0.3 * t);
     }
-    let (want, rep) = run(&m, 1, Search::Global, false);
+    let (want, rep) = run(&m, 1, false);
     println!(
         "{} definitions, {} sides on {} master surfaces, {} builds, {} side-steps with only the needed boxes, {} penetrated",
         rep.definitions, rep.sides, rep.surfaces, rep.builds, rep.lazy_boxes, rep.penetrated
@@ -199,7 +169,7 @@ fn sides_sharing_a_master_surface_find_what_each_alone_would() {
     assert!(rep.lazy_boxes > 0, "no step with only the needed boxes");
     assert!(rep.penetrated > 0, "no contact");
     for threads in [1, 3] {
-        let (got, checked) = run(&m, threads, Search::Global, true);
+        let (got, checked) = run(&m, threads, true);
         assert!(got == want, "{threads} threads: the runs differ");
         assert_eq!(checked.penetrated, rep.penetrated);
     }

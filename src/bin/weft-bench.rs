@@ -372,19 +372,6 @@ fn bench_woven(
             rep.penetrated as f64 / n,
             rep.slave_steps
         );
-        if let Some(ts) = &rep.tiles {
-            eprintln!(
-                "    tiled search: {} tiles of {} × {} cells; {} tile builds at {} steps ({:.1} per step with builds, {} marked by a node changing cell), {} re-grids",
-                ts.tiles,
-                weft::solver::contact::surface::tiled::TILE_CELLS,
-                weft::solver::contact::surface::tiled::TILE_CELLS,
-                ts.tile_builds,
-                ts.steps_with_builds,
-                ts.tile_builds as f64 / ts.steps_with_builds.max(1) as f64,
-                ts.marked,
-                ts.regrids
-            );
-        }
         let tr = &rep.triggers;
         let pct = |m: &weft::solver::contact::surface::MeanMax| {
             format!(
@@ -393,8 +380,7 @@ fn bench_woven(
                 100.0 * m.max
             )
         };
-        if rep.tiles.is_none() {
-            eprintln!(
+        eprintln!(
             "    staleness triggers: {} ({} by a node past U); per trigger, cells over the skin {} (of {} cells); 4 × 4-cell tiles holding them {} (of {} tiles); slaves in those tiles and their ring {}",
             tr.triggers,
             tr.far,
@@ -404,7 +390,6 @@ fn bench_woven(
             tr.tiles_held,
             pct(&tr.slaves)
         );
-        }
     }
     Ok(())
 }

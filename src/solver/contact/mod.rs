@@ -5,7 +5,6 @@ pub mod closest;
 pub mod projectile;
 pub mod staleness;
 pub mod surface;
-pub mod tiles;
 
 pub use projectile::*;
 pub use surface::{ContactReport, SurfaceContact};

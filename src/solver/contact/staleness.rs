@@ -28,13 +28,101 @@
 //! until they have moved U, instead of skin/2. The per-cell minima and maxima are exact
 //! (no sums), so the test gives the same answer on any thread count.
 //!
-//! This is the special case of one tile over all cells of [`super::tiles`] (whose docs
-//! state the general lemma and theorem), with the cells sized as there
-//! ([`CellGrid::covering`]).
+//! **The cells** ([`CellGrid`]): the origin at the lower bounds of the nodes' build
+//! positions, the size h grown by 1.5 from ρ + W + 4U until there are at most 4 cells per
+//! node (+64; [`cell_counts`]): a larger h keeps the argument above. A cell index is
+//! ⌊(x_d − o_d)/h⌋ clamped to [0, dims_d − 1]; clamping is monotone, so it never widens a
+//! difference of indices, and a component of one cell gives every node the same index.
+//! The build positions lie within the bounds, so their indices need no clamping but for
+//! round-off.
+//!
+//! Round-off: the test compares the computed spreads with the skin itself. A computed
+//! difference fl(x − x^b) is within 2⁻⁵³|x − x^b| of the exact one, so a computed spread
+//! is within ~2ε̂ of the exact spread, ε̂ = 2⁻⁵² max(|x|, |x^b|) (~10⁻¹⁶ of the
+//! coordinates); the retired tiled search (git history, last in 2491c90) tested against
+//! skin − 4ε̂ to make the bound strict, this test does not.
 
 use rayon::prelude::*;
 
-use super::tiles::{CellGrid, EMPTY_RANGE};
+/// Most cells of the staleness grid per node (past it, the cells grow: a patch far apart
+/// in one direction would otherwise ask for a huge, empty grid).
+const CELLS_PER_NODE: usize = 4;
+
+/// A cell's empty range of displacements: min Δ (3) at +∞, max Δ (3) at −∞, ready for
+/// min/max folds.
+pub const EMPTY_RANGE: [f64; 6] = [
+    f64::INFINITY,
+    f64::INFINITY,
+    f64::INFINITY,
+    f64::NEG_INFINITY,
+    f64::NEG_INFINITY,
+    f64::NEG_INFINITY,
+];
+
+/// The cells per axis over (lo, hi) at the cell size `h` (finite, > 0), and the cell size:
+/// h grown by 1.5 until there are at most `cap` cells (a set far apart in one direction
+/// would otherwise ask for a huge, empty grid). Shared by the staleness grid and the
+/// surface contact's face grid (`surface::grid`).
+pub fn cell_counts(lo: &[f64; 3], hi: &[f64; 3], mut h: f64, cap: usize) -> ([usize; 3], f64) {
+    let mut dims = [1usize; 3];
+    loop {
+        for d in 0..3 {
+            dims[d] = ((hi[d] - lo[d]) / h).floor() as usize + 1;
+        }
+        if dims[0].saturating_mul(dims[1]).saturating_mul(dims[2]) <= cap {
+            break;
+        }
+        h *= 1.5;
+    }
+    (dims, h)
+}
+
+/// Fixed cells over the contact nodes: origin, size h, counts per axis; indices clamped
+/// (module docs, "The cells").
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct CellGrid {
+    origin: [f64; 3],
+    h: f64,
+    dims: [usize; 3],
+}
+
+impl CellGrid {
+    /// Cells of size at least `h_min` from `lo` covering up to `hi` (the nodes' bounds),
+    /// grown by 1.5 until there are at most 4 per node (+64). Without nodes, or with a
+    /// non-finite bound or size: one cell.
+    pub fn covering(lo: [f64; 3], hi: [f64; 3], h_min: f64, nodes: usize) -> CellGrid {
+        let mut h = h_min;
+        let mut origin = lo;
+        if nodes == 0 || !(h > 0.0) || !(0..3).all(|d| lo[d].is_finite() && hi[d].is_finite()) {
+            origin = [0.0; 3];
+            h = f64::INFINITY;
+        }
+        let mut dims = [1usize; 3];
+        if h.is_finite() {
+            (dims, h) = cell_counts(&lo, &hi, h, CELLS_PER_NODE * nodes + 64);
+        }
+        CellGrid { origin, h, dims }
+    }
+
+    /// The cell of a position.
+    pub fn cell(&self, p: &[f64; 3]) -> usize {
+        if !self.h.is_finite() {
+            return 0;
+        }
+        let i: [usize; 3] = std::array::from_fn(|d| {
+            (((p[d] - self.origin[d]) / self.h).max(0.0) as usize).min(self.dims[d] - 1)
+        });
+        (i[2] * self.dims[1] + i[1]) * self.dims[0] + i[0]
+    }
+
+    pub fn dims(&self) -> [usize; 3] {
+        self.dims
+    }
+
+    pub fn cells(&self) -> usize {
+        self.dims[0] * self.dims[1] * self.dims[2]
+    }
+}
 
 /// The absolute bound U as a multiple of the skin: larger U means larger cells, so
 /// larger neighbourhoods whose spread reaches the skin sooner. Measured on the 60 × 60
@@ -349,7 +437,50 @@ pub fn tile_marks(dims: [usize; 3], over: &[bool], occupied: &[bool]) -> StaleCe
 #[cfg(test)]
 mod tests {
     use super::super::uniform;
-    use super::{Staleness, ABSOLUTE_PER_SKIN};
+    use super::{cell_counts, CellGrid, Staleness, ABSOLUTE_PER_SKIN};
+
+    /// The cells cover the nodes' bounds within the cap: `cell_counts` grows h by 1.5
+    /// only while there are more cells than the cap (so h/1.5 would give too many), and
+    /// `CellGrid::covering` puts the lower bound in the first cell, the upper in the last
+    /// and every node in a cell whose box holds it (indices by hand from the origin and
+    /// h); without nodes or with a non-finite bound, one cell.
+    #[test]
+    fn cells_cover_the_nodes_within_the_cap() {
+        let (lo, hi) = ([0.0, -1.0, 0.0], [10.0, 1.0, 0.1]);
+        let count = |h: f64| -> usize {
+            (0..3)
+                .map(|d| ((hi[d] - lo[d]) / h).floor() as usize + 1)
+                .product()
+        };
+        let (dims, h) = cell_counts(&lo, &hi, 0.01, 500);
+        assert!(dims.iter().product::<usize>() <= 500 && count(h) <= 500);
+        assert!(h > 0.01 && count(h / 1.5) > 500, "h = {h}");
+        assert_eq!(cell_counts(&lo, &hi, 5.0, 500), ([3, 1, 1], 5.0));
+        let mut st = 11u64;
+        let x: Vec<[f64; 3]> = (0..300)
+            .map(|_| std::array::from_fn(|d| lo[d] + (hi[d] - lo[d]) * uniform(&mut st)))
+            .collect();
+        let g = CellGrid::covering(lo, hi, 0.05, x.len());
+        let dims = g.dims();
+        assert!(g.cells() <= 4 * x.len() + 64 && g.cells() > 1);
+        assert_eq!(g.cell(&lo), 0);
+        assert_eq!(g.cell(&hi), g.cells() - 1);
+        for p in &x {
+            let c = g.cell(p);
+            let i = [
+                c % dims[0],
+                (c / dims[0]) % dims[1],
+                c / (dims[0] * dims[1]),
+            ];
+            for d in 0..3 {
+                let a = lo[d] + i[d] as f64 * g.h;
+                assert!(p[d] >= a && p[d] < a + g.h, "node {p:?}, cell {i:?}");
+            }
+        }
+        let one = CellGrid::covering([0.0; 3], [f64::NAN, 0.0, 0.0], 0.05, 10);
+        assert_eq!((one.cells(), one.cell(&[3.0, 4.0, 5.0])), (1, 0));
+        assert_eq!(CellGrid::covering(lo, hi, 0.05, 0).cells(), 1);
+    }
 
     /// What "not stale" promises, checked by brute force over every pair of nodes (the
     /// oracle): any two nodes now within ρ + W + 2U of each other in every component

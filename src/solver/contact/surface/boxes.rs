@@ -106,14 +106,14 @@ impl MasterBoxes {
     }
 
     /// The directions of the faces' envelope bounds at `x`, then their bounds (at a broad
-    /// phase), for the faces `mask` marks (None: all; `sd`: a side of this surface). For a
+    /// phase), for every live face (`sd`: a side of this surface). For a
     /// face of unit normal n̂ and in-plane thickness gradient ∇t_F
     /// ([`super::thickness_gradient`]), m± = (±n̂ − ½∇t_F)/|±n̂ − ½∇t_F|: the outward
     /// normals of the two sides of the thickness envelope of a flat face with a linear
     /// thickness (a lenticular band's quad thins to its edge, where the thickness box
     /// stays as high as its thickest node). Any unit direction gives a sound bound, so
     /// they are refreshed only here, while the bounds follow the nodes every step.
-    pub(super) fn set_directions_of(&mut self, sd: &Side, x: &[[f64; 3]], mask: Option<&[bool]>) {
+    pub(super) fn set_directions_of(&mut self, sd: &Side, x: &[[f64; 3]]) {
         let (faces, face_t, nf) = (&sd.faces, &sd.face_t, sd.nf);
         if nf < 3 {
             return;
@@ -127,7 +127,7 @@ impl MasterBoxes {
             .for_each(|(c, (ds, bs))| {
                 for (j, (d, b)) in ds.iter_mut().zip(bs.iter_mut()).enumerate() {
                     let fi = c * FACE_CHUNK + j;
-                    if (any_dead && !alive[fi]) || mask.is_some_and(|m| !m[fi]) {
+                    if any_dead && !alive[fi] {
                         continue;
                     }
                     *d = envelope_directions(&faces[fi], &face_t[fi], nf, x);
@@ -223,15 +223,15 @@ pub(super) fn stamp_sides<'a>(
         let (sd, stamps) = sides[k];
         let stamps = &stamps.0;
         let (margin, cell) = (&sd.margin, &sd.slave_cell);
-        let (cand_at, lists) = (&sd.cand_at, &sd.lists);
+        let (cand_at, cand) = (&sd.cand_at, &sd.cand);
         let s0 = ci * SLAVE_CHUNK;
         let s1 = (s0 + SLAVE_CHUNK).min(margin.len());
         for si in s0..s1 {
             if margin[si] > spread[cell[si] as usize] {
                 continue;
             }
-            let [l, a, b] = cand_at[si];
-            for &fi in &lists[l as usize][a as usize..b as usize] {
+            let [a, b] = cand_at[si];
+            for &fi in &cand[a as usize..b as usize] {
                 stamps[fi as usize].store(epoch, Relaxed);
             }
         }

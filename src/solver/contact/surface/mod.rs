@@ -77,14 +77,20 @@
 //!   own result slot and its chunk's list of reaction shares; the results are gathered
 //!   onto the nodes in chunk order (the slaves, then their reactions), so 1 and N threads
 //!   give bit-identical forces.
+//! - **oracle** (a check for tests, off unless the caller sets
+//!   [`SurfaceContact::oracle`]): at every force evaluation each side is built again
+//!   alone, in a grid of its own at its own reach, and its narrow phase run without
+//!   skipping a slave; every result must be the same bits as the step's, which shares the
+//!   master surfaces' boxes and grids among sides, computes only the boxes it needs,
+//!   skips far slaves and runs every side in one parallel loop.
 //!
 //! Where things live: [`kernels`] (the pure kernels: thickness box and envelope bounds,
 //! distance tests, the pair force with friction; the closest points are
 //! [`super::closest`]'s), [`solid`] (a hexahedron part's boundary faces and nodes, and
 //! its faces' one-sided kernel), [`side`] (a definition's side and its per-step data), [`grid`]
 //! (the broad phase), [`narrow`] (the narrow phase), and this module: the driver
-//! ([`SurfaceContact`]: setup, the step's phases in order, the report), and `gather` (the
-//! forces onto the nodes in a canonical order, in parallel).
+//! ([`SurfaceContact`]: setup, the step's phases in order, the report), `gather` (the
+//! forces onto the nodes in a canonical order, in parallel) and `oracle`.
 
 mod boxes;
 mod gather;
@@ -94,7 +100,6 @@ pub mod narrow;
 mod oracle;
 pub mod side;
 pub mod solid;
-pub mod tiled;
 
 pub use super::closest::{closest_on_face, closest_on_quad};
 use super::projectile::PENALTY_FACTOR;
@@ -106,90 +111,6 @@ use boxes::MasterBoxes;
 pub use kernels::{pair_force, thickness_gradient, Friction, SlaveState, MAX_THICKNESS_GRADIENT};
 use side::{part_nodes, ChunkSums};
 pub use side::{PairOut, Reaction, Side};
-use tiled::TileSearch;
-pub use tiled::TileStats;
-
-/// How the broad phase finds each slave's candidate faces. Both give the same bits in
-/// every result (see [`tiled`]); they differ in what they rebuild.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum Search {
-    /// One set of lists for all slaves, rebuilt whole when the staleness test
-    /// ([`super::staleness`]) finds any region stale: the default (the faster on every
-    /// model measured, see [`tiled::TILE_CELLS`]).
-    #[default]
-    Global,
-    /// Lists per tile of cells, each rebuilt when its own test finds it stale
-    /// ([`tiled`]).
-    Tiles,
-}
-
-/// The search a run's contact uses, and whether it checks itself against the global one
-/// at every step ([`SurfaceContact::oracle`]).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct SearchChoice {
-    pub search: Search,
-    pub oracle: bool,
-    /// The tiles' size in cells and the binning's hysteresis in skins (defaults
-    /// [`tiled::TILE_CELLS`], [`tiled::TILE_U_PER_SKIN`]; tests take small ones, so that
-    /// small models have many tiles and nodes that change cell).
-    pub tile_cells: usize,
-    pub tile_u_per_skin: f64,
-    /// The tiles' width cap W_cap = W + `tile_width_slack` U, W the widest box at the
-    /// last grid (default 2; 0 in a test re-grids whenever a box widens).
-    pub tile_width_slack: f64,
-}
-
-impl SearchChoice {
-    /// `search`, without the oracle, the tiles at their defaults.
-    pub fn new(search: Search) -> SearchChoice {
-        SearchChoice {
-            search,
-            oracle: false,
-            tile_cells: tiled::TILE_CELLS,
-            tile_u_per_skin: tiled::TILE_U_PER_SKIN,
-            tile_width_slack: 2.0,
-        }
-    }
-}
-
-thread_local! {
-    static CHOICE: std::cell::Cell<Option<SearchChoice>> = const { std::cell::Cell::new(None) };
-}
-
-/// Runs `f` with the contacts it creates on this thread using `choice` (tests and
-/// benchmarks; inside a thread pool's `install`, so that the solver is created on the
-/// thread that set it).
-pub fn with_search<T>(choice: SearchChoice, f: impl FnOnce() -> T) -> T {
-    let old = CHOICE.with(|c| c.replace(Some(choice)));
-    let r = f();
-    CHOICE.with(|c| c.set(old));
-    r
-}
-
-/// The search of a new contact: [`with_search`]'s on this thread, else the environment's
-/// `WEFT_CONTACT_SEARCH` (`global` or `tiles`; the same results, for timing one against
-/// the other) and `WEFT_CONTACT_ORACLE=1`, else the global search without the oracle.
-pub fn chosen_search() -> SearchChoice {
-    if let Some(c) = CHOICE.with(|c| c.get()) {
-        return c;
-    }
-    let search = match std::env::var("WEFT_CONTACT_SEARCH").as_deref() {
-        Ok("global") | Err(_) => Search::Global,
-        Ok("tiles") => Search::Tiles,
-        Ok(other) => {
-            eprintln!(
-                "warning: WEFT_CONTACT_SEARCH=`{other}` is neither `global` nor `tiles`; \
-                 using `global`"
-            );
-            Search::Global
-        }
-    };
-    let oracle = std::env::var("WEFT_CONTACT_ORACLE").is_ok_and(|v| v == "1");
-    SearchChoice {
-        oracle,
-        ..SearchChoice::new(search)
-    }
-}
 
 /// A recorded initial penetration.
 #[derive(Debug, Clone)]
@@ -240,15 +161,22 @@ pub struct ContactReport {
     /// Slave-steps skipped whole: the slave was farther from every candidate at the
     /// build than its neighbourhood's nodes have since moved apart (see `Side::margin`).
     pub skipped: u64,
-    /// What the stale tests that triggered the builds (after the setup's) found (the
-    /// global search).
+    /// What the stale tests that triggered the builds (after the setup's) found.
     pub triggers: TriggerStats,
     /// Side-steps whose thickness boxes were computed only for the faces the narrow phase
     /// could read (see [`LAZY_BOXES_SKIPPED`]).
     pub lazy_boxes: u64,
-    /// The search used, and what the tiled search rebuilt (None: the global search).
-    pub search: Option<Search>,
+    /// Always None: the tiled search that filled it is retired (issue 53; in git history,
+    /// last in 2491c90). Kept only while `weft-simulate` still prints it; goes with its
+    /// lines there.
     pub tiles: Option<TileStats>,
+}
+
+/// What the retired tiled search rebuilt ([`ContactReport::tiles`], always None).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct TileStats {
+    pub tiles: usize,
+    pub tile_builds: u64,
 }
 
 /// Over the stale tests that triggered a build: how local the staleness was, the gate of
@@ -386,17 +314,13 @@ pub struct SurfaceContact {
     /// Nodes that take part (slaves and face nodes), sorted.
     nodes: Vec<u32>,
     /// Their positions at the last broad phase, and the test of when the candidate lists
-    /// go stale (the global search).
+    /// go stale.
     motion: Staleness,
-    /// The search ([`chosen_search`] at creation), and the tiled search's state (from
-    /// [`SurfaceContact::start`]).
-    pub search: Search,
-    tile_cells: usize,
-    tile_u_per_skin: f64,
-    tile_width_slack: f64,
-    tiles: Option<Box<TileSearch>>,
-    /// Check every step's results against the global search's, and stop on a
-    /// difference (tests: the tiled search must find the same pairs and the same bits).
+    /// The oracle (module docs; off by default, the same results either way): check
+    /// every force evaluation against each side built alone, afresh, skipping nothing,
+    /// and panic on a difference. Set by the caller (tests) once the contact is made,
+    /// before the first force evaluation (`tests/contact_search.rs`); it costs a
+    /// side's build and narrow phase per side and step.
     pub oracle: bool,
     /// Force evaluations so far (the oracle names the step of a difference).
     evaluations: u64,
@@ -471,17 +395,12 @@ impl SurfaceContact {
         };
         let kappa_max = sides.iter().map(|s| s.kappa).fold(0.0, f64::max);
         let masters = MasterBoxes::group(&mut sides);
-        let choice = chosen_search();
         SurfaceContact {
             sides,
             masters,
             nodes,
             motion: Staleness::new(skin),
-            search: choice.search,
-            oracle: choice.oracle,
-            tile_cells: choice.tile_cells,
-            tile_u_per_skin: choice.tile_u_per_skin,
-            tile_width_slack: choice.tile_width_slack,
+            oracle: false,
             skip_far: true,
             skin,
             kappa_max,
@@ -599,7 +518,7 @@ impl SurfaceContact {
         let skin = self.skin;
         for mb in &mut self.masters {
             let sides = &mut self.sides;
-            mb.set_directions_of(&sides[mb.sides[0]], x, None);
+            mb.set_directions_of(&sides[mb.sides[0]], x);
             let r = mb
                 .sides
                 .iter()
@@ -716,22 +635,7 @@ impl SurfaceContact {
     /// when their definition says so).
     pub fn start(&mut self, m: &Model, x: &[[f64; 3]]) -> Result<()> {
         self.update_all_boxes(x);
-        if self.search == Search::Tiles {
-            let mut t = TileSearch::new(
-                &self.sides,
-                &self.masters,
-                &self.nodes,
-                x,
-                self.skin,
-                (self.tile_cells, self.tile_u_per_skin, self.tile_width_slack),
-            );
-            t.check(&self.masters, x);
-            t.rebuild(&mut self.sides, &mut self.masters, x);
-            self.tiles = Some(Box::new(t));
-            self.builds += 1;
-        } else {
-            self.rebuild(x);
-        }
+        self.rebuild(x);
         let zero = vec![[0.0; 3]; m.num_nodes()];
         for s in &mut self.sides {
             s.narrow(&self.masters[s.surface], x, &zero, 1.0, 0.0, true, None);
@@ -772,7 +676,10 @@ impl SurfaceContact {
     }
 
     /// Contact forces at x^n added into `fcon` (which the caller has cleared); the stored
-    /// energy and the dissipated work are booked.
+    /// energy and the dissipated work are booked. The step's phases in order: the broad
+    /// phase ([`SurfaceContact::broad_phase`]), the erosion probe when faces leave, the
+    /// narrow phase of every side ([`SurfaceContact::narrow_phase`]), the oracle when
+    /// asked, the eroded energy, and the gather onto the nodes.
     pub fn forces(
         &mut self,
         x: &[[f64; 3]],
@@ -783,20 +690,48 @@ impl SurfaceContact {
     ) {
         let t0 = std::time::Instant::now();
         self.evaluations += 1;
-        // Every box when the search or the oracle reads them all (the tiles' width test,
-        // the oracle's build) or when no slave is skipped; else, after the staleness
-        // test, every box at a build and otherwise those of the candidates that the narrow
-        // phase will test (`SurfaceContact::update_needed_boxes`).
-        let all_boxes = self.tiles.is_some() || self.oracle || !self.skip_far;
+        self.broad_phase(x, t0);
+        let t1 = std::time::Instant::now();
+        let probed = if self.sides.iter().any(|s| !s.pending.is_empty()) {
+            let sp = self.skip_far.then(|| self.motion.spread().to_vec());
+            Some(self.probe_erosion(x, v, dt, dt_prev, sp.as_deref()))
+        } else {
+            None
+        };
+        let before = self.oracle.then(|| self.sides.clone());
+        let stored = self.narrow_phase(x, v, dt, dt_prev);
+        if let Some(before) = before {
+            self.check_oracle(before, x, v, dt, dt_prev);
+        }
+        if let Some(with) = probed {
+            self.book_erosion(&with, v, dt_prev);
+        }
+        let t_narrow = std::time::Instant::now();
+        let ph = &mut self.phases;
+        ph.narrow += (t_narrow - t1).as_secs_f64();
+        // Gather onto the nodes in the canonical order (side, chunk, the chunk's slaves,
+        // then their reactions' face nodes): bit-identical for any thread count.
+        gather::gather(&self.sides, fcon);
+        self.stored = stored;
+        self.phases.scatter += t_narrow.elapsed().as_secs_f64();
+        self.narrow_time += t1.elapsed();
+    }
+
+    /// The step's broad phase at `x` (the force evaluation began at `t0`): the thickness
+    /// boxes, the staleness test (a stale one booked, [`SurfaceContact::record_trigger`])
+    /// and, when stale, the build; their wall times booked.
+    fn broad_phase(&mut self, x: &[[f64; 3]], t0: std::time::Instant) {
+        // Every box when the oracle reads them all (its builds) or when no slave is
+        // skipped; else, after the staleness test, every box at a build and otherwise
+        // those of the candidates that the narrow phase will test
+        // (`SurfaceContact::update_needed_boxes`).
+        let all_boxes = self.oracle || !self.skip_far;
         if all_boxes {
             self.update_all_boxes(x);
         }
         let t_boxes = std::time::Instant::now();
-        let stale = match self.tiles.as_mut() {
-            Some(t) => t.check(&self.masters, x) > 0,
-            None => self.stale(x),
-        };
-        if stale && self.tiles.is_none() {
+        let stale = self.stale(x);
+        if stale {
             self.record_trigger();
         }
         let t_stale = std::time::Instant::now();
@@ -805,13 +740,7 @@ impl SurfaceContact {
         }
         let t_lazy = std::time::Instant::now();
         if stale {
-            match self.tiles.as_mut() {
-                Some(t) => {
-                    t.rebuild(&mut self.sides, &mut self.masters, x);
-                    self.builds += 1;
-                }
-                None => self.rebuild(x),
-            }
+            self.rebuild(x);
         }
         let t1 = std::time::Instant::now();
         self.build_time += t1 - t0;
@@ -819,17 +748,14 @@ impl SurfaceContact {
         ph.boxes += (t_boxes - t0).as_secs_f64() + (t_lazy - t_stale).as_secs_f64();
         ph.staleness += (t_stale - t_boxes).as_secs_f64();
         ph.builds += (t1 - t_lazy).as_secs_f64();
-        let mut stored = 0.0;
-        let probed = if self.sides.iter().any(|s| !s.pending.is_empty()) {
-            let sp = self
-                .skip_far
-                .then(|| spread_of(&self.tiles, &self.motion).to_vec());
-            Some(self.probe_erosion(x, v, dt, dt_prev, sp.as_deref()))
-        } else {
-            None
-        };
-        let before = self.oracle.then(|| self.sides.clone());
-        let spread = self.skip_far.then(|| spread_of(&self.tiles, &self.motion));
+    }
+
+    /// The narrow phase of every side at x^n, in one parallel loop
+    /// ([`narrow::narrow_sides`]; far slaves skipped when `skip_far`), then its chunks'
+    /// sums booked: the friction work, the counts and, when kept, the friction work by
+    /// node. Returns the stored energy.
+    fn narrow_phase(&mut self, x: &[[f64; 3]], v: &[[f64; 3]], dt: f64, dt_prev: f64) -> f64 {
+        let spread = self.skip_far.then(|| self.motion.spread());
         let masters = &self.masters;
         narrow::narrow_sides(
             self.sides.iter_mut().map(|s| {
@@ -843,6 +769,7 @@ impl SurfaceContact {
             false,
             spread,
         );
+        let mut stored = 0.0;
         for s in &self.sides {
             // Sums in side and chunk order: bit-identical for any thread count.
             for c in &s.chunk_sums {
@@ -863,26 +790,7 @@ impl SurfaceContact {
                 }
             }
         }
-        if let Some(before) = before {
-            self.check_oracle(before, x, v, dt, dt_prev);
-        }
-        if let Some(with) = probed {
-            self.book_erosion(&with, v, dt_prev);
-        }
-        let t_narrow = std::time::Instant::now();
-        let ph = &mut self.phases;
-        ph.narrow += (t_narrow - t1).as_secs_f64();
-        // Gather onto the nodes in the canonical order (side, chunk, the chunk's slaves,
-        // then their reactions' face nodes): bit-identical for any thread count.
-        gather::gather(&self.sides, fcon);
-        self.stored = stored;
-        self.phases.scatter += t_narrow.elapsed().as_secs_f64();
-        self.narrow_time += t1.elapsed();
-    }
-
-    /// What the tiled search did (None: the global search).
-    pub fn tile_stats(&self) -> Option<TileStats> {
-        self.tiles.as_ref().map(|t| t.stats)
+        stored
     }
 
     /// A summary for reports.
@@ -918,8 +826,7 @@ impl SurfaceContact {
             penetrated: self.counts.penetrated,
             triggers: self.triggers,
             lazy_boxes: self.lazy_boxes,
-            search: (!self.sides.is_empty()).then_some(self.search),
-            tiles: self.tile_stats(),
+            tiles: None,
         }
     }
 
@@ -929,14 +836,5 @@ impl SurfaceContact {
             .iter()
             .map(|s| s.chunk_active.iter().map(|a| a.len()).sum::<usize>())
             .sum()
-    }
-}
-
-/// Per cell, |S| of the skip test at this step: the tiles' grid's, or the staleness
-/// test's (a function of the two fields, so that the sides can be borrowed beside it).
-fn spread_of<'a>(tiles: &'a Option<Box<TileSearch>>, motion: &'a Staleness) -> &'a [f64] {
-    match tiles.as_ref() {
-        Some(t) => t.spread(),
-        None => motion.spread(),
     }
 }

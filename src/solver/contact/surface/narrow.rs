@@ -267,8 +267,8 @@ struct Narrow<'a> {
     slaves: &'a [u32],
     slave_t: &'a [f64],
     slave_m: &'a [f64],
-    cand_at: &'a [[u32; 3]],
-    lists: &'a [Vec<u32>],
+    cand_at: &'a [[u32; 2]],
+    cand: &'a [u32],
     fr: Friction,
     kappa: f64,
     zeta: f64,
@@ -366,7 +366,7 @@ impl Side {
             ref slave_t,
             ref slave_m,
             ref cand_at,
-            ref lists,
+            ref cand,
             friction,
             kappa,
             damping,
@@ -402,7 +402,7 @@ impl Side {
             slave_t,
             slave_m,
             cand_at,
-            lists,
+            cand,
             fr: friction,
             kappa,
             zeta: damping,
@@ -617,8 +617,8 @@ impl Narrow<'_> {
         // Only faces the node penetrates (g > 0) matter: a node whose best g is
         // ≤ 0 is open whether or not some face was evaluated, and a tracked initial
         // penetration g₀ then drops to 0 either way.
-        let [l, a, b] = self.cand_at[si];
-        let list = &self.lists[l as usize][a as usize..b as usize];
+        let [a, b] = self.cand_at[si];
+        let list = &self.cand[a as usize..b as usize];
         sums.tested += list.len() as u64;
         for block in list.chunks(32) {
             let nn = filter_block::<NF>(

@@ -1,11 +1,15 @@
-//! The oracle ([`SurfaceContact::oracle`]): every step's contact checked against a
-//! search that builds each side alone, afresh, and skips nothing.
+//! The oracle ([`SurfaceContact::oracle`]): every step's contact checked against each
+//! side built alone, afresh, in a grid of its own at its own reach, whose narrow phase
+//! skips no slave. The step itself shares each master surface's boxes and grid among its
+//! sides, computes on lazy steps only the boxes its narrow phases can read, skips the
+//! slaves that no candidate can reach yet and runs every side in one parallel loop: each
+//! of these must give the same bits as the side alone (tests/contact_search.rs).
 
 use super::{Side, SurfaceContact};
 
 impl SurfaceContact {
     /// The oracle ([`SurfaceContact::oracle`]): the sides as they were before this
-    /// step's narrow phase (`before`) get fresh global lists at `x` and a narrow phase
+    /// step's narrow phase (`before`) get fresh lists of their own at `x` and a narrow phase
     /// that skips no slave; every slave's contact, state and reaction shares, and every
     /// chunk's energies and penetrated count, must be the same bits as this step's.
     pub(super) fn check_oracle(
@@ -23,9 +27,9 @@ impl SurfaceContact {
             r.narrow(mb, x, v, dt, dt_prev, false, None);
             if let Err(e) = same_results(&self.sides[k], &r) {
                 panic!(
-                    "contact oracle: the {:?} search differs from the global one at force \
+                    "contact oracle: the step differs from its side built alone at force \
                      evaluation {}, contact {} (side {k}): {e}",
-                    self.search, self.evaluations, self.sides[k].contact_id
+                    self.evaluations, self.sides[k].contact_id
                 );
             }
         }
@@ -53,7 +57,7 @@ fn same_results(a: &Side, b: &Side) -> std::result::Result<(), String> {
             .map(|&s| node(s))
             .collect();
         return Err(format!(
-            "slaves in contact differ: only here node indices {only_a:?}, only in the global search {only_b:?}"
+            "slaves in contact differ: only here node indices {only_a:?}, only in the side alone {only_b:?}"
         ));
     }
     let bits = |v: &[f64]| v.iter().map(|f| f.to_bits()).collect::<Vec<_>>();
@@ -63,7 +67,7 @@ fn same_results(a: &Side, b: &Side) -> std::result::Result<(), String> {
         let qv = [q.f[0], q.f[1], q.f[2], q.stored, q.dissipated, q.g];
         if p.face != q.face || bits(&pv) != bits(&qv) {
             return Err(format!(
-                "node index {}: {p:?} against the global search's {q:?}",
+                "node index {}: {p:?} against the side alone's {q:?}",
                 node(si)
             ));
         }
@@ -73,7 +77,7 @@ fn same_results(a: &Side, b: &Side) -> std::result::Result<(), String> {
         let qv = [q.ft[0], q.ft[1], q.ft[2], q.k, q.g0];
         if bits(&pv) != bits(&qv) || a.held[si] != b.held[si] {
             return Err(format!(
-                "node index {}: state {p:?} against the global search's {q:?}",
+                "node index {}: state {p:?} against the side alone's {q:?}",
                 node(si as u32)
             ));
         }
@@ -93,9 +97,7 @@ fn same_results(a: &Side, b: &Side) -> std::result::Result<(), String> {
             || p.dissipated.to_bits() != q.dissipated.to_bits()
             || p.penetrated != q.penetrated
         {
-            return Err(format!(
-                "chunk {ci}: {p:?} against the global search's {q:?}"
-            ));
+            return Err(format!("chunk {ci}: {p:?} against the side alone's {q:?}"));
         }
     }
     Ok(())

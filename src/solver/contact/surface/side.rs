@@ -96,11 +96,10 @@ pub struct Side {
     pub(super) slave_t_max: f64,
     /// Round-off allowance η of the thickness-box tests [m] (see [`BOX_MARGIN`]).
     pub(super) box_margin: f64,
-    /// Candidate lists from the last broad phase: per slave, (list, first, end) into
-    /// `lists` (one list per tile of the tiled search, each rebuilt alone; one for all
-    /// slaves in the global search), each slave's candidates ascending.
-    pub(super) cand_at: Vec<[u32; 3]>,
-    pub(super) lists: Vec<Vec<u32>>,
+    /// Candidate lists from the last broad phase: per slave, (first, end) into `cand`,
+    /// the lists of all slaves one after another, each slave's candidates ascending.
+    pub(super) cand_at: Vec<[u32; 2]>,
+    pub(super) cand: Vec<u32>,
     /// Per slave, from the last broad phase: its margin [m] (+∞ without candidates), so
     /// that the narrow phase can skip a slave that no candidate can reach yet.
     ///
@@ -120,9 +119,8 @@ pub struct Side {
     /// times it as in the box test. Measured on the 60 × 60 woven quarter: 86 % of the
     /// slave-steps skipped to 10 µs, 43 % to 60 µs.
     pub(super) margin: Vec<f64>,
-    /// Per slave, its cell at the last build: of the staleness test in the global
-    /// search, of the tiles' grid in the tiled one (the narrow phase reads its spread
-    /// |S| there).
+    /// Per slave, its cell of the staleness test at the last build (the narrow phase
+    /// reads its spread |S| there).
     pub(super) slave_cell: Vec<u32>,
     pub state: Vec<SlaveState>,
     /// Per slave: whether its state differs from the default (a stick spring or a
@@ -406,7 +404,7 @@ impl Side {
             slave_t_max: ts_max,
             box_margin: BOX_MARGIN * (x_max + 0.5 * (ts_max + tf_box)),
             cand_at: vec![],
-            lists: vec![],
+            cand: vec![],
             margin: vec![],
             slave_cell: vec![],
             chunk_active: vec![],
