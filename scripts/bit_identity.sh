@@ -61,7 +61,7 @@ run_all "$after" "$work/after"
 python3 - "$work/before" "$work/after" <<'PY'
 import sys, pathlib, pyarrow.parquet as pq
 a, b = map(pathlib.Path, sys.argv[1:3])
-skip_cols = lambda c: "wall" in c or "per_second" in c or c in ("file", "path", "seconds", "threads", "contact_builds")
+skip_cols = lambda c: "wall" in c or "per_second" in c or c in ("file", "path", "seconds", "threads")
 files = sorted(p.relative_to(a) for p in a.rglob("*.parquet") if ".weft" not in p.parts)
 bad, n = [], 0
 for rel in files:

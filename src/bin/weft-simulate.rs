@@ -158,12 +158,6 @@ fn run_cli() -> anyhow::Result<ExitCode> {
             "  contact: {} definitions ({} sides on {} master surfaces), {} slave nodes against {} faces or segments; {} broad-phase builds (skin {:.3e} m) {:.3} s, narrow phase {:.3} s; {} slaves in contact at the end, friction work {:.4e} J",
             c.definitions, c.sides, c.surfaces, c.slaves, c.faces, c.builds, c.skin, c.build_seconds, c.narrow_seconds, c.active, c.friction_work
         );
-        if let Some(t) = &c.tiles {
-            eprintln!(
-                "  contact search: {} tiles; {} tile builds at those {} builds",
-                t.tiles, t.tile_builds, c.builds
-            );
-        }
         if let Some((cid, node, el, depth)) = c.deepest {
             eprintln!(
                 "  contact: {} nodes started inside a surface and are tracked, not pushed out; deepest node `{node}` by {depth:.3e} m (element `{el}`, contact `{cid}`)",

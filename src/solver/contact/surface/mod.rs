@@ -166,17 +166,6 @@ pub struct ContactReport {
     /// Side-steps whose thickness boxes were computed only for the faces the narrow phase
     /// could read (see [`LAZY_BOXES_SKIPPED`]).
     pub lazy_boxes: u64,
-    /// Always None: the tiled search that filled it is retired (issue 53; in git history,
-    /// last in 2491c90). Kept only while `weft-simulate` still prints it; goes with its
-    /// lines there.
-    pub tiles: Option<TileStats>,
-}
-
-/// What the retired tiled search rebuilt ([`ContactReport::tiles`], always None).
-#[derive(Debug, Clone, Copy, Default)]
-pub struct TileStats {
-    pub tiles: usize,
-    pub tile_builds: u64,
 }
 
 /// Over the stale tests that triggered a build: how local the staleness was, the gate of
@@ -826,7 +815,6 @@ impl SurfaceContact {
             penetrated: self.counts.penetrated,
             triggers: self.triggers,
             lazy_boxes: self.lazy_boxes,
-            tiles: None,
         }
     }
 
