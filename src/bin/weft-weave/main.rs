@@ -190,13 +190,13 @@ struct WovenBandArgs {
     #[arg(long, requires = "membrane_length", default_value_t = Surround::default().growth)]
     membrane_growth: f64,
     /// Membrane areal density / the patch's (the paper's §3: 0.8).
-    #[arg(long, requires = "membrane_length", default_value_t = Surround::default().density_ratio)]
+    #[arg(long, requires = "membrane_length", default_value_t = Surround::default().membrane.density_ratio)]
     membrane_density_ratio: f64,
     /// Membrane E₁ = E₂ / the yarns' E (the paper's §3: 0.3).
-    #[arg(long, requires = "membrane_length", default_value_t = Surround::default().modulus_ratio)]
+    #[arg(long, requires = "membrane_length", default_value_t = Surround::default().membrane.modulus_ratio)]
     membrane_modulus_ratio: f64,
     /// Membrane G₁₂ / its E (the paper's §3: 0.0042).
-    #[arg(long, requires = "membrane_length", default_value_t = Surround::default().shear_ratio)]
+    #[arg(long, requires = "membrane_length", default_value_t = Surround::default().membrane.shear_ratio)]
     membrane_shear_ratio: f64,
     /// Membrane thickness [m] (an assumption; default 2A/p per layer, the yarns' section
     /// per unit width of both families).
@@ -932,11 +932,14 @@ impl WovenBandArgs {
             surround: self.membrane_length.map(|length| Surround {
                 length,
                 growth: self.membrane_growth,
-                density_ratio: self.membrane_density_ratio,
-                modulus_ratio: self.membrane_modulus_ratio,
-                shear_ratio: self.membrane_shear_ratio,
-                thickness: self.membrane_thickness,
-                failure_strain: self.membrane_failure_strain,
+                membrane: SurroundParams {
+                    density_ratio: self.membrane_density_ratio,
+                    modulus_ratio: self.membrane_modulus_ratio,
+                    shear_ratio: self.membrane_shear_ratio,
+                    thickness: self.membrane_thickness,
+                    failure_strain: self.membrane_failure_strain,
+                    ..SurroundParams::default()
+                },
             }),
             failure: YarnFailure {
                 strain: self.failure_strain,
