@@ -362,15 +362,13 @@ fn both_woven_generators_refuse_a_bad_striking_speed_in_one_wording() {
             projectile_velocity: v,
             ..WovenBandParams::default()
         })
-        .err()
-        .expect("the yarn-level patch refuses it")
+        .expect_err("the yarn-level patch refuses it")
         .to_string();
         let reduced = woven_reduced(&WovenParams {
             projectile_velocity: v,
             ..WovenParams::paper()
         })
-        .err()
-        .expect("the reduced model refuses it")
+        .expect_err("the reduced model refuses it")
         .to_string();
         assert_eq!(band, reduced);
         for part in [

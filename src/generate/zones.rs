@@ -211,13 +211,13 @@ pub fn combined(p: &CombinedParams) -> Result<Model> {
 
 /// An even number of centre cells, and a coarsening that divides half of them.
 fn check(p: &CombinedParams) -> Result<()> {
-    if p.centre_cells == 0 || p.centre_cells % 2 != 0 {
+    if p.centre_cells == 0 || !p.centre_cells.is_multiple_of(2) {
         return Err(
             WeftError::input(format!("--centre-cells = `{}`", p.centre_cells))
                 .expected("an even number of cells > 0 (a node at the centre)"),
         );
     }
-    if p.coarsening == 0 || (p.centre_cells / 2) % p.coarsening != 0 {
+    if p.coarsening == 0 || !(p.centre_cells / 2).is_multiple_of(p.coarsening) {
         return Err(
             WeftError::input(format!("--coarsening = `{}`", p.coarsening)).expected(format!(
                 "a divisor of centre-cells/2 = {}",
