@@ -351,6 +351,36 @@ fn the_reduced_woven_model() {
     assert!(e.balance_error.abs() < 0.01 * ke0, "{e:?}");
 }
 
+/// The striking speed is checked in one place (`generate::projectile`): both woven
+/// generators refuse a negative or non-finite `--projectile-velocity` in the same words,
+/// the flag, the value, what is expected and a hint.
+#[test]
+fn both_woven_generators_refuse_a_bad_striking_speed_in_one_wording() {
+    use weft::generate::woven::{woven, WovenBandParams};
+    for v in [-1.0, f64::NAN, f64::NEG_INFINITY] {
+        let band = woven(&WovenBandParams {
+            projectile_velocity: v,
+            ..WovenBandParams::default()
+        })
+        .expect_err("the yarn-level patch refuses it")
+        .to_string();
+        let reduced = woven_reduced(&WovenParams {
+            projectile_velocity: v,
+            ..WovenParams::paper()
+        })
+        .expect_err("the reduced model refuses it")
+        .to_string();
+        assert_eq!(band, reduced);
+        for part in [
+            format!("--projectile-velocity = `{v}`"),
+            "expected a finite striking speed ≥ 0 in m/s".to_string(),
+            "hint: give the speed without a sign".to_string(),
+        ] {
+            assert!(band.contains(&part), "{band} lacks {part}");
+        }
+    }
+}
+
 #[test]
 fn combined_models_run_stably_at_their_defaults() {
     for centre in [Centre::Girder, Centre::Membrane] {

@@ -4,9 +4,11 @@
 pub mod block;
 pub mod bullet;
 pub mod cylinder;
+pub mod failure;
 pub mod grid;
 pub mod layers;
 pub mod metals;
+pub mod projectile;
 pub mod pulse;
 pub mod reduced_failure;
 pub mod rod;

@@ -1,6 +1,7 @@
 //! Failure of the reduced woven model (`woven-reduced --failure-strain`): its rods fail by
-//! the yarn-level patch's law (an axial strain compared after a delay), its membrane
-//! surround may fail along its fibre directions, and its elements carry the fabric's
+//! the yarn-level patch's law (an axial strain compared after a delay; the shared pieces
+//! in [`super::failure`]), its membrane surround may fail along its fibre directions
+//! ([`super::surround::fail_membranes`]), and its elements carry the fabric's
 //! `layer` and `yarn` tags, so that a run is watched and judged as a yarn-level patch's
 //! (per-layer energies, broken yarns, the projectile's outcome; docs/theory.md, "Failure,
 //! perforation and the ballistic limit").
@@ -8,7 +9,7 @@
 use serde::Serialize;
 
 use crate::error::{Result, WeftError};
-use crate::generate::woven::{DELAY_TRANSITS, FAILURE_CONTACT_DAMPING};
+use crate::generate::failure::{check_delay_and_damping, contact_damping, DELAY_TRANSITS};
 use crate::model::{ElementKind, Model};
 
 /// How the reduced model's rods fail.
@@ -35,13 +36,10 @@ impl ReducedFailure {
             .unwrap_or_else(|| DELAY_TRANSITS * spacing / (modulus / density).sqrt())
     }
 
-    /// The projectile's contact damping: the one given, or 0.5 when the rods can fail.
+    /// The projectile's contact damping: the one given, or 0.5 when the rods can fail
+    /// ([`contact_damping`]).
     pub fn contact_damping(&self) -> f64 {
-        self.contact_damping.unwrap_or(if self.strain > 0.0 {
-            FAILURE_CONTACT_DAMPING
-        } else {
-            0.0
-        })
+        contact_damping(self.contact_damping, self.strain)
     }
 
     /// A finite strain ≥ 0, a delay ≥ 0, a damping in [0, 1].
@@ -53,51 +51,7 @@ impl ReducedFailure {
                 ),
             );
         }
-        if let Some(d) = self.delay {
-            if !(d >= 0.0 && d.is_finite()) {
-                return Err(WeftError::input(format!("--failure-delay = `{d}`"))
-                    .expected("a delay ≥ 0 in s"));
-            }
-        }
-        if let Some(z) = self.contact_damping {
-            if !((0.0..=1.0).contains(&z)) {
-                return Err(
-                    WeftError::input(format!("--projectile-contact-damping = `{z}`"))
-                        .expected("a fraction of critical damping in [0, 1]"),
-                );
-            }
-        }
-        Ok(())
-    }
-}
-
-/// A membrane failure strain, if given, must be a strain > 0.
-pub fn check_membrane_strain(strain: Option<f64>) -> Result<()> {
-    match strain {
-        Some(e) if !(e > 0.0 && e.is_finite()) => Err(WeftError::input(format!(
-            "--membrane-failure-strain = `{e}`"
-        ))
-        .expected("a failure strain > 0 of the membrane's fibre directions (the yarns': 0.036)")
-        .hint("leave it out for a membrane that cannot fail")),
-        _ => Ok(()),
-    }
-}
-
-/// Every membrane quad part of `m` (the surround: parts named `coarse_membrane…`) fails
-/// at `strain` along either fibre direction, after the failure `delay` [s], and is then
-/// removed (OpenRadioss' /FAIL/FABRIC with NDIR = 1). Keeping an element whose one
-/// direction has failed (NDIR = 2) leaves a quad with no stiffness along that direction,
-/// which the nose then stretches without bound (a Green strain of 9 within 110 µs,
-/// measured), and its stable step with it.
-pub fn fail_membranes(m: &mut Model, strain: f64, delay: f64) {
-    for part in m
-        .parts
-        .iter_mut()
-        .filter(|q| q.kind == ElementKind::Quad && q.name.starts_with("coarse_membrane"))
-    {
-        part.props.failure_strain = Some(strain);
-        part.props.failure_strain_2 = Some(strain);
-        part.props.failure_delay = Some(delay);
+        check_delay_and_damping(self.delay, self.contact_damping)
     }
 }
 

@@ -231,6 +231,34 @@ impl GirderParams {
 /// oracles"). Rods on the boundary stand for half a cell: half the modulus and half the
 /// density, unless `full_edge_rods`.
 pub fn girder(p: &GirderParams) -> Result<(Model, Vec<String>)> {
+    let (b, h, warnings) = girder_section(p)?;
+    let mut m = Model::default();
+    add_lattice(&mut m, p, b, h);
+    frame(
+        &mut m,
+        &p.square,
+        p.youngs_modulus,
+        p.density,
+        p.rigid && p.clamp_rotations,
+    )?;
+    // A plane girder under in-plane loads: hold the out-of-plane motion (pinned joints have
+    // no stiffness there at all).
+    if p.square.load_case != LoadCase::Transverse {
+        for i in 0..m.num_nodes() {
+            m.constraints.push((i, [false, false, true]));
+            if p.rigid {
+                m.rot_constraints.push((i, [true, true, false]));
+            }
+        }
+    }
+    m.validate()?;
+    resolve_pulse(&mut m)?;
+    Ok((m, warnings))
+}
+
+/// The girder's flags checked, its rods' width b < a = L/N and thickness h; a warning
+/// where b lies outside the paper's range L/(20N) … L/(8N).
+fn girder_section(p: &GirderParams) -> Result<(f64, f64, Vec<String>)> {
     positive("youngs-modulus", p.youngs_modulus, "in Pa")?;
     positive("density", p.density, "in kg/m³")?;
     // The square's own flags first: the rod's default width and thickness derive from
@@ -254,7 +282,14 @@ pub fn girder(p: &GirderParams) -> Result<(Model, Vec<String>)> {
             "rod width b = {b:.4e} m lies outside the paper's range L/(20N) … L/(8N) = {lo:.4e} … {hi:.4e} m (its eq. 3); the reduced membrane closed forms assume slender rods"
         ));
     }
-    let mut m = Model::default();
+    Ok((b, h, warnings))
+}
+
+/// The girder's joints (the square's grid nodes, row by row, ids from 1) and its rods of
+/// section b × h between them, beams or trusses, those on the boundary in part 2.
+fn add_lattice(m: &mut Model, p: &GirderParams, b: f64, h: f64) {
+    let (n, l) = (p.square.cells, p.square.length);
+    let a = l / n as f64;
     let (nodes, _) = rectangle(n, n, l, l, ElementKind::Quad);
     for (i, x) in nodes.iter().enumerate() {
         m.add_node(i as i64 + 1, *x);
@@ -315,26 +350,6 @@ pub fn girder(p: &GirderParams) -> Result<(Model, Vec<String>)> {
             }
         }
     }
-    frame(
-        &mut m,
-        &p.square,
-        p.youngs_modulus,
-        p.density,
-        p.rigid && p.clamp_rotations,
-    )?;
-    // A plane girder under in-plane loads: hold the out-of-plane motion (pinned joints have
-    // no stiffness there at all).
-    if p.square.load_case != LoadCase::Transverse {
-        for i in 0..m.num_nodes() {
-            m.constraints.push((i, [false, false, true]));
-            if p.rigid {
-                m.rot_constraints.push((i, [true, true, false]));
-            }
-        }
-    }
-    m.validate()?;
-    resolve_pulse(&mut m)?;
-    Ok((m, warnings))
 }
 
 /// `membrane`: the same square meshed with quads, orthotropic with E₁ = E₂ = E.

@@ -1,7 +1,9 @@
 //! The woven surround: the graded coarse membrane with a square hole that carries the
 //! waves on around a dense patch (a girder zone, a fine membrane, the reduced or the
 //! yarn-level woven patch), the ties from the patch's boundary to the hole's edges, and
-//! the centre-line node sets through both.
+//! the centre-line node sets through both; around a woven patch, the membrane's
+//! properties from the paper's §3 ratios to the yarns ([`SurroundParams`]) and its
+//! failure ([`fail_membranes`]).
 //!
 //! The coarse membrane is a tensor-product grid of lines: uniform at spacing h_c across
 //! the centre, then growing by the ratio r out to the outer boundary, with the centre
@@ -85,6 +87,126 @@ impl MembraneProps {
             density: Some(self.density),
             ..Default::default()
         }
+    }
+}
+
+/// The paper's §3 equivalent membrane around a woven patch, relative to the patch's yarns
+/// (both woven generators' surround: `woven --membrane-length`, `woven-reduced`): its
+/// surface density from the patch's, its moduli from the yarns', its thickness, and its
+/// failure. Defaults: the paper's fitted §3 ratios ([`SurroundParams::paper`]).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SurroundParams {
+    /// Surface density of the membrane / surface density of the woven patch, ρ_m s/(2ρA/p)
+    /// [–] (per layer; the paper's §3: 0.8).
+    pub density_ratio: f64,
+    /// Young's modulus of the membrane E₁ = E₂ / Young's modulus of the yarn, E_m/E_y [–]
+    /// (the paper's §3: 0.3).
+    pub modulus_ratio: f64,
+    /// Shear modulus of the membrane / its Young's modulus, G₁₂/E_m [–] (the paper's §3:
+    /// 0.0042).
+    pub shear_ratio: f64,
+    /// Poisson's ratio ν of the (isotropic in-plane) membrane [–] (0: the woven patch's
+    /// yarn families do not couple).
+    pub poisson_ratio: f64,
+    /// Membrane thickness s [m], an assumption (the paper states none); `None`: 2A/p per
+    /// layer, the yarns' section per unit width of both families, so that the membrane's
+    /// stress is the yarns' at the same strain when E_m = E/2. The thickness only sets
+    /// ρ_m = ratio·(2ρA/p)/s: s ρ_m and s E_m are what the membrane's waves see.
+    pub thickness: Option<f64>,
+    /// Failure strain of the membrane along both fibre directions (None: it cannot fail,
+    /// as in the paper's studies); see [`fail_membranes`].
+    pub failure_strain: Option<f64>,
+}
+
+impl Default for SurroundParams {
+    /// [`SurroundParams::paper`].
+    fn default() -> Self {
+        SurroundParams::paper()
+    }
+}
+
+impl SurroundParams {
+    /// The paper's §3 ratios: 0.8, 0.3, 0.0042; ν = 0; s = 2A/p; no failure.
+    pub fn paper() -> SurroundParams {
+        SurroundParams {
+            density_ratio: 0.8,
+            modulus_ratio: 0.3,
+            shear_ratio: 0.0042,
+            poisson_ratio: 0.0,
+            thickness: None,
+            failure_strain: None,
+        }
+    }
+
+    /// The membrane's properties around a patch of yarns of modulus `yarn_modulus` and of
+    /// `surface_density` [kg/m²] (one layer's): s (`default_thickness` unless given),
+    /// ρ_m = r_ρ (surface density)/s, E_m = r_E E_y, G_m = r_G E_m.
+    pub fn props(
+        &self,
+        yarn_modulus: f64,
+        surface_density: f64,
+        default_thickness: f64,
+    ) -> MembraneProps {
+        let s = self.thickness.unwrap_or(default_thickness);
+        let e_m = self.modulus_ratio * yarn_modulus;
+        MembraneProps {
+            youngs_modulus: e_m,
+            poisson_ratio: self.poisson_ratio,
+            shear_modulus: self.shear_ratio * e_m,
+            thickness: s,
+            density: self.density_ratio * surface_density / s,
+        }
+    }
+
+    /// Ratios > 0, a thickness > 0 where given, −1 < ν < 1, a failure strain > 0 where
+    /// given; each refusal names its `--membrane-…` flag.
+    pub fn check(&self) -> Result<()> {
+        for (name, v) in [
+            ("membrane-density-ratio", self.density_ratio),
+            ("membrane-modulus-ratio", self.modulus_ratio),
+            ("membrane-shear-ratio", self.shear_ratio),
+        ] {
+            if !(v > 0.0 && v.is_finite()) {
+                return Err(WeftError::input(format!("--{name} = `{v}`")).expected("a ratio > 0"));
+            }
+        }
+        if let Some(t) = self.thickness {
+            if !(t > 0.0 && t.is_finite()) {
+                return Err(WeftError::input(format!("--membrane-thickness = `{t}`"))
+                    .expected("a thickness > 0 in m"));
+            }
+        }
+        let nu = self.poisson_ratio;
+        if !(nu > -1.0 && nu < 1.0) {
+            return Err(WeftError::input(format!("--membrane-poisson = `{nu}`"))
+                .expected("−1 < ν < 1 (an isotropic membrane, ν² < 1)"));
+        }
+        match self.failure_strain {
+            Some(e) if !(e > 0.0 && e.is_finite()) => Err(WeftError::input(format!(
+                "--membrane-failure-strain = `{e}`"
+            ))
+            .expected("a failure strain > 0 of the membrane's fibre directions (the yarns': 0.036)")
+            .hint("leave it out for a membrane that cannot fail")),
+            _ => Ok(()),
+        }
+    }
+}
+
+/// Every membrane quad part of `m` (the surround: parts named `coarse_membrane…`) fails
+/// at `strain` along either fibre direction, after the failure `delay` [s], and is then
+/// removed (OpenRadioss' /FAIL/FABRIC with NDIR = 1). Keeping an element whose one
+/// direction has failed (NDIR = 2) leaves a quad with no stiffness along that direction,
+/// which the nose then stretches without bound (a Green strain of 9 within 110 µs,
+/// measured), and its stable step with it.
+pub fn fail_membranes(m: &mut Model, strain: f64, delay: f64) {
+    for part in m
+        .parts
+        .iter_mut()
+        .filter(|q| q.kind == ElementKind::Quad && q.name.starts_with("coarse_membrane"))
+    {
+        part.props.failure_strain = Some(strain);
+        part.props.failure_strain_2 = Some(strain);
+        part.props.failure_delay = Some(delay);
     }
 }
 

@@ -156,99 +156,21 @@ impl CombinedOptions {
     }
 }
 
+/// The combined model: the dense centre zone ([`Centre`]) on its grid, the graded coarse
+/// membrane around it tied to the zone's boundary and pinned at its outer edge, the
+/// force pulse at the centre, the node sets and the analysis.
 pub fn combined(p: &CombinedParams) -> Result<Model> {
-    if p.centre_cells == 0 || p.centre_cells % 2 != 0 {
-        return Err(
-            WeftError::input(format!("--centre-cells = `{}`", p.centre_cells))
-                .expected("an even number of cells > 0 (a node at the centre)"),
-        );
-    }
-    if p.coarsening == 0 || (p.centre_cells / 2) % p.coarsening != 0 {
-        return Err(
-            WeftError::input(format!("--coarsening = `{}`", p.coarsening)).expected(format!(
-                "a divisor of centre-cells/2 = {}",
-                p.centre_cells / 2
-            )),
-        );
-    }
+    check(p)?;
     let a = p.centre_length / p.centre_cells as f64;
     let c = 0.5 * p.centre_length;
     let pos = graded_lines(c, a * p.coarsening as f64, 0.5 * p.length, p.growth)?;
     let mut m = Model::default();
-    // Dense zone: nodes on the centre grid (ids from 1), quarter or full.
-    let (lo, n) = if p.quarter {
-        (0usize, p.centre_cells / 2)
-    } else {
-        (0, p.centre_cells)
-    };
-    let x0 = if p.quarter { 0.0 } else { -c };
-    let mut fine = vec![];
-    for j in lo..=n {
-        for i in lo..=n {
-            fine.push(m.add_node(
-                (fine.len() + 1) as i64,
-                [x0 + i as f64 * a, x0 + j as f64 * a, 0.0],
-            ));
-        }
-    }
-    let w = n + 1;
-    let id = |i: usize, j: usize| fine[j * w + i];
+    let zone = CentreGrid::new(&mut m, p, a, c);
     match p.centre {
-        Centre::Girder => {
-            let rod = |f: f64| PartProps {
-                youngs_modulus: Some(f * p.youngs_modulus),
-                density: Some(f * p.density * (1.0 - p.rod_width / (2.0 * a))),
-                width: Some(p.rod_width),
-                height: Some(p.rod_width),
-                poisson_ratio: Some(0.0),
-                ..Default::default()
-            };
-            let part = m.add_part(1, "rods", ElementKind::Beam, rod(1.0));
-            // Rods on the hole boundary (half a cell; the membrane carries the other half)
-            // and on a symmetry plane (half belongs to the neighbouring quarter) carry half
-            // of everything: half the modulus and half the density at the full section
-            // halve every stiffness (axial, both bendings, torsion) and the mass alike.
-            let half = m.add_part(2, "half_rods", ElementKind::Beam, rod(0.5));
-            // k = 0 is a symmetry plane in a quarter and the hole's other boundary in a
-            // full model: half rods either way.
-            let on_line = |k: usize| k == n || k == 0;
-            let mut eid = 1;
-            for j in 0..=n {
-                for i in 0..=n {
-                    if i < n {
-                        m.add_element(
-                            eid,
-                            if on_line(j) { half } else { part },
-                            &[id(i, j), id(i + 1, j)],
-                        );
-                        eid += 1;
-                    }
-                    if j < n {
-                        m.add_element(
-                            eid,
-                            if on_line(i) { half } else { part },
-                            &[id(i, j), id(i, j + 1)],
-                        );
-                        eid += 1;
-                    }
-                }
-            }
-        }
-        Centre::Membrane => {
-            let part = m.add_part(1, "fine_membrane", ElementKind::Quad, p.membrane.part());
-            let mut eid = 1;
-            for j in 0..n {
-                for i in 0..n {
-                    m.add_element(
-                        eid,
-                        part,
-                        &[id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)],
-                    );
-                    eid += 1;
-                }
-            }
-        }
+        Centre::Girder => add_centre_girder(&mut m, p, &zone, a),
+        Centre::Membrane => add_fine_membrane(&mut m, p, &zone),
     }
+    let fine = zone.nodes;
     let coarse = coarse_membrane(&mut m, &pos, p.quarter, c, &p.membrane, 100_000);
     let boundary: Vec<usize> = fine
         .iter()
@@ -285,4 +207,123 @@ pub fn combined(p: &CombinedParams) -> Result<Model> {
     m.validate()?;
     resolve_pulse(&mut m)?;
     Ok(m)
+}
+
+/// An even number of centre cells, and a coarsening that divides half of them.
+fn check(p: &CombinedParams) -> Result<()> {
+    if p.centre_cells == 0 || !p.centre_cells.is_multiple_of(2) {
+        return Err(
+            WeftError::input(format!("--centre-cells = `{}`", p.centre_cells))
+                .expected("an even number of cells > 0 (a node at the centre)"),
+        );
+    }
+    if p.coarsening == 0 || !(p.centre_cells / 2).is_multiple_of(p.coarsening) {
+        return Err(
+            WeftError::input(format!("--coarsening = `{}`", p.coarsening)).expected(format!(
+                "a divisor of centre-cells/2 = {}",
+                p.centre_cells / 2
+            )),
+        );
+    }
+    Ok(())
+}
+
+/// The dense zone's nodes: the centre grid of cell size a (ids from 1), (n + 1)² of them,
+/// n the cells per side (half of them in a quarter), row by row.
+struct CentreGrid {
+    nodes: Vec<usize>,
+    n: usize,
+}
+
+impl CentreGrid {
+    /// The grid's nodes on the quarter [0, c]² or on the full [−c, c]².
+    fn new(m: &mut Model, p: &CombinedParams, a: f64, c: f64) -> CentreGrid {
+        let n = if p.quarter {
+            p.centre_cells / 2
+        } else {
+            p.centre_cells
+        };
+        let x0 = if p.quarter { 0.0 } else { -c };
+        let mut nodes = vec![];
+        for j in 0..=n {
+            for i in 0..=n {
+                nodes.push(m.add_node(
+                    (nodes.len() + 1) as i64,
+                    [x0 + i as f64 * a, x0 + j as f64 * a, 0.0],
+                ));
+            }
+        }
+        CentreGrid { nodes, n }
+    }
+
+    /// The node at (i, j) of the grid.
+    fn id(&self, i: usize, j: usize) -> usize {
+        self.nodes[j * (self.n + 1) + i]
+    }
+}
+
+/// The girder centre: beams along the grid lines (rigid joints), those on the zone's
+/// boundary or on a symmetry plane half rods.
+fn add_centre_girder(m: &mut Model, p: &CombinedParams, g: &CentreGrid, a: f64) {
+    let rod = |f: f64| PartProps {
+        youngs_modulus: Some(f * p.youngs_modulus),
+        density: Some(f * p.density * (1.0 - p.rod_width / (2.0 * a))),
+        width: Some(p.rod_width),
+        height: Some(p.rod_width),
+        poisson_ratio: Some(0.0),
+        ..Default::default()
+    };
+    let part = m.add_part(1, "rods", ElementKind::Beam, rod(1.0));
+    // Rods on the hole boundary (half a cell; the membrane carries the other half)
+    // and on a symmetry plane (half belongs to the neighbouring quarter) carry half
+    // of everything: half the modulus and half the density at the full section
+    // halve every stiffness (axial, both bendings, torsion) and the mass alike.
+    let half = m.add_part(2, "half_rods", ElementKind::Beam, rod(0.5));
+    // k = 0 is a symmetry plane in a quarter and the hole's other boundary in a
+    // full model: half rods either way.
+    let n = g.n;
+    let on_line = |k: usize| k == n || k == 0;
+    let mut eid = 1;
+    for j in 0..=n {
+        for i in 0..=n {
+            if i < n {
+                m.add_element(
+                    eid,
+                    if on_line(j) { half } else { part },
+                    &[g.id(i, j), g.id(i + 1, j)],
+                );
+                eid += 1;
+            }
+            if j < n {
+                m.add_element(
+                    eid,
+                    if on_line(i) { half } else { part },
+                    &[g.id(i, j), g.id(i, j + 1)],
+                );
+                eid += 1;
+            }
+        }
+    }
+}
+
+/// The membrane centre: a quad on every cell of the grid, of the coarse membrane's
+/// properties.
+fn add_fine_membrane(m: &mut Model, p: &CombinedParams, g: &CentreGrid) {
+    let part = m.add_part(1, "fine_membrane", ElementKind::Quad, p.membrane.part());
+    let mut eid = 1;
+    for j in 0..g.n {
+        for i in 0..g.n {
+            m.add_element(
+                eid,
+                part,
+                &[
+                    g.id(i, j),
+                    g.id(i + 1, j),
+                    g.id(i + 1, j + 1),
+                    g.id(i, j + 1),
+                ],
+            );
+            eid += 1;
+        }
+    }
 }

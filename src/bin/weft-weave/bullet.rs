@@ -1,5 +1,5 @@
-//! The deformable bullet's flags, shared by `weft-weave woven` (flattened into its
-//! arguments).
+//! The deformable bullet's flags, flattened into the projectile's group that `woven` and
+//! `woven-reduced` share ([`super::fabric::ProjectileArgs`]).
 
 use weft::generate::bullet::{BulletKind, BulletParams};
 use weft::generate::metals::Metal;

@@ -39,15 +39,17 @@ mod params;
 mod section;
 mod yarns;
 
-pub use params::{
-    Edge, StrengthPer, Surround, WovenBandParams, YarnFailure, YarnModel, DELAY_TRANSITS,
-    FAILURE_CONTACT_DAMPING,
-};
+pub use params::{Edge, StrengthPer, Surround, WovenBandParams, YarnFailure, YarnModel};
 pub use section::{chain_touching_amplitude, Lenticular};
 use section::{crimp_amplitude, crimp_of, Section};
 use yarns::{add_layer, insert_sets, Built, Weave};
 
 use crate::error::{Result, WeftError};
+use crate::generate::failure::check_delay_and_damping;
+use crate::generate::projectile::check_striking_speed;
+use crate::generate::surround::{
+    coarse_membrane_at, fail_membranes, graded_lines, tie_to_hole, MembraneProps, Sheet,
+};
 use crate::model::contacts::{ContactDef, Slave};
 use crate::model::{Analysis, ElementKind, Model, ProjectileSpec, SymmetryPlane};
 
@@ -155,18 +157,13 @@ fn check(p: &WovenBandParams) -> Result<()> {
             "a safety factor 0 < f ≤ 1 on the stable step",
         );
     }
-    if !(p.projectile_velocity.is_finite() && p.projectile_velocity >= 0.0) {
-        return bad(
-            "projectile-velocity",
-            p.projectile_velocity.to_string(),
-            "a speed ≥ 0 in m/s",
-        );
-    }
+    check_striking_speed("--projectile-velocity", p.projectile_velocity)?;
     check_failure(&p.failure)
 }
 
 /// The yarn failure's parameters: a finite failure strain ≥ 0 (0: none), a Weibull
-/// modulus and gauge length > 0, a rate law with C ≥ 0 and ε̇₀ > 0.
+/// modulus and gauge length > 0, a rate law with C ≥ 0 and ε̇₀ > 0, a delay ≥ 0 and a
+/// contact damping in [0, 1].
 fn check_failure(f: &YarnFailure) -> Result<()> {
     let bad = |name: &str, v: f64, exp: &str| {
         Err(WeftError::input(format!("--{name} = `{v}`")).expected(exp.to_string()))
@@ -208,21 +205,7 @@ fn check_failure(f: &YarnFailure) -> Result<()> {
     if !(f.reference_rate.is_finite() && f.reference_rate > 0.0) {
         return bad("failure-reference-rate", f.reference_rate, "ε̇₀ > 0 in 1/s");
     }
-    if let Some(d) = f.delay {
-        if !(d.is_finite() && d >= 0.0) {
-            return bad("failure-delay", d, "a delay ≥ 0 in s");
-        }
-    }
-    if let Some(z) = f.contact_damping {
-        if !(0.0..=1.0).contains(&z) {
-            return bad(
-                "projectile-contact-damping",
-                z,
-                "a fraction 0 ≤ ζ ≤ 1 of critical",
-            );
-        }
-    }
-    Ok(())
+    check_delay_and_damping(f.delay, f.contact_damping)
 }
 
 /// The yarn-level patch and what was derived.
@@ -429,11 +412,41 @@ fn add_projectile(m: &mut Model, p: &WovenBandParams, s: &Section, top: f64) {
     });
 }
 
-/// Ties the quarter patch's yarn ends into a graded membrane (see [`Surround`]).
+/// Ties the quarter patch's yarn ends into a graded membrane (see [`Surround`]): one
+/// sheet per layer, the node sets `interface` (the tied ends) and `axis_x_all`, and the
+/// membrane's failure.
 fn surround(m: &mut Model, p: &WovenBandParams, s: &Surround, info: &WovenInfo) -> Result<()> {
-    use crate::generate::surround::{
-        coarse_membrane_at, graded_lines, tie_to_hole, MembraneProps, Sheet,
-    };
+    let c = check_surround(p, s)?;
+    // Each sheet carries one layer's share: one layer's surface density, and the yarns'
+    // section per unit width 2A/p as its default thickness.
+    let props = s
+        .membrane
+        .props(p.modulus, info.areal_density, 2.0 * info.area / p.spacing);
+    // The yarn ends are tied, not held.
+    let ends = m.node_sets["edge"].clone();
+    let is_end: std::collections::HashSet<usize> = ends.iter().copied().collect();
+    m.constraints.retain(|(n, _)| !is_end.contains(n));
+    let lines = graded_lines(c, 0.5 * p.spacing, s.length, s.growth)?;
+    let patch_nodes = m.num_nodes();
+    let mut tied = Vec::new();
+    for layer in 0..p.layers {
+        let z = -(layer as f64) * info.layer_pitch;
+        tied.extend(add_sheet(m, layer, z, &lines, c, &props, &ends)?);
+    }
+    let axis = axis_through_surround(m, patch_nodes, c);
+    m.node_sets.insert("axis_x_all".into(), axis);
+    m.node_sets.insert("interface".into(), tied);
+    if let Some(e) = s.membrane.failure_strain {
+        fail_membranes(m, e, p.failure_delay());
+    }
+    m.analysis.history_sets.push("axis_x_all".into());
+    Ok(())
+}
+
+/// The surround's flags: a quarter patch, a half-size beyond its yarn ends, a growth
+/// ratio in [1, 3], the membrane's own ([`crate::generate::surround::SurroundParams`]).
+/// Returns the half-size c = (N − ½)p of the patch, where the yarn ends lie.
+fn check_surround(p: &WovenBandParams, s: &Surround) -> Result<f64> {
     if !p.quarter {
         return Err(WeftError::input("--membrane-length with --full".to_string())
             .expected("a quarter patch: a full patch's yarn ends lie at the crimp's crests, off the membrane's plane")
@@ -453,84 +466,64 @@ fn surround(m: &mut Model, p: &WovenBandParams, s: &Surround, info: &WovenInfo) 
     if !(s.growth >= 1.0 && s.growth <= 3.0) {
         return bad("membrane-growth", s.growth, "a growth ratio in [1, 3]");
     }
-    for (name, v) in [
-        ("membrane-density-ratio", s.density_ratio),
-        ("membrane-modulus-ratio", s.modulus_ratio),
-        ("membrane-shear-ratio", s.shear_ratio),
-    ] {
-        if !(v > 0.0 && v.is_finite()) {
-            return bad(name, v, "a ratio > 0");
+    s.membrane.check()?;
+    Ok(c)
+}
+
+/// The membrane sheet of `layer` at height `z` (the layer's mid-plane: the quarter's
+/// edge lies where the crimp crosses it) on the graded `lines` around the hole of
+/// half-size `c`, clamped at its outer edge, the layer's yarn `ends` tied to it; its
+/// quads tagged with the layer (its energies and deflection go with it). Returns the
+/// tied ends.
+fn add_sheet(
+    m: &mut Model,
+    layer: usize,
+    z: f64,
+    lines: &[f64],
+    c: f64,
+    props: &MembraneProps,
+    ends: &[usize],
+) -> Result<Vec<usize>> {
+    let sheet = if layer == 0 {
+        Sheet::default()
+    } else {
+        Sheet {
+            z,
+            part_id: 90 + layer as i64,
+            name: format!("coarse_membrane_{}", layer + 1),
+            first_element: 1_000_000 + 200_000 * layer as i64,
         }
-    }
-    // One membrane sheet per layer, at the layer's height, carrying one layer's share:
-    // each layer's yarn ends (at its mid-plane: the quarter's edge lies where the crimp
-    // crosses it) are tied to its own sheet.
-    let layers = p.layers;
-    let thickness = s.thickness.unwrap_or(2.0 * info.area / p.spacing);
-    if !(thickness > 0.0 && thickness.is_finite()) {
-        return bad("membrane-thickness", thickness, "a thickness > 0 in m");
-    }
-    let e_m = s.modulus_ratio * p.modulus;
-    let props = MembraneProps {
-        youngs_modulus: e_m,
-        poisson_ratio: 0.0,
-        shear_modulus: s.shear_ratio * e_m,
-        thickness,
-        density: s.density_ratio * info.areal_density / thickness,
     };
-    // The yarn ends are tied, not held.
-    let ends = m.node_sets["edge"].clone();
-    let is_end: std::collections::HashSet<usize> = ends.iter().copied().collect();
-    m.constraints.retain(|(n, _)| !is_end.contains(n));
-    let lines = graded_lines(c, 0.5 * p.spacing, s.length, s.growth)?;
-    let patch_nodes = m.num_nodes();
-    let mut tied = Vec::new();
-    for l in 0..layers {
-        let zl = -(l as f64) * info.layer_pitch;
-        let sheet = if l == 0 {
-            Sheet::default()
-        } else {
-            Sheet {
-                z: zl,
-                part_id: 90 + l as i64,
-                name: format!("coarse_membrane_{}", l + 1),
-                first_element: 1_000_000 + 200_000 * l as i64,
-            }
-        };
-        let first_id = m.node_id.iter().copied().max().unwrap_or(0) + 1;
-        let before = m.elements.get(&ElementKind::Quad).map_or(0, |b| b.len());
-        let coarse = coarse_membrane_at(m, &lines, true, c, &props, first_id, &sheet);
-        let layer_ends: Vec<usize> = ends
-            .iter()
-            .copied()
-            .filter(|&n| (m.coords[n][2] - zl).abs() <= 1e-9)
-            .collect();
-        tied.extend(tie_to_hole(m, &coarse, &layer_ends)?);
-        for &o in &coarse.outer {
-            m.constraints.push((o, [true, true, true]));
-        }
-        // The sheet belongs to its layer (its energies and deflection with it).
-        let b = m
-            .elements
-            .get_mut(&ElementKind::Quad)
-            .expect("the sheet's quads");
-        b.layer.resize(before, None);
-        b.layer.resize(b.len(), Some(l as i64 + 1));
+    let first_id = m.node_id.iter().copied().max().unwrap_or(0) + 1;
+    let before = m.elements.get(&ElementKind::Quad).map_or(0, |b| b.len());
+    let coarse = coarse_membrane_at(m, lines, true, c, props, first_id, &sheet);
+    let layer_ends: Vec<usize> = ends
+        .iter()
+        .copied()
+        .filter(|&n| (m.coords[n][2] - z).abs() <= 1e-9)
+        .collect();
+    let tied = tie_to_hole(m, &coarse, &layer_ends)?;
+    for &o in &coarse.outer {
+        m.constraints.push((o, [true, true, true]));
     }
-    // The x axis line on both sides of the interface: the patch's crossings, then the
-    // membrane's nodes on y = 0 beyond it.
+    let b = m
+        .elements
+        .get_mut(&ElementKind::Quad)
+        .expect("the sheet's quads");
+    b.layer.resize(before, None);
+    b.layer.resize(b.len(), Some(layer as i64 + 1));
+    Ok(tied)
+}
+
+/// The x axis line on both sides of the interface at x = c: the patch's crossings
+/// (`axis_x`), then the membrane's nodes on y = 0 beyond it (those added after the
+/// patch's first `patch_nodes`), ordered by x.
+fn axis_through_surround(m: &Model, patch_nodes: usize, c: f64) -> Vec<usize> {
     let mut axis: Vec<usize> = m.node_sets["axis_x"].clone();
     let mut beyond: Vec<usize> = (patch_nodes..m.num_nodes())
         .filter(|&n| m.coords[n][1].abs() < 1e-12 && m.coords[n][0] > c - 1e-12)
         .collect();
     beyond.sort_by(|&a, &b| m.coords[a][0].total_cmp(&m.coords[b][0]));
     axis.extend(beyond);
-    m.node_sets.insert("axis_x_all".into(), axis);
-    m.node_sets.insert("interface".into(), tied);
-    crate::generate::reduced_failure::check_membrane_strain(s.failure_strain)?;
-    if let Some(e) = s.failure_strain {
-        crate::generate::reduced_failure::fail_membranes(m, e, p.failure_delay());
-    }
-    m.analysis.history_sets.push("axis_x_all".into());
-    Ok(())
+    axis
 }

@@ -4,6 +4,8 @@
 
 use serde::Serialize;
 
+use crate::generate::failure::{contact_damping, DELAY_TRANSITS};
+use crate::generate::surround::SurroundParams;
 use crate::model::ProjectileShape;
 
 /// Edge condition of the yarn ends at the patch edge.
@@ -85,20 +87,9 @@ impl Default for YarnFailure {
     }
 }
 
-/// Element transits in the default failure delay: a struck yarn's first elements
-/// overshoot Smith's strain by about 40 % for about ten steps whatever the element size;
-/// with this delay (and the nose's contact damping) a struck chain and band break within
-/// 1 % and 2 % of Smith's critical velocity (`tests/failure.rs`).
-pub const DELAY_TRANSITS: f64 = 10.0;
-
-/// The nose's contact damping (fraction of critical) when the yarns can fail: the nodes
-/// under a nose otherwise ring on their penalty springs at ±30 % of Smith's strain
-/// (measured), which breaks a struck yarn below its critical velocity.
-pub const FAILURE_CONTACT_DAMPING: f64 = 0.5;
-
 impl WovenBandParams {
     /// The failure delay: the one given, or [`DELAY_TRANSITS`] element transits
-    /// (spacing/per_spacing)/√(E/ρ).
+    /// (spacing/per_spacing)/√(E/ρ) ([`crate::generate::failure`]).
     pub fn failure_delay(&self) -> f64 {
         self.failure.delay.unwrap_or_else(|| {
             DELAY_TRANSITS * self.spacing
@@ -106,16 +97,10 @@ impl WovenBandParams {
                 / (self.modulus / self.density).sqrt()
         })
     }
-    /// The projectile's contact damping: the one given, or [`FAILURE_CONTACT_DAMPING`]
-    /// when the yarns can fail (0 otherwise, as before failure existed).
+    /// The projectile's contact damping: the one given, or 0.5 when the yarns can fail
+    /// ([`contact_damping`]).
     pub fn contact_damping(&self) -> f64 {
-        self.failure
-            .contact_damping
-            .unwrap_or(if self.failure.strain > 0.0 {
-                FAILURE_CONTACT_DAMPING
-            } else {
-                0.0
-            })
+        contact_damping(self.failure.contact_damping, self.failure.strain)
     }
 }
 
@@ -190,26 +175,18 @@ pub struct WovenBandParams {
 /// x = c and y = c, c = (N − ½)p, are tied to the membrane's inner edge (each end node to
 /// the membrane edge it lies on, linear weights); the membrane is clamped at its outer
 /// edge; `edge` no longer applies. Membrane cells are p/2 at the patch and grow by
-/// `growth` outwards. Defaults: the paper's fitted §3 ratios.
+/// `growth` outwards; one sheet per layer, each with one layer's share of the patch's
+/// surface density ([`SurroundParams`], the reduced model's surround too).
 #[derive(Debug, Clone, Serialize)]
 pub struct Surround {
     /// Outer half-size of the model [m] (the reference patch's: 60 mm for 60 yarns).
     pub length: f64,
     /// Growth ratio of the membrane cells away from the patch (≥ 1).
     pub growth: f64,
-    /// Membrane areal density / the patch's (all layers; paper 0.8).
-    pub density_ratio: f64,
-    /// Membrane E₁ = E₂ / the yarns' E (paper 0.3).
-    pub modulus_ratio: f64,
-    /// Membrane G₁₂ / its E (paper 0.0042).
-    pub shear_ratio: f64,
-    /// Membrane thickness [m]. An assumption (the paper states none): None takes 2A/p per
-    /// layer, the yarns' cross-section per unit width of both families, so that the
-    /// membrane's stress is the yarns' at the same strain when E_m = E/2.
-    pub thickness: Option<f64>,
-    /// Failure strain of the membrane along both fibre directions (None: it cannot fail);
-    /// see [`crate::generate::reduced_failure::fail_membranes`].
-    pub failure_strain: Option<f64>,
+    /// The membrane's properties relative to the yarns, and its failure (defaults: the
+    /// paper's §3 ratios).
+    #[serde(flatten)]
+    pub membrane: SurroundParams,
 }
 
 impl Default for Surround {
@@ -221,16 +198,13 @@ impl Default for Surround {
 }
 
 impl Surround {
-    /// The paper's §3 ratios around a patch, out to `length`.
+    /// The paper's §3 ratios ([`SurroundParams::paper`]) around a patch, out to `length`,
+    /// its cells growing by 1.2.
     pub fn paper(length: f64) -> Surround {
         Surround {
             length,
             growth: 1.2,
-            density_ratio: 0.8,
-            modulus_ratio: 0.3,
-            shear_ratio: 0.0042,
-            thickness: None,
-            failure_strain: None,
+            membrane: SurroundParams::paper(),
         }
     }
 }
