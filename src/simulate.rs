@@ -10,6 +10,7 @@ use serde::Serialize;
 use crate::element_results::{ElementResults, WithElementResults};
 use crate::error::{Result, WeftError};
 use crate::model::io::read_tables;
+use crate::model::striker::check_striking_speed;
 use crate::model::{ElementKind, Model, ValidatedModel};
 use crate::solver::output::ParquetSink;
 use crate::solver::{RunStats, Solver};
@@ -105,10 +106,7 @@ pub fn apply_overrides(m: &mut Model, c: &Config) {
 /// Checks the overrides that have no home in the model's own validation.
 fn check_overrides(m: &Model, c: &Config) -> Result<()> {
     if let Some(v) = c.projectile_velocity {
-        if !(v.is_finite() && v >= 0.0) {
-            return Err(WeftError::input(format!("--projectile-velocity = `{v}`"))
-                .expected("a striking speed ≥ 0 in m/s"));
-        }
+        check_striking_speed("--projectile-velocity", v)?;
         if !m.has_striker() {
             return Err(WeftError::input(format!(
                 "--projectile-velocity {v} for a model without a projectile"

@@ -351,7 +351,7 @@ fn the_reduced_woven_model() {
     assert!(e.balance_error.abs() < 0.01 * ke0, "{e:?}");
 }
 
-/// The striking speed is checked in one place (`generate::projectile`): both woven
+/// The striking speed is checked in one place (`model::striker::check_striking_speed`): both woven
 /// generators refuse a negative or non-finite `--projectile-velocity` in the same words,
 /// the flag, the value, what is expected and a hint.
 #[test]

@@ -8,7 +8,6 @@ pub mod failure;
 pub mod grid;
 pub mod layers;
 pub mod metals;
-pub mod projectile;
 pub mod pulse;
 pub mod reduced_failure;
 pub mod rod;

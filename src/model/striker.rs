@@ -5,6 +5,20 @@
 //! watch of the outcome need of either.
 
 use super::types::Model;
+use crate::error::{Result, WeftError};
+
+/// A striking speed `v` [m/s], given by `flag` (`--projectile-velocity` of the woven
+/// generators and of `weft-simulate`), must be finite and ≥ 0: the projectile flies
+/// along its axis, towards the fabric, so the speed carries no sign. One wording
+/// wherever a speed is given.
+pub fn check_striking_speed(flag: &str, v: f64) -> Result<()> {
+    if v.is_finite() && v >= 0.0 {
+        return Ok(());
+    }
+    Err(WeftError::input(format!("{flag} = `{v}`"))
+        .expected("a finite striking speed ≥ 0 in m/s")
+        .hint("give the speed without a sign: the projectile flies along its axis, towards the fabric (0: at rest)"))
+}
 
 /// The node set of a deformable projectile.
 pub const BULLET_SET: &str = "bullet";

@@ -46,11 +46,11 @@ use yarns::{add_layer, insert_sets, Built, Weave};
 
 use crate::error::{Result, WeftError};
 use crate::generate::failure::check_delay_and_damping;
-use crate::generate::projectile::check_striking_speed;
 use crate::generate::surround::{
     coarse_membrane_at, fail_membranes, graded_lines, tie_to_hole, MembraneProps, Sheet,
 };
 use crate::model::contacts::{ContactDef, Slave};
+use crate::model::striker::check_striking_speed;
 use crate::model::{Analysis, ElementKind, Model, ProjectileSpec, SymmetryPlane};
 
 /// What the generator reports besides the model.

@@ -5,9 +5,9 @@
 use serde::Serialize;
 
 use crate::error::{Result, WeftError};
-use crate::generate::projectile::check_striking_speed;
 use crate::generate::reduced_failure::ReducedFailure;
 use crate::generate::surround::{MembraneProps, SurroundParams};
+use crate::model::striker::check_striking_speed;
 use crate::model::ProjectileShape;
 
 /// How a pretensioned reduced model starts.
