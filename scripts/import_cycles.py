@@ -1,12 +1,22 @@
 #!/usr/bin/env python3
-"""Import circles between the crate's modules (files).
+"""Import circles between the crate's modules, at two levels.
 
-Reads every `.rs` file under `src/` (binaries in `src/bin/` are leaves and skipped),
-takes each `use` path and each inline `crate::`/`super::`/`self::` path, resolves it to
-the module that *defines* the item (following `pub use` re-exports), and reports every
-strongly connected component of more than one module, with one cycle through it.
-A parent module that imports from its child and a child that imports from its parent
-form a circle too. Exit 1 when a circle exists.
+Reads every `.rs` file under `src/` (binaries in `src/bin/` are leaves and skipped; test
+modules, `#[cfg(test)] mod ... { }`, may import anything), takes each `use` path and each
+inline `crate::`/`super::`/`self::` path, resolves it to the module that *defines* the
+item (following `pub use` re-exports), and reports:
+
+- file level: every strongly connected component of more than one file module, with
+  one cycle through it. A parent module that imports from its child and a child that
+  imports from its parent form a circle too.
+- module level: for every module with children, each child taken with its whole
+  subtree (a folder module and all its files) as one node, an edge from child A to
+  child B when any file under A imports an item defined under B; every component of
+  more than one child is a circle (`model` <-> `solver` when a file of the model calls
+  into the solver and the solver reads the model), even when no two files import each
+  other. Each edge of the cycle shows one import that makes it.
+
+Exit 1 when a circle exists at either level.
 
     python3 scripts/import_cycles.py [src]
 """
@@ -186,45 +196,89 @@ for m, t in src.items():
         if r and r != m and r != ("crate",):
             edges[m].add(r); why.setdefault((m, r), x.group(1))
 
-# Tarjan
-index, low, on, stack, comps, idx = {}, {}, set(), [], [], [0]
-sys.setrecursionlimit(10000)
-def strong(v):
-    index[v] = low[v] = idx[0]; idx[0] += 1; stack.append(v); on.add(v)
-    for w in edges[v]:
-        if w not in index:
-            strong(w); low[v] = min(low[v], low[w])
-        elif w in on:
-            low[v] = min(low[v], index[w])
-    if low[v] == index[v]:
-        c = []
-        while True:
-            w = stack.pop(); on.discard(w); c.append(w)
-            if w == v: break
-        comps.append(c)
-for v in list(files):
-    if v not in index:
-        strong(v)
-
 name = lambda m: "::".join(m[1:]) or "crate"
-bad = [c for c in comps if len(c) > 1]
-for c in bad:
-    cs = set(c)
-    # one cycle: BFS from c[0] back to itself inside the component
-    start = sorted(c)[0]
+
+def components(nodes, out):
+    """Strongly connected components of the graph `out` (node -> set of nodes), Tarjan."""
+    index, low, on, stack, comps, idx = {}, {}, set(), [], [], [0]
+    def strong(v):
+        index[v] = low[v] = idx[0]; idx[0] += 1; stack.append(v); on.add(v)
+        for w in sorted(out[v]):
+            if w not in index:
+                strong(w); low[v] = min(low[v], low[w])
+            elif w in on:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            c = []
+            while True:
+                w = stack.pop(); on.discard(w); c.append(w)
+                if w == v: break
+            comps.append(c)
+    for v in nodes:
+        if v not in index:
+            strong(v)
+    return [c for c in comps if len(c) > 1]
+
+def one_cycle(c, out):
+    """A cycle through the component `c`: a breadth-first path from its first node back."""
+    cs = set(c); start = sorted(c)[0]
     prev = {start: None}; q = [start]; found = None
     while q and not found:
         v = q.pop(0)
-        for w in sorted(edges[v]):
+        for w in sorted(out[v]):
             if w not in cs: continue
             if w == start: found = v; break
             if w not in prev: prev[w] = v; q.append(w)
     cyc = [start]; v = found
     while v is not None and v != start:
         cyc.insert(1, v); v = prev[v]
-    cyc.append(start)
+    return cyc + [start]
+
+HINT = ("    hint: move what both sides need below both (a module of its own that neither "
+        "imports back), or let the lower one define it")
+
+# File level.
+bad = components(list(files), edges)
+for c in bad:
     print(f"circle of {len(c)} modules: " + ", ".join(sorted(name(x) for x in c)))
+    cyc = one_cycle(c, edges)
     for a, b in zip(cyc, cyc[1:]):
         print(f"    {name(a)} -> {name(b)}   ({why.get((a, b), '?')})")
-print(f"{len(files)} modules, {sum(len(e) for e in edges.values())} import edges, {len(bad)} circles")
-sys.exit(1 if bad else 0)
+    print(HINT)
+
+# Module level: the children of each module, each with its subtree.
+children = defaultdict(set)
+for m in files:
+    for k in range(1, len(m)):
+        children[m[:k]].add(m[:k + 1])
+bad_modules = 0
+for parent in sorted(children):
+    kids = sorted(children[parent])
+    if len(kids) < 2:
+        continue
+    def child_of(m):
+        for c in kids:
+            if m[:len(c)] == c:
+                return c
+        return None
+    out, via = defaultdict(set), {}
+    for a, targets in edges.items():
+        ca = child_of(a)
+        if ca is None: continue
+        for b in targets:
+            cb = child_of(b)
+            if cb is None or cb == ca: continue
+            out[ca].add(cb)
+            via.setdefault((ca, cb), (a, b))
+    for c in components(kids, out):
+        bad_modules += 1
+        print(f"module circle under `{name(parent)}`: " + ", ".join(sorted(name(x) for x in c)))
+        cyc = one_cycle(c, out)
+        for a, b in zip(cyc, cyc[1:]):
+            fa, fb = via[(a, b)]
+            print(f"    {name(a)} -> {name(b)}   ({files[fa]}: {why.get((fa, fb), name(fb))})")
+        print(HINT)
+
+print(f"{len(files)} modules, {sum(len(e) for e in edges.values())} import edges, "
+      f"{len(bad)} circles between files, {bad_modules} between modules")
+sys.exit(1 if bad or bad_modules else 0)

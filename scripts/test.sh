@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# The whole test suite on a fresh machine, every oracle required: installs what the tests
+# The whole test suite on a fresh machine, every oracle required: the structure checks
+# (scripts/checks.sh: function and file sizes, import circles), then installs what the tests
 # need (CalculiX for the exported decks, a single-node Slurm for the Slurm executor,
 # pandas, polars, pyarrow and VTK for the read-back tests: with pip, or in .venv-test/
 # where the system's Python is externally managed), starts Slurm, runs
@@ -12,6 +13,8 @@
 # reported as ignored (with a SKIPPED line naming it) instead of failing.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+# The structure checks first: seconds, before any install or build (scripts/checks.sh).
+scripts/checks.sh
 export CARGO_TERM_COLOR=never
 SUDO=$([ "$(id -u)" = 0 ] || echo sudo)
 # pandas, polars and pyarrow for tests/read_tables.py (the pandas/polars read test and
