@@ -20,6 +20,7 @@ pub mod striker;
 pub mod types;
 pub mod validate;
 mod validate_contacts;
+mod validate_parts;
 pub mod yarn;
 
 pub use kinds::ElementKind;
@@ -28,5 +29,6 @@ pub use types::{
     Analysis, Curve, ElementBlock, Load, Model, Part, ProjectileShape, ProjectileSpec,
     SymmetryPlane, Tie, TimeLaw,
 };
-pub use validate::{validate_part, ValidatedModel};
+pub use validate::ValidatedModel;
+pub use validate_parts::validate_part;
 pub use yarn::YarnWindow;

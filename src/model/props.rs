@@ -7,7 +7,7 @@
 //! satisfy for each, what a null means and why, the short aliases `weft-fit` accepts, and
 //! a one-line meaning. Everything that lists part properties is driven by the table:
 //! reading and writing `parts.parquet` ([`read_columns`], [`columns`]), the checks and
-//! their messages ([`Property::check`], used by [`super::validate::validate_part`]), the properties
+//! their messages ([`Property::check`], used by [`super::validate_part`]), the properties
 //! and aliases `weft-fit` accepts ([`fittable`], [`resolve_alias`]), and the
 //! `parts.parquet` section of `docs/tables.md` ([`parts_table_markdown`]; the test
 //! `tests/docs_drift.rs` fails when the two differ, and `WEFT_BLESS=1 cargo test --release

@@ -6,7 +6,7 @@ use crate::error::Result;
 use crate::model::kinds::ElementKind;
 use crate::model::props;
 use crate::model::types::{Model, Part};
-use crate::model::validate::validate_part;
+use crate::model::validate_part;
 use crate::table::{batch, Col};
 
 pub const FILE: &str = "parts.parquet";
