@@ -283,7 +283,7 @@ fn ballistic_line(s: &Solver) -> Option<String> {
         return None;
     }
     let eroded = s
-        .failures
+        .failure_log()
         .events
         .iter()
         .filter(|e| e.failure.eroded)
@@ -577,13 +577,13 @@ fn ballistic_columns(s: &Solver, m: &Model, status: &Status) -> Vec<Col> {
     };
     let layered = w.n_layers > 0;
     let first_failure = s
-        .failures
+        .failure_log()
         .events
         .iter()
         .find(|e| e.failure.eroded)
         .map(|e| e.time);
     let eroded = s
-        .failures
+        .failure_log()
         .events
         .iter()
         .filter(|e| e.failure.eroded)

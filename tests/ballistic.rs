@@ -54,9 +54,9 @@ fn a_perforating_projectile_loses_the_impulse_of_its_contact_force() {
     let (s, out, stats) = run_in_memory(&m).unwrap();
     let Outcome::Perforated {
         residual_velocity, ..
-    } = s.watch.outcome
+    } = s.watch().outcome
     else {
-        panic!("not perforated: {:?}", s.watch.outcome);
+        panic!("not perforated: {:?}", s.watch().outcome);
     };
     let mass = m.projectiles[0].mass;
     let pr = &out.projectile;

@@ -102,7 +102,7 @@ fn drop(z0: f64) -> (f64, f64, f64, f64, f64) {
         ..Analysis::default()
     };
     let (s, out, _) = run_in_memory(&m).unwrap();
-    assert!(s.op.surfaces.builds >= 1);
+    assert!(s.operator().surfaces.builds >= 1);
     let uz = out.series(0, 2);
     let g_max = uz
         .iter()
@@ -227,7 +227,7 @@ fn block_on_band(ratio: f64) -> (f64, f64, f64) {
     let slip = *ux.last().unwrap();
     let tau = t_end - t_pull;
     let a = (ratio - 1.0) * mu * n_force / mass;
-    (slip, 0.5 * a * tau * tau, s.op.surfaces.dissipated)
+    (slip, 0.5 * a * tau * tau, s.operator().surfaces.dissipated)
 }
 
 #[test]
@@ -331,7 +331,11 @@ fn crossing_strings_pass_the_force_through_contact() {
     };
     let (mut s, _, _) = run_in_memory(&m).unwrap();
     let nb: Vec<usize> = (0..m.num_nodes()).filter(|&n| m.node_id[n] > 100).collect();
-    let fc = [0.0, 0.0, nb.iter().map(|&n| s.op.fcon[n][2]).sum::<f64>()];
+    let fc = [
+        0.0,
+        0.0,
+        nb.iter().map(|&n| s.operator().fcon[n][2]).sum::<f64>(),
+    ];
     let fi = s.internal_forces();
     let reaction: f64 = ends_a.iter().map(|&n| fi[n][2]).sum();
     println!("contact force on B {:.9e} N, applied {f:e} N (rel {:.2e}); A's end reactions {:.9e} N (rel {:.2e})", fc[2], rel(fc[2], f), -reaction, rel(-reaction, f));
@@ -357,9 +361,9 @@ fn a_node_that_starts_inside_is_reported_not_launched() {
         ..Analysis::default()
     };
     let (s, out, _) = run_in_memory(&m).unwrap();
-    let pen = &s.op.surfaces.initial;
+    let pen = &s.operator().surfaces.initial;
     assert_eq!(pen.len(), 1);
-    assert_eq!(s.node_id[pen[0].node], 10_000);
+    assert_eq!(s.node_ids()[pen[0].node], 10_000);
     assert!(
         rel(pen[0].depth, depth) < 1e-9,
         "depth {} against {depth}",
@@ -392,7 +396,7 @@ fn two_crossing_layers_are_bit_identical_on_one_and_two_threads() {
             (
                 out.u,
                 out.energy,
-                s.op.surfaces.active(),
+                s.operator().surfaces.active(),
                 stats.max_balance_error_relative,
             )
         })
@@ -421,10 +425,10 @@ fn skipping_far_slaves_changes_no_bit() {
     let m = crossing_bands(&c);
     let run = |skip: bool| {
         let mut s = Solver::new(&m).unwrap();
-        s.op.surfaces.skip_far = skip;
+        s.operator_mut().surfaces.skip_far = skip;
         let mut sink = weft::solver::output::MemorySink::default();
         let stats = s.run(&mut sink, &mut |_| {}).unwrap();
-        let rep = s.op.surfaces.report(&m.node_id);
+        let rep = s.operator().surfaces.report(&m.node_id);
         (
             (sink.u, sink.v),
             sink.energy,
@@ -466,9 +470,9 @@ fn keep_mode_pushes_from_the_first_step_with_the_full_depth() {
     };
     // The contact forces at t = 0.
     let mut s = Solver::new(&m).unwrap();
-    let (st, mass_n) = (s.state.clone(), s.mass.clone());
-    s.op.contact_and_ties(&st, &mass_n, dt);
-    let f = s.op.fcon[b];
+    let (st, mass_n) = (s.state().clone(), s.masses().to_vec());
+    s.operator_mut().contact_and_ties(&st, &mass_n, dt);
+    let f = s.operator().fcon[b];
     let closed = 0.1 * mass / (dt * dt) * depth;
     println!(
         "keep: initial contact force {:.9e} N vs κ m g/Δt² = {closed:.9e} N",
@@ -479,7 +483,7 @@ fn keep_mode_pushes_from_the_first_step_with_the_full_depth() {
         rel(f[2], closed) < 1e-9 && f[0].abs() < 1e-9 * closed && f[1].abs() < 1e-9 * closed,
         "{f:?}"
     );
-    assert!(s.op.surfaces.initial.is_empty());
+    assert!(s.operator().surfaces.initial.is_empty());
 }
 
 /// A node pressed into a crease: two fixed quads meeting along the y axis at slopes ±s
@@ -545,24 +549,24 @@ fn a_node_in_a_crease_pushes_both_faces_alike() {
         ..Analysis::default()
     };
     let mut s = Solver::new(&m).unwrap();
-    let (st, mass_n) = (s.state.clone(), s.mass.clone());
-    s.op.contact_and_ties(&st, &mass_n, dt);
-    let f = s.op.fcon[bn];
+    let (st, mass_n) = (s.state().clone(), s.masses().to_vec());
+    s.operator_mut().contact_and_ties(&st, &mass_n, dt);
+    let f = s.operator().fcon[bn];
     let k = 0.1 * mass / (dt * dt);
     println!(
         "crease: ball {f:?} N (k g = {:.6e} N); x = −a nodes {:?} {:?}, x = +a nodes {:?} {:?}",
         k * depth,
-        s.op.fcon[left[0]],
-        s.op.fcon[left[1]],
-        s.op.fcon[right[0]],
-        s.op.fcon[right[1]]
+        s.operator().fcon[left[0]],
+        s.operator().fcon[left[1]],
+        s.operator().fcon[right[0]],
+        s.operator().fcon[right[1]]
     );
     assert!(
         rel(f[2], k * depth) < 1e-9 && f[0].abs() < 1e-9 * f[2],
         "{f:?}"
     );
     for (l, r) in left.iter().zip(&right) {
-        let (fl, fr) = (s.op.fcon[*l], s.op.fcon[*r]);
+        let (fl, fr) = (s.operator().fcon[*l], s.operator().fcon[*r]);
         // Each side pushed (a few % of the force: the feet lie a bit off the crease)
         // and pushed alike: the mirror image to round-off.
         assert!(fl[2] < -1e-3 * f[2], "{fl:?}");
@@ -576,7 +580,7 @@ fn a_node_in_a_crease_pushes_both_faces_alike() {
     let mut sum = [0.0; 3];
     for n in left.iter().chain(&mid).chain(&right) {
         for d in 0..3 {
-            sum[d] += s.op.fcon[*n][d];
+            sum[d] += s.operator().fcon[*n][d];
         }
     }
     for d in 0..3 {

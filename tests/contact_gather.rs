@@ -19,7 +19,7 @@ fn the_parallel_gather_is_bit_identical_on_two_and_three_threads() {
             .unwrap();
         pool.install(|| {
             let (s, out, _) = run_in_memory(&m).unwrap();
-            (out.u, out.energy, s.op.surfaces.active())
+            (out.u, out.energy, s.operator().surfaces.active())
         })
     };
     let (u1, e1, active) = run(1);

@@ -47,10 +47,10 @@ fn run(m: &Model, threads: usize, oracle: bool) -> (String, ContactReport) {
         .unwrap()
         .install(|| {
             let mut s = Solver::new(m).unwrap();
-            s.op.surfaces.oracle = oracle;
+            s.operator_mut().surfaces.oracle = oracle;
             let mut out = MemorySink::default();
             s.run(&mut out, &mut |_| {}).unwrap();
-            let rep = s.op.surfaces.report(&s.node_id);
+            let rep = s.operator().surfaces.report(&s.node_ids());
             let text = format!(
                 "{:?}\n{:?}\n{:?}\n{:?}",
                 out.u, out.energy, out.projectile, out.layers

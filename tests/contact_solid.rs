@@ -54,7 +54,7 @@ fn add_bar(m: &mut Model, id: i64, n: usize, h: f64, x0: f64) -> (usize, usize) 
 /// Σ m v over all nodes at the last output sample.
 fn momentum(s: &Solver) -> [f64; 3] {
     let mut p = [0.0; 3];
-    for (mi, v) in s.mass.iter().zip(&s.state.vn) {
+    for (mi, v) in s.masses().iter().zip(&s.state().vn) {
         for d in 0..3 {
             p[d] += mi * v[d];
         }
@@ -66,8 +66,8 @@ fn momentum(s: &Solver) -> [f64; 3] {
 fn mean_vx(s: &Solver, nodes: std::ops::Range<usize>) -> f64 {
     let (mut p, mut mt) = (0.0, 0.0);
     for i in nodes {
-        p += s.mass[i] * s.state.vn[i][0];
-        mt += s.mass[i];
+        p += s.masses()[i] * s.state().vn[i][0];
+        mt += s.masses()[i];
     }
     p / mt
 }
@@ -109,9 +109,9 @@ fn identical_elastic_bars_exchange_their_velocity_after_two_transit_times() {
     let err_t = (duration - t_c) / t_c;
     let (va, vb) = (mean_vx(&s, fa..fb), mean_vx(&s, fb..nn));
     let p = momentum(&s);
-    let p0 = s.mass[fa..fb].iter().sum::<f64>() * v;
+    let p0 = s.masses()[fa..fb].iter().sum::<f64>() * v;
     let ke = stats.final_energies.kinetic;
-    let ke0 = 0.5 * s.mass[fa..fb].iter().sum::<f64>() * v * v;
+    let ke0 = 0.5 * s.masses()[fa..fb].iter().sum::<f64>() * v * v;
     let bal = stats.max_balance_error_relative;
     eprintln!(
         "contact {duration:.4e} s against 2L/c0 = {t_c:.4e} s ({err_t:+.2e}); striker {va:+.3e} m/s, target {vb:.4} m/s (v = {v}); momentum {:+.2e}, KE {:.4} of the start; balance {bal:.2e}",
@@ -219,11 +219,14 @@ fn momentum_check(
     chain: std::ops::Range<usize>,
     v: f64,
 ) -> (f64, f64) {
-    let p0 = -v * s.mass[block].iter().sum::<f64>();
+    let p0 = -v * s.masses()[block].iter().sum::<f64>();
     let p = momentum(s);
-    let pc: f64 = chain.clone().map(|i| s.mass[i] * s.state.vn[i][2]).sum();
+    let pc: f64 = chain
+        .clone()
+        .map(|i| s.masses()[i] * s.state().vn[i][2])
+        .sum();
     let err = ((p[0].abs() + p[1].abs() + (p[2] - p0).abs()) / p0).abs();
-    let mc: f64 = chain.map(|i| s.mass[i]).sum();
+    let mc: f64 = chain.map(|i| s.masses()[i]).sum();
     // (The chain's mean velocity over −v.)
     (err, pc / mc / (-v))
 }
@@ -238,10 +241,10 @@ fn a_solid_face_stops_the_nodes_of_a_fine_chain_under_it() {
     let (err, share) = momentum_check(&s, block.clone(), chain.clone(), v);
     // The bottom face's plane at the end (its four nodes: z ≈ uniform); a chain node is
     // inside the solid when it is above it.
-    let bottom: f64 = (0..4).map(|i| s.state.x[i][2]).sum::<f64>() / 4.0;
+    let bottom: f64 = (0..4).map(|i| s.state().x[i][2]).sum::<f64>() / 4.0;
     let worst = chain
         .clone()
-        .map(|i| s.state.x[i][2] - bottom)
+        .map(|i| s.state().x[i][2] - bottom)
         .fold(f64::NEG_INFINITY, f64::max);
     eprintln!(
         "fine chain: momentum {err:.2e}, chain's mean velocity {share:.4} v; highest chain node {worst:.3e} m from the bottom face; balance {bal:.2e}"
@@ -269,11 +272,11 @@ fn the_nodes_of_a_fine_solid_stop_on_a_coarse_rod() {
     let (err, share) = momentum_check(&s, block.clone(), chain.clone(), v);
     // The rod's axis under each of the block's bottom nodes on it (y = 2 mm): the
     // clearance (node − axis) must stay positive.
-    let (a, b) = (s.state.x[chain.start], s.state.x[chain.start + 1]);
+    let (a, b) = (s.state().x[chain.start], s.state().x[chain.start + 1]);
     let worst = block
-        .filter(|&i| s.x0[i][2] == 0.0 && s.x0[i][1] == 2e-3)
+        .filter(|&i| s.reference_positions()[i][2] == 0.0 && s.reference_positions()[i][1] == 2e-3)
         .map(|i| {
-            let p = s.state.x[i];
+            let p = s.state().x[i];
             let t = (p[0] - a[0]) / (b[0] - a[0]);
             p[2] - (a[2] + t * (b[2] - a[2]))
         })
@@ -355,9 +358,9 @@ fn block_on_band() -> (Vec<[f64; 3]>, Vec<f64>, f64, usize) {
         .iter()
         .flat_map(|e| [e.kinetic, e.internal, e.contact])
         .collect();
-    let pen = s.op.surfaces.report(&s.node_id).penetrated;
+    let pen = s.operator().surfaces.report(&s.node_ids()).penetrated;
     (
-        s.state.x.clone(),
+        s.state().x.clone(),
         e,
         stats.max_balance_error_relative,
         pen as usize,

@@ -106,8 +106,8 @@ fn a_truss_chain_breaks_at_its_failure_strain() {
     m.analysis.end_time = end_time();
     m.analysis.output_interval = 5e-8;
     let (s, out, stats) = run_in_memory(&m).unwrap();
-    let ev = &s.failures.events;
-    let dt = s.stable.dt;
+    let ev = &s.failure_log().events;
+    let dt = s.time_step().dt;
     println!(
         "truss strip: {} failures, first {:?}; dt {dt:.3e} s, balance {:.2e}",
         ev.len(),
@@ -250,8 +250,8 @@ fn check_membrane_strip(triangles: bool) {
     m.analysis.end_time = end_time();
     m.analysis.output_interval = 5e-8;
     let (s, out, stats) = run_in_memory(&m).unwrap();
-    let ev = &s.failures.events;
-    let dt = s.stable.dt;
+    let ev = &s.failure_log().events;
+    let dt = s.time_step().dt;
     let per_cell = if triangles { 2 } else { 1 };
     println!(
         "{} strip: {} failures, first {:?}; dt {dt:.3e} s, balance {:.2e}",
@@ -357,8 +357,8 @@ fn check_link(by_force: bool) {
     // (The oscillator's stable step is 5.7 ms; a step of 1 µs resolves the failure.)
     m.analysis.time_step = Some(1e-6);
     let (s, out, stats) = run_in_memory(&m).unwrap();
-    let ev = &s.failures.events;
-    let dt = s.stable.dt;
+    let ev = &s.failure_log().events;
+    let dt = s.time_step().dt;
     assert_eq!(ev.len(), 1, "{ev:?}");
     let f = ev[0].failure;
     let v_at = (V * V - k * d_f * d_f / mass).sqrt();
@@ -478,7 +478,7 @@ const AROUND_BAND: [f64; 4] = [0.97, 0.98, 1.02, 1.03];
 
 /// Whether a struck yarn broke near its middle (within `reach` of the nose), and when.
 fn broke_near(s: &weft::solver::Solver, m: &Model, reach: f64) -> Option<f64> {
-    s.failures
+    s.failure_log()
         .events
         .iter()
         .find(|e| {

@@ -93,16 +93,16 @@ fn a_segment_that_fails_under_a_pressed_node_takes_the_contact_energy() {
     };
     let (s, out, _) = run_in_memory(&m).unwrap();
     // The segment fails at 3.6 % (after 36 steps at 10⁴ s⁻¹).
-    assert_eq!(s.failures.events.len(), 1);
+    assert_eq!(s.failure_log().events.len(), 1);
     // m* = min(m_ball, the foot's mass ½(m_A + m_B)) = m_ball.
     let k = 0.1 * m_ball / (dt * dt);
     let want = 0.5 * k * g0 * g0;
-    let got = s.op.surfaces.eroded;
+    let got = s.operator().surfaces.eroded;
     let bal = worst_balance(&out);
     println!(
         "contact energy taken {got:.9e} J, ½ k g₀² {want:.9e} J ({:.1e}); element's {:.4e} J; worst balance {bal:.1e}",
         rel(got, want),
-        s.failures.events[0].failure.energy
+        s.failure_log().events[0].failure.energy
     );
     // Measured 1.7·10⁻¹⁵.
     assert!(rel(got, want) < 1e-14, "{got} against {want}");
@@ -148,7 +148,7 @@ fn hit_from_behind(shape: ProjectileShape) {
     };
     let (s, out, _) = run_in_memory(&m).unwrap();
     let v_node = out.v.last().unwrap()[0];
-    let v_proj = s.op.projectiles.projectiles[0].v_full;
+    let v_proj = s.operator().projectiles.projectiles[0].v_full;
     let tot = m_node + mass_p;
     let (want_node, want_proj) = (-u * (m_node - mass_p) / tot, -u * 2.0 * m_node / tot);
     let bal = worst_balance(&out);
@@ -205,18 +205,18 @@ fn a_chain_patch_keeps_its_energy_long_after_its_yarns_break() {
     };
     let (m, _) = woven(&p).unwrap();
     let (s, out, stats) = run_in_memory(&m).unwrap();
-    let first = s.failures.events.first().map(|e| e.time).unwrap();
+    let first = s.failure_log().events.first().map(|e| e.time).unwrap();
     let bal = worst_balance(&out);
     println!(
         "{} failures from {:.1} µs, {:?}; worst balance {bal:.2e} ({:.2e} J), run's {:.2e}",
-        s.failures.events.len(),
+        s.failure_log().events.len(),
         first * 1e6,
-        s.watch.outcome,
+        s.watch().outcome,
         bal * out.energy.last().unwrap().scale,
         stats.max_balance_error_relative
     );
-    assert!(s.failures.events.len() >= 5);
-    assert!(matches!(s.watch.outcome, Outcome::Perforated { .. }));
+    assert!(s.failure_log().events.len() >= 5);
+    assert!(matches!(s.watch().outcome, Outcome::Perforated { .. }));
     assert!(first < 1.2e-4 && stats.end_time == 5e-4);
     // Measured 2.15·10⁻³ of the 0.9 J impact (1.94·10⁻³ J, at 130 µs). Before the
     // deepest-face law after a failure (`Side::deepest_only`) the error was 4.2·10⁻² when

@@ -153,7 +153,7 @@ fn a_formed_weave_left_alone_stays_where_it_is() {
     let (mut all, mut at_crossings) = (0.0f64, 0.0f64);
     for sample in &out.u {
         for (j, u) in sample.iter().enumerate() {
-            let n = s.output_nodes[j];
+            let n = s.output_nodes()[j];
             all = all.max(size(u));
             if crossing[n] {
                 at_crossings = at_crossings.max(size(u));
@@ -715,7 +715,7 @@ fn relaxation_finds_the_statics_of_a_pulled_string() {
             &mut |_| {},
         )
         .unwrap();
-    let c = s.state.x[n / 2];
+    let c = s.state().x[n / 2];
     let expect = c[0] * p / (2.0 * t0);
     let err = (-c[2] - expect).abs() / expect;
     println!(

@@ -48,7 +48,7 @@ fn girder_and_membrane_counts_masses_and_sets() {
             let a = 0.1 / n as f64;
             let (b, h) = (p.b(), p.h());
             let s = Solver::new(&m).unwrap();
-            let mass: f64 = s.mass.iter().sum();
+            let mass: f64 = s.masses().iter().sum();
             // ρ × volume, each b × b crossing counted once (per rod b·h·(a − b/2)), the
             // 4N boundary rods with half the height: the lattice's areal density
             // ρ·b·h·(2 − b/a)/a over L².
@@ -60,7 +60,7 @@ fn girder_and_membrane_counts_masses_and_sets() {
         let m = membrane(&mp).unwrap();
         assert_eq!(m.num_nodes(), (n + 1) * (n + 1));
         assert_eq!(m.num_elements(), n * n);
-        let mass: f64 = Solver::new(&m).unwrap().mass.iter().sum();
+        let mass: f64 = Solver::new(&m).unwrap().masses().iter().sum();
         assert!(rel(mass, mp.density * mp.thickness * 0.01) < 1e-12);
         for model in [&m, &girder(&gp(n, LoadCase::Shear, true)).unwrap().0] {
             let x = &model.coords;
@@ -266,7 +266,7 @@ fn combined_models_are_tied_without_hanging_nodes_and_weigh_what_they_should() {
             let m = combined(&p).unwrap();
             no_hanging_nodes(&m);
             sets_on_lines(&m);
-            let mass: f64 = weft::solver::Solver::new(&m).unwrap().physical_mass;
+            let mass: f64 = weft::solver::Solver::new(&m).unwrap().physical_mass();
             let (c, half) = (0.01, 0.03);
             let area_out = if quarter {
                 half * half - c * c
@@ -298,7 +298,8 @@ fn a_quarter_combined_model_matches_the_full_one() {
     let (sq_, oq, _) = run_in_memory(&q).unwrap();
     let (sf, of, _) = run_in_memory(&f).unwrap();
     let find = |s: &Solver, x: f64, y: f64| {
-        s.x0.iter()
+        s.reference_positions()
+            .iter()
             .position(|p| (p[0] - x).abs() < 1e-12 && (p[1] - y).abs() < 1e-12)
             .unwrap()
     };
@@ -332,9 +333,9 @@ fn the_reduced_woven_model() {
     let mem = mp.density * mp.thickness * (0.05f64.powi(2) - c * c);
     let s = Solver::new(&m).unwrap();
     assert!(
-        rel(s.physical_mass, yarn + mem) < 1e-9,
+        rel(s.physical_mass(), yarn + mem) < 1e-9,
         "{} vs {}",
-        s.physical_mass,
+        s.physical_mass(),
         yarn + mem
     );
     // It runs stably, in seconds, and the patch takes up the projectile.
@@ -477,7 +478,7 @@ fn an_unloaded_model_at_rest_runs_with_no_energy_error() {
     let (s, out, st) = run_in_memory(&m).unwrap();
     let ke = out.energy.iter().map(|e| e.kinetic).fold(0.0, f64::max);
     let scale = out.energy.last().unwrap().scale;
-    let mass: f64 = s.mass.iter().sum();
+    let mass: f64 = s.masses().iter().sum();
     eprintln!(
         "unloaded combined: kinetic ≤ {ke:.2e} J, scale {scale:.2e} J, balance {:.2e}",
         st.max_balance_error_relative
@@ -557,7 +558,7 @@ fn a_membrane_with_a_girder_zone_weighs_and_stretches_as_the_lattice() {
         assert_eq!(mine, theirs);
         // Mass: the lattice's areal density ρ_g·b²(2 − b/a)/a over all of L², the zone
         // as rods (its boundary rods half) and the rest as the equivalent membrane.
-        let mass = Solver::new(&m).unwrap().physical_mass;
+        let mass = Solver::new(&m).unwrap().physical_mass();
         let exact = 7800.0 * b * b * (2.0 - b / a) / a * 0.01;
         assert!(rel(mass, exact) < 1e-12, "{mass} vs {exact}");
         // Static tension (ν = 0): uniform strain ε = F/(E·s·L) = F/(E·b²·N_g) in the

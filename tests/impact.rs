@@ -91,7 +91,8 @@ fn quarter_model_with_symmetry_planes_matches_the_full_model() {
     let (sf, of, _) = run_in_memory(&full).unwrap();
     let (sq, oq, _) = run_in_memory(&quarter).unwrap();
     let find = |s: &weft::solver::Solver, x: f64, y: f64| {
-        s.x0.iter()
+        s.reference_positions()
+            .iter()
             .position(|p| (p[0] - x).abs() < 1e-9 && (p[1] - y).abs() < 1e-9)
             .unwrap()
     };

@@ -74,10 +74,10 @@ fn a_prestressed_strip_held_at_both_ends_is_in_equilibrium() {
     m.analysis.max_energy_error = 1e300;
     let (mut s, out, _) = run_in_memory(&m).unwrap();
     let umax = s
-        .state
+        .state()
         .x
         .iter()
-        .zip(&s.x0)
+        .zip(s.reference_positions())
         .map(|(x, x0)| (0..3).map(|d| (x[d] - x0[d]).abs()).fold(0.0, f64::max))
         .fold(0.0, f64::max);
     let f = s.internal_forces();
@@ -130,7 +130,7 @@ fn a_released_prestressed_strip_shortens_to_zero_stress() {
     m.analysis.end_time = 3e-4;
     let (s, _, _) = run_in_memory(&m).unwrap();
     let n = 10;
-    let u = s.state.x[n][0] - s.x0[n][0];
+    let u = s.state().x[n][0] - s.reference_positions()[n][0];
     let closed = L * ((1.0 - 2.0 * S0 / E).sqrt() - 1.0);
     println!(
         "released: end displacement {u:.6e} m vs L(√(1 − 2S₀/E) − 1) = {closed:.6e} m ({:.2e})",

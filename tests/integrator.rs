@@ -71,7 +71,7 @@ fn spring_mass_static_deflection_and_period() {
     m.analysis.output_interval = 1e-4;
     // Stable step of a mass on a spring to ground: 2√(m/k) (Belytschko eq. 6.2.11).
     let s = weft::solver::Solver::new(&m).unwrap();
-    assert!(rel(s.stable.dt_stable, 2.0 * (M / K).sqrt()) < 1e-12);
+    assert!(rel(s.time_step().dt_stable, 2.0 * (M / K).sqrt()) < 1e-12);
     // Accuracy needs ωΔt ≪ 1: ωΔt = 0.02.
     m.analysis.time_step = Some(1e-3);
     let (_s, out, _) = run_in_memory(&m).unwrap();
@@ -102,7 +102,7 @@ fn dashpot_decays_exponentially() {
     m.analysis.time_step = Some(tau / 400.0);
     let (s, out, _) = run_in_memory(&m).unwrap();
     // Pure dashpot: critical step 2m/c.
-    assert!(rel(s.stable.dt_stable, 2.0 * M / c) < 1e-12);
+    assert!(rel(s.time_step().dt_stable, 2.0 * M / c) < 1e-12);
     let worst = out
         .t
         .iter()
@@ -247,7 +247,7 @@ fn mass_scaling_reaches_target_step_and_reports_added_mass() {
     m.analysis.end_time = 0.2;
     m.analysis.output_interval = 1e-4;
     let (s, out, _) = run_in_memory(&m).unwrap();
-    let sc = s.scaling.clone().unwrap();
+    let sc = s.mass_scaling().clone().unwrap();
     let m_new = M * (4.0f64 / 0.9).powi(2);
     assert!(
         rel(sc.added_mass, m_new - M) < 1e-6,
@@ -256,7 +256,7 @@ fn mass_scaling_reaches_target_step_and_reports_added_mass() {
         m_new - M
     );
     assert_eq!(sc.nodes_scaled, 1);
-    assert!(rel(s.stable.dt, target) < 1e-12);
+    assert!(rel(s.time_step().dt, target) < 1e-12);
     // At ωΔt = 1.8 the discrete solution oscillates with ω_h = (2/Δt) asin(ωΔt/2)
     // (Hughes, The Finite Element Method, §9.3): the scaled system is the one simulated.
     let x = out.series(1, 0);

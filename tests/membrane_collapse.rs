@@ -83,7 +83,7 @@ fn a_quad_sheared_flat_leaves_and_the_energy_balances() {
         ..Analysis::default()
     };
     let (s, _, stats) = run_in_memory(&m).unwrap();
-    let ev = &s.failures.events;
+    let ev = &s.failure_log().events;
     assert_eq!(ev.len(), 1, "{ev:?}");
     let f = &ev[0].failure;
     assert_eq!(f.criterion, Criterion::TimeStep);
@@ -128,7 +128,7 @@ fn a_membrane_leaves_when_its_step_falls_below_half_the_runs() {
         ..Analysis::default()
     };
     let (s, _, _) = run_in_memory(&m).unwrap();
-    let ev = &s.failures.events;
+    let ev = &s.failure_log().events;
     assert_eq!(ev.len(), 1, "{ev:?}");
     let f = &ev[0].failure;
     assert_eq!((ev[0].id, ev[0].step), (1, 1));

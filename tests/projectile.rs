@@ -165,7 +165,7 @@ fn free_projectile_on_a_pinned_string_conserves_momentum_and_energy() {
         .nodes
         .iter()
         .enumerate()
-        .map(|(j, &i)| s.mass[i] * out.v[last][j][2])
+        .map(|(j, &i)| s.masses()[i] * out.v[last][j][2])
         .sum();
     let pz_proj = mass
         * out

@@ -101,9 +101,9 @@ fn a_failing_girder_is_perforated_as_newton_says() {
     let (s, out, stats) = run_in_memory(&m).unwrap();
     let Outcome::Perforated {
         residual_velocity, ..
-    } = s.watch.outcome
+    } = s.watch().outcome
     else {
-        panic!("not perforated at 400 m/s: {:?}", s.watch.outcome);
+        panic!("not perforated at 400 m/s: {:?}", s.watch().outcome);
     };
     let mass = m.projectiles[0].mass;
     let pr = &out.projectile;
@@ -113,7 +113,7 @@ fn a_failing_girder_is_perforated_as_newton_says() {
         .map(|w| 0.5 * (w[1].0 - w[0].0) * (w[0].2[8] + w[1].2[8]))
         .sum();
     let rods: Vec<_> = s
-        .failures
+        .failure_log()
         .events
         .iter()
         .map(|e| &e.failure)
@@ -140,8 +140,8 @@ fn a_slow_projectile_is_arrested_by_the_girder() {
     let m = woven_reduced(&girder(10.0)).unwrap();
     let (s, _, _) = run_in_memory(&m).unwrap();
     assert!(
-        matches!(s.watch.outcome, Outcome::Arrested { .. }),
+        matches!(s.watch().outcome, Outcome::Arrested { .. }),
         "{:?}",
-        s.watch.outcome
+        s.watch().outcome
     );
 }

@@ -120,13 +120,16 @@ fn chain_stable_step_is_element_length_over_wave_speed() {
     let s = weft::solver::Solver::new(&m).unwrap();
     let h = p.length / p.elements as f64;
     assert!(
-        rel(s.stable.dt_stable, h / p.wave_speed()) < 1e-9,
+        rel(s.time_step().dt_stable, h / p.wave_speed()) < 1e-9,
         "{} vs {}",
-        s.stable.dt_stable,
+        s.time_step().dt_stable,
         h / p.wave_speed()
     );
-    assert!(rel(s.stable.dt, 0.9 * h / p.wave_speed()) < 1e-9);
-    assert_eq!(s.stable.element.unwrap().0, weft::model::ElementKind::Truss);
+    assert!(rel(s.time_step().dt, 0.9 * h / p.wave_speed()) < 1e-9);
+    assert_eq!(
+        s.time_step().element.unwrap().0,
+        weft::model::ElementKind::Truss
+    );
 }
 
 #[test]
@@ -176,10 +179,10 @@ fn pretensioned_string_carries_transverse_waves_at_sqrt_t_over_mu() {
     let (s, out, _) = run_in_memory(&m).unwrap();
     // The initial axial force is E·A·ε₀.
     let n0 = weft::solver::truss::axial_force(
-        &s.x0[0],
-        &s.x0[1],
-        s.op.el.truss.k[0],
-        s.op.el.truss.l0[0],
+        &s.reference_positions()[0],
+        &s.reference_positions()[1],
+        s.operator().el.truss.k[0],
+        s.operator().el.truss.l0[0],
         false,
     );
     assert!(rel(n0, e * 1e-8 * eps0) < 1e-12, "{n0}");

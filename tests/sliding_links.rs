@@ -141,7 +141,7 @@ fn a_node_pressed_on_a_yarn_slides_along_it_at_mu_n_across_its_nodes() {
         let got = *x.last().unwrap();
         let zmax = z.iter().map(|v| (v - z[0]).abs()).fold(0.0, f64::max);
         let e = out.energy.last().unwrap();
-        let st = s.op.el.sliding_link.state[0];
+        let st = s.operator().el.sliding_link.state[0];
         let slide = (got - mu * n_load / K_T) / P;
         let dissipated = mu * n_load * (got - mu * n_load / K_T);
         eprintln!(
@@ -203,18 +203,18 @@ fn without_a_slider_the_link_is_a_spring_along_the_yarn() {
         "largest |x − (v₀/ω) sin ωt| {err:.3e} m of {:.3e}; balance {:.2e}; ends {:?}",
         v0 / w,
         e.balance_error_relative,
-        s.op.el.sliding_link.state[0].xi
+        s.operator().el.sliding_link.state[0].xi
     );
     // Measured: 4.2·10⁻³ of the amplitude (the central difference's phase error over 1.25
     // periods); energy balance 3.7·10⁻³ (its O((ωΔt)²) swing, ω the normal spring's).
     assert!(err < 5e-3 * v0 / w);
     assert!(e.balance_error_relative.abs() < 1e-2);
-    assert_eq!(s.op.el.sliding_link.state[0].xi, [4.0, 1.0]);
+    assert_eq!(s.operator().el.sliding_link.state[0].xi, [4.0, 1.0]);
 }
 
 /// W at window positions `x` (A's nine nodes, then B's; B padded with its last node).
 fn energy_at(s: &Solver, x: &[[f64; 3]; 2 * WIN], st: &SlidingState) -> f64 {
-    let g = &s.op.el.sliding_link;
+    let g = &s.operator().el.sliding_link;
     let xs = [
         std::array::from_fn(|k| x[k]),
         std::array::from_fn(|k| x[WIN + k]),
@@ -231,7 +231,7 @@ fn the_sliding_link_force_is_minus_its_energy_gradient_on_every_window_node() {
     // nodes (ξ_A = 5.3, on a segment, ξ_B = 0.6), every node displaced at random.
     let m = node_on_yarn(1e-6, 2e-3, 1e-4, PartProps::default());
     let s = Solver::new(&m).unwrap();
-    let g = &s.op.el.sliding_link;
+    let g = &s.operator().el.sliding_link;
     let st = SlidingState {
         xi: [5.3, 0.6],
         gap: g.geom[0].d0[2] + 1e-5,
@@ -329,14 +329,14 @@ fn a_frictionless_slide_keeps_its_speed_across_the_crests() {
         v0 * m.analysis.end_time,
         e.kinetic,
         e.friction,
-        s.op.el.sliding_link.state[0].xi[0]
+        s.operator().el.sliding_link.state[0].xi[0]
     );
     // Measured: x and the kinetic energy to rounding, friction −4.9·10⁻¹¹ J (3.9·10⁻⁸ of
     // it).
     assert!(rel(x, v0 * m.analysis.end_time) < 1e-9);
     assert!(rel(e.kinetic, k0) < 1e-9);
     assert!(e.friction.abs() < 1e-7 * k0);
-    assert!((s.op.el.sliding_link.state[0].xi[0] - 6.5).abs() < 0.01);
+    assert!((s.operator().el.sliding_link.state[0].xi[0] - 6.5).abs() < 0.01);
 }
 
 #[test]

@@ -449,7 +449,7 @@ fn a_solid_model_round_trips_through_its_tables_and_runs_from_them_as_in_memory(
         "the read model runs differently"
     );
     // It yielded: 1.2 kN on 1 mm² is 1.2 GPa against 250 MPa.
-    let ep = s.op.el.hex.state[0].plastic_strain;
+    let ep = s.operator().el.hex.state[0].plastic_strain;
     eprintln!("plastic strain of the loaded element: {ep:.3e}");
     assert!(ep > 0.0);
 }
@@ -471,17 +471,17 @@ fn a_copper_block_struck_on_a_corner_region_balances_energy_and_runs_the_same_on
         o1.u == o2.u && o1.energy == o2.energy,
         "1 and 2 threads differ"
     );
-    assert!(s1.op.el.hex.state == s2.op.el.hex.state);
+    assert!(s1.operator().el.hex.state == s2.operator().el.hex.state);
     let e = o1.energy.last().unwrap();
     let ep = s1
-        .op
+        .operator()
         .el
         .hex
         .state
         .iter()
         .fold(0.0f64, |a, p| a.max(p.plastic_strain));
     let t = s1
-        .op
+        .operator()
         .el
         .hex
         .state

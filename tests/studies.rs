@@ -206,7 +206,7 @@ fn woven_patch_pipeline_forms_and_hits_the_patch() {
     let model = weft::model::io::read_model(&out.join("formed")).unwrap();
     let bullet = &model.projectiles[0];
     let m_p = bullet.mass;
-    let mass = weft::solver::Solver::new(&model).unwrap().mass;
+    let mass = weft::solver::Solver::new(&model).unwrap().masses().to_vec();
     let index: std::collections::HashMap<i64, usize> = model
         .node_id
         .iter()

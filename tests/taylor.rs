@@ -40,7 +40,7 @@ struct Shape {
 }
 
 fn shape(m: &Model, s: &Solver, st: &RunStats) -> Shape {
-    let x = &s.state.x;
+    let x = &s.state().x;
     let axis = &m.node_sets["axis"];
     let (lo, hi) = axis.iter().fold((f64::MAX, f64::MIN), |(lo, hi), &i| {
         (lo.min(x[i][2]), hi.max(x[i][2]))
@@ -55,7 +55,7 @@ fn shape(m: &Model, s: &Solver, st: &RunStats) -> Shape {
         hourglass_share: e.hourglass / e.internal,
         balance: st.max_balance_error_relative,
         steps: st.steps,
-        dt_ratio: s.stable.dt_min / s.stable.dt,
+        dt_ratio: s.time_step().dt_min / s.time_step().dt,
     }
 }
 
@@ -208,6 +208,9 @@ fn a_taylor_rod_runs_the_same_on_one_and_two_threads() {
     let (s1, o1, st1) = go(1);
     let (s2, o2, st2) = go(2);
     assert!(o1.u == o2.u && o1.energy == o2.energy && st1.steps == st2.steps);
-    assert_eq!(s1.stable.dt_min.to_bits(), s2.stable.dt_min.to_bits());
-    assert!(s1.op.el.hex.state == s2.op.el.hex.state);
+    assert_eq!(
+        s1.time_step().dt_min.to_bits(),
+        s2.time_step().dt_min.to_bits()
+    );
+    assert!(s1.operator().el.hex.state == s2.operator().el.hex.state);
 }

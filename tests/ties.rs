@@ -163,7 +163,7 @@ fn momentum_is_conserved_to_round_off_across_ties() {
             out.nodes
                 .iter()
                 .enumerate()
-                .map(|(j, &i)| s.mass[i] * out.v[k][j][0])
+                .map(|(j, &i)| s.masses()[i] * out.v[k][j][0])
                 .sum()
         })
         .collect();
@@ -178,7 +178,7 @@ fn momentum_is_conserved_to_round_off_across_ties() {
         .nodes
         .iter()
         .enumerate()
-        .filter(|&(j, &i)| s.x0[i][0] > 0.12 && out.v[last][j][0].abs() > 1e-3)
+        .filter(|&(j, &i)| s.reference_positions()[i][0] > 0.12 && out.v[last][j][0].abs() > 1e-3)
         .count();
     assert!(coarse_moving > 0, "no motion reached the coarse zone");
 }
@@ -251,7 +251,7 @@ fn a_tied_impedance_step_reflects_and_transmits_what_the_impedances_say() {
     let (mut fine, mut coarse) = (0.0, 0.0);
     for (j, &i) in out.nodes.iter().enumerate() {
         let v = out.v[last][j];
-        let ke = 0.5 * s.mass[i] * (v[0] * v[0] + v[1] * v[1]);
+        let ke = 0.5 * s.masses()[i] * (v[0] * v[0] + v[1] * v[1]);
         if i < off {
             fine += ke;
         } else {
@@ -318,7 +318,7 @@ fn a_formed_tied_node_keeps_its_offset_and_stays_at_rest() {
     m.analysis.output_interval = 1e-4;
     m.validate().unwrap();
     let (sv, out, _) = run_in_memory(&m).unwrap();
-    let jb = sv.output_nodes.iter().position(|&n| n == b).unwrap();
+    let jb = sv.output_nodes().iter().position(|&n| n == b).unwrap();
     let moved = out
         .u
         .iter()

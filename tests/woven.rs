@@ -79,7 +79,7 @@ fn lenticular_section_and_areal_density_match_their_closed_forms() {
     // density 2ρA(1 + c)/p.
     let s = Solver::new(&m).unwrap();
     let side = (p.yarns as f64 - 0.5) * p.spacing;
-    let areal = s.physical_mass / (side * side);
+    let areal = s.physical_mass() / (side * side);
     let closed = 2.0 * p.density * area * (1.0 + crimp) / p.spacing;
     // The mesh follows the crimp by flat quads, `per_spacing` = 4 per spacing: chords
     // from x_i = ip/4 to x_{i+1}, so its exact mass is 2ρA(n − ½) Σ √((p/4)² + (z_{i+1} − z_i)²).
@@ -93,9 +93,9 @@ fn lenticular_section_and_areal_density_match_their_closed_forms() {
     // The nodal masses summed with Kahan's compensation: the plain sum of 85 562 of them
     // (`physical_mass`) carries up to n·ε of rounding (Higham, *Accuracy and Stability of
     // Numerical Algorithms*, §4.2; measured 5.7e-13), the compensated one a few ulps.
-    assert!(s.scaling.is_none());
+    assert!(s.mass_scaling().is_none());
     let (mut lumped, mut carry) = (0.0f64, 0.0f64);
-    for &mass in &s.mass {
+    for &mass in s.masses() {
         let y = mass - carry;
         let t = lumped + y;
         carry = (t - lumped) - y;
@@ -117,7 +117,7 @@ fn lenticular_section_and_areal_density_match_their_closed_forms() {
     // Measured 9.5e-16: the lumped masses are the chords' mass but for rounding (a bound
     // of 1e-13, about 450 ulps).
     assert!(rel(lumped, chord_mass) < 1e-13);
-    assert!(rel(s.physical_mass, lumped) < s.mass.len() as f64 * f64::EPSILON);
+    assert!(rel(s.physical_mass(), lumped) < s.masses().len() as f64 * f64::EPSILON);
     // What the generator reports (`weft-weave` prints it): its crimp by Simpson's rule
     // against the elliptic integral, measured 2.6e-14 (2 ulps of the path length 1 + c,
     // which c is the small difference of); bound 1e-12.
@@ -227,13 +227,14 @@ fn a_full_patch_crosses_at_its_crests() {
     // most in both; with the crests between the yarns, a whole centre thickness.
     let deepest = |m: &Model| {
         let s = Solver::new(m).unwrap();
-        let d =
-            s.op.surfaces
-                .initial
-                .iter()
-                .map(|p| p.depth)
-                .fold(0.0, f64::max);
-        (s.op.surfaces.initial.len(), d)
+        let d = s
+            .operator()
+            .surfaces
+            .initial
+            .iter()
+            .map(|p| p.depth)
+            .fold(0.0, f64::max);
+        (s.operator().surfaces.initial.len(), d)
     };
     let (count, depth) = deepest(&m);
     let (qcount, qdepth) = deepest(
@@ -544,8 +545,8 @@ fn a_patch_tied_into_a_membrane_weighs_and_conserves_what_it_should() {
     })
     .unwrap();
     let c = (base.yarns as f64 - 0.5) * base.spacing;
-    let mass_patch = Solver::new(&patch).unwrap().physical_mass;
-    let mass_all = Solver::new(&m).unwrap().physical_mass;
+    let mass_patch = Solver::new(&patch).unwrap().physical_mass();
+    let mass_all = Solver::new(&m).unwrap().physical_mass();
     let expected = 0.8 * info.areal_density * (length * length - c * c);
     let membrane = mass_all - mass_patch;
     eprintln!(

@@ -254,9 +254,9 @@ fn interface_yarns_carry_half_as_the_lattice_bookkeeping_asks() {
         let mem = mp.density * mp.thickness * (total_side * total_side - side * side);
         let s = Solver::new(&m).unwrap();
         assert!(
-            rel(s.physical_mass, expected + mem) < 1e-9,
+            rel(s.physical_mass(), expected + mem) < 1e-9,
             "{} vs {}",
-            s.physical_mass,
+            s.physical_mass(),
             expected + mem
         );
     }
@@ -296,7 +296,7 @@ fn band_ends_meet_the_membrane_where_the_yarn_level_patch_does() {
     let mp = p.membrane();
     let mem = mp.density * mp.thickness * (0.25 * p.length * p.length - c * c);
     let s = Solver::new(&m).unwrap();
-    assert!(rel(s.physical_mass, expected + mem) < 1e-9);
+    assert!(rel(s.physical_mass(), expected + mem) < 1e-9);
     // The yarn-level patch of the same crossings (`woven --yarns n + 1 --membrane-length
     // L/2`): its membrane has the same nodes, and its warp's centre-line crossing nodes on
     // the diagonal lie where the girder's do when the girder's crimp offset is the
@@ -904,11 +904,11 @@ fn coulomb_work_step_by_step(s: &mut Solver, steps: u64, sliding: bool) -> f64 {
     let unit = |a: V| -> V { a.map(|c| c / dot(a, a).sqrt()) };
     let mut work = 0.0;
     let mut sink = MemorySink::default();
-    while s.state.step < steps {
-        let x = s.state.x.clone();
-        let step = s.state.step;
+    while s.state().step < steps {
+        let x = s.state().x.clone();
+        let step = s.state().step;
         let (normal, mu, before): (Vec<f64>, Vec<f64>, Vec<[f64; 2]>) = if sliding {
-            let g = &s.op.el.sliding_link;
+            let g = &s.operator().el.sliding_link;
             (
                 (0..g.id.len())
                     .map(|e| g.normal_spring_force(e, &x).max(0.0))
@@ -917,7 +917,7 @@ fn coulomb_work_step_by_step(s: &mut Solver, steps: u64, sliding: bool) -> f64 {
                 g.state.iter().map(|st| st.xi).collect(),
             )
         } else {
-            let g = &s.op.el.framed_link;
+            let g = &s.operator().el.framed_link;
             (
                 (0..g.id.len())
                     .map(|e| g.normal_spring_force(e, &x).max(0.0))
@@ -926,13 +926,13 @@ fn coulomb_work_step_by_step(s: &mut Solver, steps: u64, sliding: bool) -> f64 {
                 g.state.iter().map(|st| st.slip).collect(),
             )
         };
-        s.analysis.end_time = s.state.t;
-        s.analysis.output_interval = s.state.t.max(f64::MIN_POSITIVE);
+        s.analysis_mut().end_time = s.state().t;
+        s.analysis_mut().output_interval = s.state().t.max(f64::MIN_POSITIVE);
         s.run(&mut sink, &mut |_| {}).unwrap();
-        assert_eq!(s.state.step, step + 1, "one step per call");
+        assert_eq!(s.state().step, step + 1, "one step per call");
         for e in 0..normal.len() {
             let slide = if sliding {
-                let g = &s.op.el.sliding_link;
+                let g = &s.operator().el.sliding_link;
                 let (nodes, win) = (&g.nodes[e], &g.geom[e].win);
                 let at = |side: usize, k: usize| x[nodes[side * WIN + k] as usize];
                 let chord = |side: usize, k: usize| -> V {
@@ -969,7 +969,7 @@ fn coulomb_work_step_by_step(s: &mut Solver, steps: u64, sliding: bool) -> f64 {
                 let (d0, d1) = (d_t(before[e]), d_t(after));
                 (d1[0] - d0[0]).hypot(d1[1] - d0[1])
             } else {
-                let after = s.op.el.framed_link.state[e].slip;
+                let after = s.operator().el.framed_link.state[e].slip;
                 (after[0] - before[e][0]).hypot(after[1] - before[e][1])
             };
             work += mu[e] * normal[e] * slide;
@@ -1006,7 +1006,7 @@ fn the_reduced_model_with_local_coulomb_unilateral_links_runs_and_balances_energ
         // The same run stepped one step at a time (the same bits), summing μN·|Δd_t|.
         let mut stepped = Solver::new(&m).unwrap();
         let coulomb = coulomb_work_step_by_step(&mut stepped, st.steps, sliding);
-        assert!(stepped.state.x == s.state.x, "stepping changed the run");
+        assert!(stepped.state().x == s.state().x, "stepping changed the run");
         eprintln!(
             "local/Coulomb/unilateral, sliding {sliding}: {} steps, projectile {v:.1} m/s, friction {:.6e} J vs Σ μN|Δd_t| {coulomb:.6e} J ({:.2e}), worst energy error {worst:.3e} J of {ke0} J",
             st.steps,

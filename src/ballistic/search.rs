@@ -62,14 +62,14 @@ pub fn impact(m: &Model, v: f64, label: &str) -> Result<(Run, u64, f64)> {
         .run(&mut Discard, &mut |_| {})
         .map_err(|e| e.context(format!("the impact at {v} m/s stopped")))?;
     let wall_time = clock.elapsed().as_secs_f64();
-    let (perforated, residual, outcome) = match s.watch.outcome {
+    let (perforated, residual, outcome) = match s.watch().outcome {
         Outcome::Perforated {
             residual_velocity, ..
         } => (true, residual_velocity, "perforated"),
         Outcome::Arrested { .. } => (false, 0.0, "arrested"),
         Outcome::Undecided => (false, 0.0, "undecided"),
     };
-    let absorbed: f64 = s.watch.last_rows.iter().map(|r| r[4]).sum();
+    let absorbed: f64 = s.watch().last_rows.iter().map(|r| r[4]).sum();
     Ok((
         Run {
             source: label.to_string(),
@@ -78,7 +78,7 @@ pub fn impact(m: &Model, v: f64, label: &str) -> Result<(Run, u64, f64)> {
             residual_velocity: residual,
             perforated,
             outcome: outcome.into(),
-            energy_absorbed: if s.watch.n_layers > 0 {
+            energy_absorbed: if s.watch().n_layers > 0 {
                 absorbed
             } else {
                 f64::NAN

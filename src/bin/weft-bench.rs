@@ -241,7 +241,7 @@ fn bench_contact(nodes: &[usize], threads: &[usize], node_steps: f64) -> anyhow:
         // the same contact state; small models are run several times.
         let mut m = crossing_bands(&CrossingBands::with_nodes(n));
         let nn = m.num_nodes();
-        let dt = Solver::new(&m)?.stable.dt;
+        let dt = Solver::new(&m)?.time_step().dt;
         let steps = 300u64;
         let reps = ((node_steps / (nn as f64 * steps as f64)).ceil() as usize).max(1);
         m.analysis.end_time = dt * steps as f64;
@@ -262,8 +262,8 @@ fn bench_contact(nodes: &[usize], threads: &[usize], node_steps: f64) -> anyhow:
             }
             let (s, stats) = last.expect("one run");
             let per = 1e9 * c / (nn as f64 * (stats.steps as usize * reps) as f64);
-            let rep = s.op.surfaces.report(&s.node_id);
-            let same = base.as_ref().map(|b| b.1 == s.state.x);
+            let rep = s.operator().surfaces.report(&s.node_ids());
+            let same = base.as_ref().map(|b| b.1 == s.state().x);
             let speedup = base
                 .as_ref()
                 .map(|b| format!(" (contact speed-up {:.2})", b.0 / c))
@@ -288,7 +288,7 @@ fn bench_contact(nodes: &[usize], threads: &[usize], node_steps: f64) -> anyhow:
                 }
             );
             if base.is_none() {
-                base = Some((c, s.state.x.clone()));
+                base = Some((c, s.state().x.clone()));
             }
         }
     }
@@ -326,11 +326,11 @@ fn bench_woven(
         let mut sink = MemorySink::default();
         let r = pool.install(|| s.run(&mut sink, &mut |_| {}));
         let wall = t0.elapsed().as_secs_f64();
-        let rep = s.op.surfaces.report(&s.node_id);
+        let rep = s.operator().surfaces.report(&s.node_ids());
         let (steps, bal, done) = match &r {
             Ok(st) => (st.steps, st.max_balance_error_relative, "yes".to_string()),
             Err(e) => (
-                s.state.step,
+                s.state().step,
                 f64::NAN,
                 format!("no: {}", e.to_string().replace(',', ";")),
             ),
@@ -341,7 +341,7 @@ fn bench_woven(
             "{model},{yarns},{t},{},{},{steps},{:.4e},{wall:.2},{cycles:.3e},{c:.2},{:.3},{},{bal:.3e},{done}",
             m.num_elements(),
             m.num_nodes(),
-            s.stable.dt,
+            s.time_step().dt,
             c / wall,
             rep.builds
         );
@@ -349,7 +349,7 @@ fn bench_woven(
             "  woven {yarns}×{yarns} quarter ({model}s, {layers} layer(s)), {t} thread(s): {} elements, {} nodes, {steps} steps of {:.3e} s in {wall:.1} s: {cycles:.3e} element-cycles/s; contact {c:.1} s ({:.0} %: broad phase {:.1} s in {} builds, narrow {:.1} s); finished: {done}",
             m.num_elements(),
             m.num_nodes(),
-            s.stable.dt,
+            s.time_step().dt,
             100.0 * c / wall,
             rep.build_seconds,
             rep.builds,
@@ -433,7 +433,7 @@ fn bench_solid(sizes: &[usize], threads: &[usize], updates: f64) -> anyhow::Resu
     for &n in sizes {
         let mut m = hex_block(n);
         let ne = m.num_elements();
-        let dt = Solver::new(&m)?.stable.dt;
+        let dt = Solver::new(&m)?.time_step().dt;
         let steps = ((updates / ne as f64).ceil() as u64).max(20);
         m.analysis.end_time = dt * steps as f64;
         m.analysis.output_interval = m.analysis.end_time;
@@ -482,7 +482,7 @@ fn main() -> anyhow::Result<()> {
     for kind in [ElementKind::Truss, ElementKind::Link] {
         for &n in &cli.sizes {
             let mut m = chain(kind, n);
-            let dt = Solver::new(&m)?.stable.dt;
+            let dt = Solver::new(&m)?.time_step().dt;
             let steps = ((cli.updates / n as f64).ceil() as u64).max(20);
             m.analysis.end_time = dt * steps as f64;
             m.analysis.output_interval = m.analysis.end_time;

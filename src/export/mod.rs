@@ -84,7 +84,7 @@ pub fn time_step(m: &Model, asked: Option<f64>) -> Result<(f64, u64)> {
         Some(v) => {
             return Err(WeftError::input(format!("--time-step {v}")).expected("a step > 0 in s"))
         }
-        None => crate::solver::Solver::new(m)?.stable.dt,
+        None => crate::solver::Solver::new(m)?.time_step().dt,
     };
     let out = m.analysis.output_interval;
     let n = (out / dt * (1.0 - 1e-12)).ceil().max(1.0);

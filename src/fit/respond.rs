@@ -96,7 +96,7 @@ pub(super) fn solve(
         let mut sink = MemorySink::default();
         solver.run(&mut sink, &mut |_| {})?;
         if striker {
-            history = projectile::from_run(&m, &sink, &solver.mass);
+            history = projectile::from_run(&m, &sink, &solver.masses());
         }
         let pos: std::collections::HashMap<usize, usize> = sink
             .nodes

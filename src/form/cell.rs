@@ -365,8 +365,8 @@ struct Balance {
 /// largest z force on the nodes held on the two-fold axes [N].
 fn balance(cell: &Cell, solver: &mut Solver) -> Balance {
     let fi = solver.internal_forces();
-    let fc = &solver.op.fcon;
-    let has_fc = solver.op.has_fcon();
+    let fc = &solver.operator().fcon;
+    let has_fc = solver.operator().has_fcon();
     let f = |n: usize, d: usize| fi[n][d] + if has_fc { fc[n][d] } else { 0.0 };
     let per = cell.layers as f64;
     let moved = [0, 1].map(|d| -cell.planes[d].iter().map(|&n| f(n, d)).sum::<f64>() / per);
@@ -540,7 +540,7 @@ pub fn form(
         let mut solver = Solver::new(&model)?;
         let opts = RelaxOptions {
             work_offset: work,
-            ..p.relax_options(solver.stable.dt, tension[0].max(tension[1]), t_max)
+            ..p.relax_options(solver.time_step().dt, tension[0].max(tension[1]), t_max)
         };
         let st = solver.relax(&opts, progress)?;
         steps += st.steps;
@@ -555,7 +555,7 @@ pub fn form(
         let balance = balance(cell, &mut solver);
         forces = balance.moved;
         u = solver
-            .state
+            .state()
             .x
             .iter()
             .zip(&model.coords)

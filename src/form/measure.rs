@@ -15,7 +15,7 @@ use super::weave::{centre_line, family, quads, trusses, CentreLines};
 /// an error when it exceeds `limit` (a yarn went through another: naming the node and
 /// the element).
 pub fn check_penetration(m: &Model, solver: &Solver, limit: f64) -> Result<f64> {
-    let max_pen = solver.op.surfaces.deepest();
+    let max_pen = solver.operator().surfaces.deepest();
     if let Some(d) = max_pen {
         let (r, g, cid, node, el) = (d.ratio, d.depth, d.contact_id, d.node, d.element);
         if r > limit {
@@ -47,8 +47,8 @@ pub fn check_penetration(m: &Model, solver: &Solver, limit: f64) -> Result<f64> 
 pub fn band_tension(m: &Model, solver: &Solver, section: [f64; 2]) -> [f64; 2] {
     let quads = quads(m);
     let trusses = trusses(m);
-    let x = &solver.state.x;
-    let qs = &solver.op.el.quad;
+    let x = &solver.state().x;
+    let qs = &solver.operator().el.quad;
     let mut tens = [f64::NAN; 2];
     for (f, t) in tens.iter_mut().enumerate() {
         let (mut sv, mut v) = (0.0, 0.0);
@@ -62,7 +62,7 @@ pub fn band_tension(m: &Model, solver: &Solver, section: [f64; 2]) -> [f64; 2] {
             v += vol;
         }
         // Chains: the length-weighted mean of the trusses' stress N/A.
-        let tg = &solver.op.el.truss;
+        let tg = &solver.operator().el.truss;
         for e in 0..tg.id.len() {
             if family(m, trusses.part[e]) != Some(f) {
                 continue;
@@ -220,7 +220,7 @@ pub fn measure(
     Ok(Measured {
         band_tension: band_tension(m, solver, ends.section),
         end_tension: end_tension(ends, &fi),
-        crimps: Crimps::measure(m, &solver.state.x, lines),
+        crimps: Crimps::measure(m, &solver.state().x, lines),
         max_penetration_ratio,
     })
 }

@@ -87,7 +87,7 @@ fn tied_model(m: &Model, contacts_of: &Model, solver: &Solver, pre: &PreStress) 
     m2.initial_velocities.clear();
     m2.contacts = contacts_of.contacts.clone();
     m2.initial_displacement = solver
-        .state
+        .state()
         .x
         .iter()
         .zip(&m.coords)
@@ -133,7 +133,7 @@ pub fn settle(
         let before = r.stats;
         r.solver = Solver::new(&m2)?;
         r.options.work_offset = before.removed + before.kinetic + credited;
-        r.options.creep_window = p.creep_window(r.solver.stable.dt);
+        r.options.creep_window = p.creep_window(r.solver.time_step().dt);
         let mut st = r.solver.relax(&r.options, progress)?;
         st.steps += before.steps;
         st.removed += before.removed;

@@ -128,7 +128,7 @@ pub fn form_from(
     }
     let eq = equilibrium(m, p, &r.stats, credited, thickness)?;
     let measured = measure(m, &mut r.solver, &ends, &lines, p.penetration_limit)?;
-    let formed = formed_model(m, &r.solver.state.x, pre_stress.as_ref())?;
+    let formed = formed_model(m, &r.solver.state().x, pre_stress.as_ref())?;
     let report = Report::new(
         &r.stats,
         &eq,

@@ -47,7 +47,7 @@ pub fn relax(
         // A patch tiled from its formed cell is in equilibrium as it is (to the
         // contacts' discretisation): test it at rest first.
         probe_first: setup.probe_first,
-        ..p.relax_options(solver.stable.dt, setup.force_scale, setup.thickness)
+        ..p.relax_options(solver.time_step().dt, setup.force_scale, setup.thickness)
     };
     let stats = solver.relax(&options, progress)?;
     Ok(Relaxation {

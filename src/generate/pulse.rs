@@ -18,7 +18,7 @@ pub(crate) fn resolve_pulse(m: &mut Model) -> Result<()> {
         _ => None,
     });
     if let Some(t_f) = t_f {
-        let stable = crate::solver::Solver::new(m)?.stable;
+        let stable = crate::solver::Solver::new(m)?.time_step().clone();
         let dt = t_f / STEPS_PER_PULSE;
         if dt < stable.dt {
             m.analysis.time_step = Some(dt);

@@ -119,35 +119,35 @@ impl RunStats {
 /// read it through its methods (the state, the operator's families and contacts, the
 /// step and what controls it, the failures and the layers' watch), never its fields.
 pub struct Solver {
-    pub node_id: Vec<i64>,
+    node_id: Vec<i64>,
     /// Reference positions X [m].
-    pub x0: Vec<[f64; 3]>,
+    x0: Vec<[f64; 3]>,
     /// Positions, velocities, rotations, time.
-    pub state: State,
+    state: State,
     /// Forces at a state.
-    pub op: Operator,
+    op: Operator,
     /// Lumped nodal masses (with mass scaling) [kg].
-    pub mass: Vec<f64>,
+    mass: Vec<f64>,
     /// Physical model mass (without scaling) [kg].
-    pub physical_mass: f64,
+    physical_mass: f64,
     inv_m: Vec<f64>,
     /// Bit d set when direction d is fixed.
     fixed: Vec<u8>,
     partials: Vec<NodePartial>,
     alpha: f64,
     /// Output nodes (indices).
-    pub output_nodes: Vec<usize>,
-    pub stable: StableStep,
-    pub scaling: Option<MassScaling>,
-    pub analysis: crate::model::Analysis,
+    output_nodes: Vec<usize>,
+    stable: StableStep,
+    scaling: Option<MassScaling>,
+    analysis: crate::model::Analysis,
     ledger: Ledger,
     /// Element failures and what they leave (empty when nothing can fail).
-    pub failures: FailureLog,
+    failures: FailureLog,
     /// Layers and the projectile's outcome (see [`watch`]).
-    pub watch: watch::Watch,
+    watch: watch::Watch,
     /// The last output time sent to the sink (NaN before the first): where the tables of
     /// a run that stopped end.
-    pub sampled_to: f64,
+    sampled_to: f64,
 }
 
 /// What other stages read of a solver.
@@ -204,6 +204,11 @@ impl Solver {
     /// The analysis settings the solver runs with.
     pub fn analysis(&self) -> &crate::model::Analysis {
         &self.analysis
+    }
+    /// The analysis settings, to run on from where a run ended (a later end time,
+    /// another output interval; the step stays as it was set).
+    pub fn analysis_mut(&mut self) -> &mut crate::model::Analysis {
+        &mut self.analysis
     }
     /// Element failures so far and what they leave.
     pub fn failure_log(&self) -> &FailureLog {

@@ -17,7 +17,7 @@ pub fn run_on(m: &Model, threads: usize) -> (MemorySink, ContactReport, RunStats
         .unwrap()
         .install(|| {
             let (s, out, stats) = run_in_memory(m).unwrap();
-            let rep = s.op.surfaces.report(&s.node_id);
+            let rep = s.operator().surfaces.report(&s.node_ids());
             (out, rep, stats)
         })
 }

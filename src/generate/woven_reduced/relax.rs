@@ -62,7 +62,7 @@ pub(super) fn relax_start(m: &mut Model, p: &WovenParams) -> Result<()> {
     }
     check_unilateral_links(m, &solver, tension)?;
     m.initial_displacement = solver
-        .state
+        .state()
         .x
         .iter()
         .zip(&m.coords)
@@ -77,20 +77,20 @@ fn check_unilateral_links(m: &Model, solver: &crate::solver::Solver, tension: f6
         return Ok(());
     };
     // The solver's three link families keep the table's order within each.
-    let el = &solver.op.el;
+    let el = &solver.operator().el;
     let (plain, framed, sliding) = (&el.link, &el.framed_link, &el.sliding_link);
     let (mut ip, mut ifr, mut isl) = (0, 0, 0);
     for e in 0..b.len() {
         let props = &m.parts[b.part[e]].props;
         let f = if props.sliding == Some(true) {
             isl += 1;
-            sliding.normal_spring_force(isl - 1, &solver.state.x)
+            sliding.normal_spring_force(isl - 1, &solver.state().x)
         } else if props.local_frame == Some(true) {
             ifr += 1;
-            framed.normal_spring_force(ifr - 1, &solver.state.x)
+            framed.normal_spring_force(ifr - 1, &solver.state().x)
         } else {
             ip += 1;
-            plain.normal_spring_force(ip - 1, &solver.state.x)
+            plain.normal_spring_force(ip - 1, &solver.state().x)
         };
         if props.unilateral != Some(true) {
             continue;
