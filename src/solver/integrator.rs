@@ -12,7 +12,7 @@
 
 use super::beam;
 use super::family::{for_chunks_of, Each, Per, CHUNK};
-use super::operator::{Operator, State};
+use super::operator::{Gather, Operator, State};
 use super::vec3::{add, dot};
 use crate::error::{Result, WeftError};
 
@@ -56,16 +56,18 @@ pub fn advance_nodes<const SNAP: bool>(
     partials: &mut [NodePartial],
 ) -> std::result::Result<(f64, f64), usize> {
     let (alpha, dt_prev) = (nd.alpha, st.dt_prev);
-    let step = NodeStep {
-        op,
-        nd,
-        fcon: op.has_fcon().then_some(&op.fcon),
-        c1: 1.0 / (1.0 + 0.5 * alpha * dt_prev),
-        c2: 1.0 - 0.5 * alpha * dt_next,
-        h_prev: 0.5 * dt_prev,
-        h_next: 0.5 * dt_next,
-        dt_next,
+    let c1 = 1.0 / (1.0 + 0.5 * alpha * dt_prev);
+    let c2 = 1.0 - 0.5 * alpha * dt_next;
+    let (h_prev, h_next) = (0.5 * dt_prev, 0.5 * dt_next);
+    let accel = Acceleration {
+        fe: &op.fe,
+        gather: &op.gather,
+        fext: &op.fext,
+        fcon: op.has_fcon().then_some(&op.fcon[..]),
+        inv_m: nd.inv_m,
+        fixed: nd.fixed,
     };
+    let mass = nd.mass;
     let n = st.x.len();
     let slices = (
         (
@@ -78,18 +80,42 @@ pub fn advance_nodes<const SNAP: bool>(
         let i0 = ci * CHUNK;
         let (mut ke, mut dp, mut bad) = (0.0, 0.0, usize::MAX);
         for j in 0..x.len() {
-            let finite = step.advance::<SNAP>(
-                i0 + j,
-                &mut x[j],
-                &mut v[j],
-                &mut xn[j],
-                &mut vn[j],
-                &mut ke,
-                &mut dp,
-            );
-            if !finite && bad == usize::MAX {
-                bad = i0 + j;
+            let i = i0 + j;
+            let a = accel.of(i);
+            let vo = v[j];
+            let vh = [
+                (vo[0] + h_prev * a[0]) * c1,
+                (vo[1] + h_prev * a[1]) * c1,
+                (vo[2] + h_prev * a[2]) * c1,
+            ];
+            let vnew = [
+                vh[0] * c2 + h_next * a[0],
+                vh[1] * c2 + h_next * a[1],
+                vh[2] * c2 + h_next * a[2],
+            ];
+            let v2 = dot(&vh, &vh);
+            if SNAP {
+                xn[j] = x[j];
+                vn[j] = vh;
+                // The kinetic energy the central difference conserves with the strain
+                // energy at x^n: ½ m v^{n−½}·v^{n+½} (exactly, for a linear system; see
+                // `advance_nodes`' doc).
+                ke += 0.5 * mass[i] * dot(&vo, &vnew);
             }
+            dp += mass[i] * v2;
+            let xo = x[j];
+            let xnew = [
+                xo[0] + dt_next * vnew[0],
+                xo[1] + dt_next * vnew[1],
+                xo[2] + dt_next * vnew[2],
+            ];
+            if !(vnew[0] + vnew[1] + vnew[2] + xnew[0] + xnew[1] + xnew[2]).is_finite()
+                && bad == usize::MAX
+            {
+                bad = i;
+            }
+            v[j] = vnew;
+            x[j] = xnew;
         }
         *part = NodePartial {
             ke,
@@ -108,47 +134,33 @@ pub fn advance_nodes<const SNAP: bool>(
     Ok((ke, dp))
 }
 
-/// What the update of one node reads: its forces (elements' slots through the gather,
-/// loads, contact), its mass and fixed directions, and the step's damping factors
-/// c₁ = 1/(1 + ½αΔt^{n−½}), c₂ = 1 − ½αΔt^{n+½} and half steps.
-struct NodeStep<'a> {
-    op: &'a Operator,
-    nd: &'a Nodal<'a>,
-    fcon: Option<&'a Vec<[f64; 3]>>,
-    c1: f64,
-    c2: f64,
-    h_prev: f64,
-    h_next: f64,
-    dt_next: f64,
+/// What a node's acceleration a^n = M⁻¹ f^n reads: its elements' force slots (through
+/// the gather, in a fixed order), its load and contact force, its inverse mass and its
+/// fixed directions.
+struct Acceleration<'a> {
+    fe: &'a [[f64; 3]],
+    gather: &'a Gather,
+    fext: &'a [[f64; 3]],
+    fcon: Option<&'a [[f64; 3]]>,
+    inv_m: &'a [f64],
+    fixed: &'a [u8],
 }
 
-impl NodeStep<'_> {
-    /// Node i's step ([`advance_nodes`]): a^n from its gathered force, v^n (kept in `vn`
-    /// with x^n in `xn` when `SNAP`), v^{n+½}, x^{n+1}; adds its kinetic energy at t_n
-    /// (when `SNAP`) to `ke` and m|v^n|² to `dp`. Whether the new state is finite.
+impl Acceleration<'_> {
+    /// Node i's acceleration: the load, the contact force and the elements' forces
+    /// summed in that order, times 1/m, 0 along the fixed directions.
     #[inline(always)]
-    #[allow(clippy::too_many_arguments)]
-    fn advance<const SNAP: bool>(
-        &self,
-        i: usize,
-        x: &mut [f64; 3],
-        v: &mut [f64; 3],
-        xn: &mut [f64; 3],
-        vn: &mut [f64; 3],
-        ke: &mut f64,
-        dp: &mut f64,
-    ) -> bool {
-        let (op, nd) = (self.op, self.nd);
-        let mut f = op.fext[i];
+    fn of(&self, i: usize) -> [f64; 3] {
+        let mut f = self.fext[i];
         if let Some(fc) = self.fcon {
             add(&mut f, &fc[i]);
         }
-        for &s in op.gather.of(i) {
-            add(&mut f, &op.fe[s as usize]);
+        for &s in self.gather.of(i) {
+            add(&mut f, &self.fe[s as usize]);
         }
-        let im = nd.inv_m[i];
+        let im = self.inv_m[i];
         let mut a = [f[0] * im, f[1] * im, f[2] * im];
-        let fx = nd.fixed[i];
+        let fx = self.fixed[i];
         if fx != 0 {
             for (d, ad) in a.iter_mut().enumerate() {
                 if fx & (1 << d) != 0 {
@@ -156,38 +168,7 @@ impl NodeStep<'_> {
                 }
             }
         }
-        let (c1, c2, h_prev, h_next) = (self.c1, self.c2, self.h_prev, self.h_next);
-        let vo = *v;
-        let vh = [
-            (vo[0] + h_prev * a[0]) * c1,
-            (vo[1] + h_prev * a[1]) * c1,
-            (vo[2] + h_prev * a[2]) * c1,
-        ];
-        let vnew = [
-            vh[0] * c2 + h_next * a[0],
-            vh[1] * c2 + h_next * a[1],
-            vh[2] * c2 + h_next * a[2],
-        ];
-        let v2 = dot(&vh, &vh);
-        if SNAP {
-            *xn = *x;
-            *vn = vh;
-            // The kinetic energy the central difference conserves with the strain
-            // energy at x^n: ½ m v^{n−½}·v^{n+½} (exactly, for a linear system; see
-            // `advance_nodes`' doc).
-            *ke += 0.5 * nd.mass[i] * dot(&vo, &vnew);
-        }
-        *dp += nd.mass[i] * v2;
-        let xo = *x;
-        let dt_next = self.dt_next;
-        let xnew = [
-            xo[0] + dt_next * vnew[0],
-            xo[1] + dt_next * vnew[1],
-            xo[2] + dt_next * vnew[2],
-        ];
-        *v = vnew;
-        *x = xnew;
-        (vnew[0] + vnew[1] + vnew[2] + xnew[0] + xnew[1] + xnew[2]).is_finite()
+        a
     }
 }
 
