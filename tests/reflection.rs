@@ -24,7 +24,8 @@
 mod common;
 use common::*;
 
-use weft::analysis::energy::{self, launch_pulse, reflection, region_energies, Region};
+use weft::analysis::energy::{self, reflection, region_energies, Region};
+use weft::analysis::pulse::{self, launch_pulse};
 use weft::model::{ElementKind, Model, PartProps, Tie};
 use weft::solver::run_in_memory;
 
@@ -391,7 +392,7 @@ fn a_formed_model_is_pulsed_only_unformed() {
     m.initial_displacement = m.coords.iter().map(|x| [1e-3 * x[0], 0.0, 0.0]).collect();
     let prov = weft::table::Provenance::new("test", serde_json::json!({}));
     weft::model::io::write_model(&m, &dir.path().join("formed"), &prov).unwrap();
-    let cfg = |unformed: bool| energy::PulseConfig {
+    let cfg = |unformed: bool| pulse::PulseConfig {
         model: dir.path().join("formed"),
         parts: vec!["bar1".into()],
         axis: "x".into(),
@@ -402,13 +403,13 @@ fn a_formed_model_is_pulsed_only_unformed() {
         unformed,
         out: dir.path().join("pulsed"),
     };
-    let e = format!("{:#}", energy::run_pulse(&cfg(false)).unwrap_err());
+    let e = format!("{:#}", pulse::run_pulse(&cfg(false)).unwrap_err());
     assert!(
         e.contains("formed model") && e.contains("--unformed"),
         "{e}"
     );
     assert!(!dir.path().join("pulsed").exists());
-    let n = energy::run_pulse(&cfg(true)).unwrap();
+    let n = pulse::run_pulse(&cfg(true)).unwrap();
     assert!(n > 0);
     let p = weft::model::io::read_model(&dir.path().join("pulsed")).unwrap();
     assert!(p.initial_displacement.iter().all(|u| *u == [0.0; 3]));

@@ -4,6 +4,7 @@
 pub mod energy;
 pub mod error;
 pub mod interp;
+pub mod pulse;
 pub mod series;
 pub mod wavespeed;
 

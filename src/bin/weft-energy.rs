@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Args, Parser, Subcommand};
-use weft::analysis::energy;
+use weft::analysis::{energy, pulse};
 
 #[derive(Parser)]
 #[command(
@@ -171,7 +171,7 @@ fn run() -> anyhow::Result<ExitCode> {
             }
         }
         Command::Pulse(a) => {
-            let n = energy::run_pulse(&energy::PulseConfig {
+            let n = pulse::run_pulse(&pulse::PulseConfig {
                 model: a.model,
                 parts: a.part,
                 axis: a.axis,

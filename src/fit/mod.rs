@@ -114,6 +114,70 @@ fn number(spec: &str, field: &str, s: &str) -> Result<f64> {
         .ok_or_else(|| bad_param(spec, format!("{field} `{s}` is not a finite number")))
 }
 
+/// One target of `--param` (`PART.PROPERTY` or `PART.PROPERTY*FACTOR`) against the
+/// model: the part must exist and the property be fittable for its kind (aliases
+/// resolved); a truss area set per element would not follow the part's.
+fn parse_target(spec: &str, t: &str, m: &Model) -> Result<Target> {
+    let (name, factor) = match t.split_once('*') {
+        Some((n, f)) => (n.trim(), number(spec, "factor", f)?),
+        None => (t.trim(), 1.0),
+    };
+    let (part, prop) = name
+        .split_once('.')
+        .ok_or_else(|| bad_param(spec, format!("`{name}` is not of the form PART.PROPERTY")))?;
+    let prop = props::resolve_alias(prop);
+    let pi = m.parts.iter().position(|p| p.name == part).ok_or_else(|| {
+        bad_param(spec, format!("the model has no part named `{part}`")).hint(format!(
+            "parts: {}",
+            m.parts
+                .iter()
+                .map(|p| format!("`{}` ({})", p.name, p.kind.name()))
+                .collect::<Vec<_>>()
+                .join(", ")
+        ))
+    })?;
+    let kind = m.parts[pi].kind;
+    let applies: Vec<&str> = props::fittable(kind).map(|p| p.name).collect();
+    if !applies.contains(&prop) {
+        return Err(bad_param(
+            spec,
+            format!("part `{part}` ({}) has no property `{prop}`", kind.name()),
+        )
+        .hint(format!(
+            "a {} part's fittable properties: {}",
+            kind.name(),
+            applies.join(", ")
+        )));
+    }
+    // A truss with an area of its own (elements_truss.parquet `area`) would keep it
+    // whatever the part's area is set to.
+    if prop == "area" {
+        if let Some(b) = m.block(ElementKind::Truss) {
+            if let Some(e) = (0..b.len()).find(|&e| {
+                b.part[e] == pi
+                    && b.area
+                        .get(e)
+                        .is_some_and(|&a| Some(a) != m.parts[pi].props.area)
+            }) {
+                return Err(bad_param(
+                    spec,
+                    format!(
+                        "truss `{}` of part `{part}` has a cross-section area of its own ({:e} m², elements_truss.parquet `area`), which the part's area does not set",
+                        b.id[e], b.area[e]
+                    ),
+                )
+                .hint("fit a part whose trusses all take the part's area (their `area` null in elements_truss.parquet)"));
+            }
+        }
+    }
+    Ok(Target {
+        part: part.to_string(),
+        property: prop.to_string(),
+        factor,
+        part_index: pi,
+    })
+}
+
 /// Parse `--param` against the model whose parts it names.
 pub fn parse_param(spec: &str, m: &Model) -> Result<Parameter> {
     let fields: Vec<&str> = spec.split(':').collect();
@@ -146,67 +210,10 @@ pub fn parse_param(spec: &str, m: &Model) -> Result<Parameter> {
             format!("a log scale needs bounds > 0, the lower bound is {lower:e}"),
         ));
     }
-    let mut targets = vec![];
-    for t in fields[0].split(',') {
-        let (name, factor) = match t.split_once('*') {
-            Some((n, f)) => (n.trim(), number(spec, "factor", f)?),
-            None => (t.trim(), 1.0),
-        };
-        let (part, prop) = name
-            .split_once('.')
-            .ok_or_else(|| bad_param(spec, format!("`{name}` is not of the form PART.PROPERTY")))?;
-        let prop = props::resolve_alias(prop);
-        let pi = m.parts.iter().position(|p| p.name == part).ok_or_else(|| {
-            bad_param(spec, format!("the model has no part named `{part}`")).hint(format!(
-                "parts: {}",
-                m.parts
-                    .iter()
-                    .map(|p| format!("`{}` ({})", p.name, p.kind.name()))
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            ))
-        })?;
-        let kind = m.parts[pi].kind;
-        let applies: Vec<&str> = props::fittable(kind).map(|p| p.name).collect();
-        if !applies.contains(&prop) {
-            return Err(bad_param(
-                spec,
-                format!("part `{part}` ({}) has no property `{prop}`", kind.name()),
-            )
-            .hint(format!(
-                "a {} part's fittable properties: {}",
-                kind.name(),
-                applies.join(", ")
-            )));
-        }
-        // A truss with an area of its own (elements_truss.parquet `area`) would keep it
-        // whatever the part's area is set to.
-        if prop == "area" {
-            if let Some(b) = m.block(ElementKind::Truss) {
-                if let Some(e) = (0..b.len()).find(|&e| {
-                    b.part[e] == pi
-                        && b.area
-                            .get(e)
-                            .is_some_and(|&a| Some(a) != m.parts[pi].props.area)
-                }) {
-                    return Err(bad_param(
-                        spec,
-                        format!(
-                            "truss `{}` of part `{part}` has a cross-section area of its own ({:e} m², elements_truss.parquet `area`), which the part's area does not set",
-                            b.id[e], b.area[e]
-                        ),
-                    )
-                    .hint("fit a part whose trusses all take the part's area (their `area` null in elements_truss.parquet)"));
-                }
-            }
-        }
-        targets.push(Target {
-            part: part.to_string(),
-            property: prop.to_string(),
-            factor,
-            part_index: pi,
-        });
-    }
+    let targets = fields[0]
+        .split(',')
+        .map(|t| parse_target(spec, t, m))
+        .collect::<Result<Vec<Target>>>()?;
     let current = {
         let t = &targets[0];
         let mut p = m.parts[t.part_index].props.clone();

@@ -82,76 +82,12 @@ pub fn gather(
         serde_json::json!({ "pipeline": p.file.display().to_string(), "stage": stage, "output": output, "table": table }),
     );
     for &i in &sel {
-        let inst = &p.instances[i];
-        let (oname, opath) = match output {
-            Some(o) => inst
-                .outputs
-                .iter()
-                .find(|(k, _)| k == o)
-                .cloned()
-                .ok_or_else(|| {
-                    WeftError::input(format!("instance `{}` has no output `{o}`", inst.name))
-                        .in_file(&p.file)
-                        .expected(format!(
-                            "one of [{}]",
-                            inst.outputs
-                                .iter()
-                                .map(|(k, _)| k.as_str())
-                                .collect::<Vec<_>>()
-                                .join(", ")
-                        ))
-                })?,
-            None if inst.outputs.len() == 1 => inst.outputs[0].clone(),
-            None => {
-                return Err(WeftError::input(format!(
-                    "instance `{}` has {} outputs",
-                    inst.name,
-                    inst.outputs.len()
-                ))
-                .in_file(&p.file)
-                .expected("`--output NAME` to choose one"))
-            }
-        };
-        let _ = oname;
-        let mut path: PathBuf = p.root.join(&opath);
-        if let Some(t) = table {
-            path = path.join(t);
-        }
-        if !path.is_file() {
-            return Err(WeftError::input(format!(
-                "`{}` of instance `{}` does not exist",
-                path.display(),
-                inst.name
-            ))
-            .hint("run the pipeline first (`weft run`), or check --table"));
-        }
+        let path = instance_table(p, &p.instances[i], output, table)?;
         prov = prov.with_input(&path)?;
         tables.push((i, Table::read(&path)?));
     }
     let schema0 = tables[0].1.batch.schema();
-    let mut batches = Vec::new();
-    for (i, t) in &tables {
-        if t.batch.schema().fields() != schema0.fields() {
-            return Err(WeftError::input(format!(
-                "the table of `{}` has columns {:?}, the first instance's has {:?}",
-                p.instances[*i].name,
-                t.batch
-                    .schema()
-                    .fields()
-                    .iter()
-                    .map(|f| format!("{}: {}", f.name(), f.data_type()))
-                    .collect::<Vec<_>>(),
-                schema0
-                    .fields()
-                    .iter()
-                    .map(|f| format!("{}: {}", f.name(), f.data_type()))
-                    .collect::<Vec<_>>()
-            ))
-            .in_file(&t.path)
-            .expected("the same columns and types in every instance"));
-        }
-        batches.push(t.batch.clone());
-    }
+    let batches = same_columns(p, &tables, &schema0)?;
     let data = arrow_select::concat::concat_batches(&schema0, &batches)
         .map_err(|e| WeftError::input(format!("cannot join the tables: {e}")))?;
     let rows: Vec<usize> = tables.iter().map(|(_, t)| t.num_rows()).collect();
@@ -194,6 +130,88 @@ pub fn gather(
     let b = RecordBatch::try_new(Arc::new(Schema::new(fields)), arrays).expect("equal lengths");
     write_table(out, &b, &prov)?;
     Ok(b.num_rows())
+}
+
+/// The table an instance wrote: its output `output` (or its only one), and inside it
+/// `table` when the output is a folder; an error names the instance and what exists.
+fn instance_table(
+    p: &Pipeline,
+    inst: &super::spec::Instance,
+    output: Option<&str>,
+    table: Option<&str>,
+) -> Result<PathBuf> {
+    let (_, opath) = match output {
+        Some(o) => inst
+            .outputs
+            .iter()
+            .find(|(k, _)| k == o)
+            .cloned()
+            .ok_or_else(|| {
+                WeftError::input(format!("instance `{}` has no output `{o}`", inst.name))
+                    .in_file(&p.file)
+                    .expected(format!(
+                        "one of [{}]",
+                        inst.outputs
+                            .iter()
+                            .map(|(k, _)| k.as_str())
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                    ))
+            })?,
+        None if inst.outputs.len() == 1 => inst.outputs[0].clone(),
+        None => {
+            return Err(WeftError::input(format!(
+                "instance `{}` has {} outputs",
+                inst.name,
+                inst.outputs.len()
+            ))
+            .in_file(&p.file)
+            .expected("`--output NAME` to choose one"))
+        }
+    };
+    let mut path: PathBuf = p.root.join(&opath);
+    if let Some(t) = table {
+        path = path.join(t);
+    }
+    if !path.is_file() {
+        return Err(WeftError::input(format!(
+            "`{}` of instance `{}` does not exist",
+            path.display(),
+            inst.name
+        ))
+        .hint("run the pipeline first (`weft run`), or check --table"));
+    }
+    Ok(path)
+}
+
+/// The instances' tables as batches, each with the first one's columns and types, else
+/// an error naming the instance and both column lists.
+fn same_columns(
+    p: &Pipeline,
+    tables: &[(usize, Table)],
+    schema0: &arrow_schema::SchemaRef,
+) -> Result<Vec<RecordBatch>> {
+    let columns = |s: &arrow_schema::Schema| -> Vec<String> {
+        s.fields()
+            .iter()
+            .map(|f| format!("{}: {}", f.name(), f.data_type()))
+            .collect()
+    };
+    let mut batches = Vec::new();
+    for (i, t) in tables {
+        if t.batch.schema().fields() != schema0.fields() {
+            return Err(WeftError::input(format!(
+                "the table of `{}` has columns {:?}, the first instance's has {:?}",
+                p.instances[*i].name,
+                columns(&t.batch.schema()),
+                columns(schema0)
+            ))
+            .in_file(&t.path)
+            .expected("the same columns and types in every instance"));
+        }
+        batches.push(t.batch.clone());
+    }
+    Ok(batches)
 }
 
 /// The records of a pipeline as a table, one row per instance, in file order.

@@ -285,6 +285,27 @@ fn scatter(
     }
 }
 
+/// The anchors' slides (Δξ_A, Δξ_B) along their yarns that move the link's tangential
+/// offset d_t by δ = (r − 1) d_t (the radial return to r = F/|f_t| of it): the 2 × 2
+/// system of the frame's tangents e₁, e₂ against the yarn tangents g_A, g_B at the
+/// anchors. `None` when the yarn tangents are (nearly) parallel in the frame's plane.
+#[inline]
+fn anchor_slides(d: &Vec3, r: f64, k: &FrameKin, a: &Anchor, b: &Anchor) -> Option<(f64, f64)> {
+    let delta = [d[0] * (r - 1.0), d[1] * (r - 1.0)];
+    let [e1, e2, _] = k.r_mat;
+    let m = [
+        [-dot(&e1, &a.g), dot(&e1, &b.g)],
+        [-dot(&e2, &a.g), dot(&e2, &b.g)],
+    ];
+    let det = m[0][0] * m[1][1] - m[0][1] * m[1][0];
+    if !(det.abs() > 1e-12 * norm(&a.g) * norm(&b.g)) {
+        return None;
+    }
+    let da = (delta[0] * m[1][1] - delta[1] * m[0][1]) / det;
+    let db = (m[0][0] * delta[1] - m[1][0] * delta[0]) / det;
+    Some((da, db))
+}
+
 /// Forces of a sliding link on its window nodes (`out`: A's [`WIN`] then B's) at
 /// positions `x` and half-step velocities `v` (v^{n−½}); moves the anchors when the
 /// slider slips and advances the dissipated energies (call once per step). `dt_prev` is
@@ -322,19 +343,9 @@ pub fn force_update(
                 break;
             }
             // Radial return: the elastic part comes back to d_t · F/|f_t|.
-            let r = limit / mag;
-            let delta = [d[0] * (r - 1.0), d[1] * (r - 1.0)];
-            let [e1, e2, _] = k.r_mat;
-            let m = [
-                [-dot(&e1, &a.g), dot(&e1, &b.g)],
-                [-dot(&e2, &a.g), dot(&e2, &b.g)],
-            ];
-            let det = m[0][0] * m[1][1] - m[0][1] * m[1][0];
-            if !(det.abs() > 1e-12 * norm(&a.g) * norm(&b.g)) {
+            let Some((da, db)) = anchor_slides(&d, limit / mag, &k, &a, &b) else {
                 break;
-            }
-            let da = (delta[0] * m[1][1] - delta[1] * m[0][1]) / det;
-            let db = (m[0][0] * delta[1] - m[1][0] * delta[0]) / det;
+            };
             let (lo_a, hi_a) = g.win[0].range();
             let (lo_b, hi_b) = g.win[1].range();
             let xi = [
