@@ -26,7 +26,7 @@
 //! is the order of the force slots, of the masses' accumulation and of the sums, so it
 //! is part of what makes results reproducible bit for bit.
 
-use super::failure::Failure;
+use super::failure::{Erosion, Failure};
 use super::rotations::Rotations;
 use super::vec3::{Mat3, Vec3};
 use crate::error::Result;
@@ -137,20 +137,32 @@ pub trait Family: Sized + Send + Sync {
     fn stiffness_sums(&self, ctx: &StiffCtx, s: &mut [f64], c: &mut [f64], rot_row: &mut [f64]);
     /// Per-chunk energy partials at the positions in `ctx` (eroded elements hold none).
     fn energies(&mut self, ctx: &ForceCtx) -> &[EnergyPartial];
+    /// The failure laws and fates of a family whose elements can fail (trusses, links,
+    /// membranes): the four methods below read them. `None` (the default): nothing fails.
+    fn erosion(&self) -> Option<&Erosion> {
+        None
+    }
+    fn erosion_mut(&mut self) -> Option<&mut Erosion> {
+        None
+    }
     /// Moves the failures of the last force pass, in element order, to `out` (a family
     /// whose elements cannot fail has none).
-    fn collect_failures(&mut self, _out: &mut Vec<Failure>) {}
+    fn collect_failures(&mut self, out: &mut Vec<Failure>) {
+        if let Some(er) = self.erosion_mut() {
+            er.collect(out);
+        }
+    }
     /// Whether element e is still in the model (not eroded).
-    fn alive(&self, _e: usize) -> bool {
-        true
+    fn alive(&self, e: usize) -> bool {
+        self.erosion().is_none_or(|er| er.alive(e))
     }
     /// The strain energy its failures have taken so far [J].
     fn eroded_energy(&self) -> f64 {
-        0.0
+        self.erosion().map_or(0.0, Erosion::eroded_energy)
     }
     /// Whether any of its elements can fail.
     fn can_fail(&self) -> bool {
-        false
+        self.erosion().is_some_and(Erosion::active)
     }
     /// Element e's stored energy at `x` (strain and hourglass) [J]; 0 once it has failed
     /// (families whose energies `ballistic.parquet` reports by layer: trusses, membranes).

@@ -465,17 +465,11 @@ impl<A: Axes> Family for Links<A> {
         });
         &self.partials
     }
-    fn collect_failures(&mut self, out: &mut Vec<Failure>) {
-        self.erosion.collect(out);
+    fn erosion(&self) -> Option<&Erosion> {
+        Some(&self.erosion)
     }
-    fn alive(&self, e: usize) -> bool {
-        self.erosion.alive(e)
-    }
-    fn eroded_energy(&self) -> f64 {
-        self.erosion.eroded_energy()
-    }
-    fn can_fail(&self) -> bool {
-        self.erosion.active()
+    fn erosion_mut(&mut self) -> Option<&mut Erosion> {
+        Some(&mut self.erosion)
     }
 }
 
