@@ -159,27 +159,6 @@ pub struct Staleness {
     last_far: bool,
 }
 
-/// Cells in-plane per tile side of the tile design's gate ([`Staleness::stale_cells`]).
-pub const GATE_TILE: usize = 4;
-
-/// Which cells made a test stale ([`Staleness::stale_cells`]), and the cells of the tiles
-/// that would rebuild.
-#[derive(Debug, Clone, Default)]
-pub struct StaleCells {
-    /// Cells whose neighbourhood is not empty.
-    pub occupied: usize,
-    /// Cells whose neighbourhood's displacements spread more than the skin in a
-    /// component, or that hold a node past U.
-    pub over: usize,
-    /// Tiles ([`GATE_TILE`] × [`GATE_TILE`] cells in the two axes of most cells, every
-    /// cell along the third) holding an occupied cell, and those holding a cell over.
-    pub tiles: usize,
-    pub tiles_over: usize,
-    /// Per cell: whether it lies in a tile holding a cell over, or in the ring of cells
-    /// around such a tile.
-    pub affected: Vec<bool>,
-}
-
 impl Staleness {
     pub fn new(skin: f64) -> Staleness {
         Staleness {
@@ -339,32 +318,6 @@ impl Staleness {
         }
     }
 
-    /// Right after a [`Staleness::stale`] that found the lists stale: which cells made
-    /// it so (a neighbourhood spread past the skin, or a node of the cell past U), and
-    /// the cells of the tiles that hold them plus one ring of cells — what a build of
-    /// only those tiles would cover (a measurement for the tile design; the test's
-    /// answer and the narrow phase's spreads are not changed: `range` and `scratch` are
-    /// scratch, and the next build resets them).
-    pub fn stale_cells(&mut self) -> StaleCells {
-        let u_max = self.u_max;
-        let past_u = |r: &[f64; 6]| !(0..3).all(|d| r[d] >= -u_max && r[d + 3] <= u_max);
-        // A far test left the cells' own ranges in `range`: its cells past U first.
-        let mut over: Vec<bool> = if self.last_far {
-            self.range.iter().map(past_u).collect()
-        } else {
-            vec![false; self.range.len()]
-        };
-        if self.last_far {
-            self.neighbourhood_ranges();
-        }
-        let mut occupied = vec![false; over.len()];
-        for ((o, oc), r) in over.iter_mut().zip(&mut occupied).zip(&self.scratch) {
-            *oc = (0..3).all(|d| r[d + 3] >= r[d]);
-            *o |= *oc && (0..3).any(|d| r[d + 3] - r[d] > self.skin);
-        }
-        tile_marks(self.grid.dims(), &over, &occupied)
-    }
-
     /// Whether the last [`Staleness::stale`] found a node past U.
     pub fn last_far(&self) -> bool {
         self.last_far
@@ -380,57 +333,6 @@ impl Staleness {
     /// after a build).
     pub fn spread(&self) -> &[f64] {
         &self.spread
-    }
-}
-
-/// The tiles of the gate ([`GATE_TILE`] × [`GATE_TILE`] cells in the two axes of most
-/// cells, every cell along the third) over cells `dims`: those holding an `occupied` cell,
-/// those holding a cell `over`, and the cells of the latter plus one ring of cells.
-pub fn tile_marks(dims: [usize; 3], over: &[bool], occupied: &[bool]) -> StaleCells {
-    // The axis of fewest cells is the one a tile spans whole.
-    let z = (0..3)
-        .min_by_key(|&d| (dims[d], std::cmp::Reverse(d)))
-        .unwrap_or(2);
-    let (a, b) = match z {
-        0 => (1, 2),
-        1 => (0, 2),
-        _ => (0, 1),
-    };
-    let tiles_per = |d: usize| dims[d].div_ceil(GATE_TILE);
-    let (ta, tb) = (tiles_per(a), tiles_per(b));
-    let index = |c: usize| -> [usize; 3] {
-        [
-            c % dims[0],
-            (c / dims[0]) % dims[1],
-            c / (dims[0] * dims[1]),
-        ]
-    };
-    let mut tile_occ = vec![false; ta * tb];
-    let mut tile_over = vec![false; ta * tb];
-    for c in 0..over.len() {
-        let i = index(c);
-        let t = (i[b] / GATE_TILE) * ta + i[a] / GATE_TILE;
-        tile_occ[t] |= occupied[c];
-        tile_over[t] |= over[c];
-    }
-    // A cell is affected when a tile over lies within one cell of it in both axes.
-    let affected = (0..over.len())
-        .map(|c| {
-            let i = index(c);
-            let near = |d: usize| {
-                let lo = i[d].saturating_sub(1) / GATE_TILE;
-                let hi = (i[d] + 1).min(dims[d] - 1) / GATE_TILE;
-                lo..=hi
-            };
-            near(b).any(|tb_| near(a).any(|ta_| tile_over[tb_ * ta + ta_]))
-        })
-        .collect();
-    StaleCells {
-        occupied: occupied.iter().filter(|&&o| o).count(),
-        over: over.iter().filter(|&&o| o).count(),
-        tiles: tile_occ.iter().filter(|&&o| o).count(),
-        tiles_over: tile_over.iter().filter(|&&o| o).count(),
-        affected,
     }
 }
 
@@ -567,98 +469,5 @@ mod tests {
             "the sweep must cross the limit: {kept} kept"
         );
         assert!(checked > 1000, "pairs checked: {checked}");
-    }
-
-    /// The gate's tiles on a planted grid, against a hand count: 10 × 9 × 2 cells, tiles
-    /// of 4 × 4 in x, y (z, the axis of fewest cells, whole): 3 × 3 tiles. A cell over at
-    /// (5, 5, 0) lies in tile (1, 1), cells 4..=7 in x and y; with the ring, cells 3..=8:
-    /// 6 × 6 × 2 = 72 cells. One at (0, 0, 1): tile (0, 0), cells 0..=3, ring to 4:
-    /// 5 × 5 × 2 = 50 cells; both: disjoint (x 3..=8 against 0..=4 overlap in 3..=4 for y
-    /// 3..=4: 2 × 2 × 2 = 8 cells counted once), 72 + 50 − 8 = 114.
-    #[test]
-    fn gate_tiles_cover_the_tile_and_its_ring() {
-        let dims = [10, 9, 2];
-        let n = dims[0] * dims[1] * dims[2];
-        let at = |i: usize, j: usize, k: usize| (k * dims[1] + j) * dims[0] + i;
-        let occupied = vec![true; n];
-        let count = |cells: &[usize]| {
-            let mut over = vec![false; n];
-            for &c in cells {
-                over[c] = true;
-            }
-            let m = super::tile_marks(dims, &over, &occupied);
-            (
-                m.affected.iter().filter(|&&a| a).count(),
-                m.tiles_over,
-                m.tiles,
-            )
-        };
-        assert_eq!(count(&[at(5, 5, 0)]), (72, 1, 9));
-        assert_eq!(count(&[at(0, 0, 1)]), (50, 1, 9));
-        assert_eq!(count(&[at(5, 5, 0), at(0, 0, 1)]), (114, 2, 9));
-        // Every cell of one tile over: the same cells as one of them.
-        assert_eq!(count(&[at(4, 4, 0), at(7, 7, 1), at(6, 5, 0)]), (72, 1, 9));
-    }
-
-    /// `stale_cells` names the cells that made a test stale: two neighbours moving apart
-    /// past the skin make their cells' neighbourhoods over (and no others beyond those
-    /// neighbourhoods: the 3 × 3 × 3 cells around each); a translation past U makes every
-    /// occupied cell over.
-    #[test]
-    fn stale_cells_name_the_cause() {
-        let skin = 1e-4;
-        let u_max = ABSOLUTE_PER_SKIN * skin;
-        let mut st = 5u64;
-        let x0: Vec<[f64; 3]> = (0..800)
-            .map(|_| {
-                [
-                    2e-2 * uniform(&mut st),
-                    2e-2 * uniform(&mut st),
-                    2e-4 * uniform(&mut st),
-                ]
-            })
-            .collect();
-        let nodes: Vec<u32> = (0..x0.len() as u32).collect();
-        let mut s = Staleness::new(skin);
-        s.reset(&nodes, &x0, 8e-4);
-        let n = x0.len();
-        let (i, j) = (0..n)
-            .flat_map(|i| (i + 1..n).map(move |j| (i, j)))
-            .find(|&(i, j)| (0..3).all(|d| (x0[i][d] - x0[j][d]).abs() < 1e-3))
-            .expect("a close pair");
-        let mut x = x0.clone();
-        x[i][2] += 0.6 * skin;
-        x[j][2] -= 0.6 * skin;
-        assert!(s.stale(&x));
-        let m = s.stale_cells();
-        let (c0, c1) = (s.cell(&x0[i]), s.cell(&x0[j]));
-        assert!(m.affected[c0] && m.affected[c1]);
-        let near = |c: usize, e: usize| {
-            let d = s.dims();
-            let i = |c: usize| [c % d[0], (c / d[0]) % d[1], c / (d[0] * d[1])];
-            (0..3).all(|k| i(c)[k].abs_diff(i(e)[k]) <= 1)
-        };
-        // Over: the cells whose neighbourhood holds both nodes' cells (each moved 0.6
-        // skin from the still nodes, within the skin of them; 1.2 skins from each other;
-        // cells of 1.6 mm, so the pair, within 1 mm, is in neighbouring cells).
-        let want = (0..m.affected.len())
-            .filter(|&c| near(c, c0) && near(c, c1))
-            .count();
-        assert!(want > 0);
-        assert_eq!(m.over, want, "cells over");
-        assert!(m.occupied > 0 && m.tiles_over >= 1 && m.tiles_over <= m.tiles);
-        // Past U: every cell with a node is over.
-        let x: Vec<[f64; 3]> = x0
-            .iter()
-            .map(|p| [p[0] + 1.01 * u_max, p[1], p[2]])
-            .collect();
-        s.reset(&nodes, &x0, 8e-4);
-        assert!(s.stale(&x));
-        let m = s.stale_cells();
-        let with_nodes = (0..m.affected.len())
-            .filter(|&c| x0.iter().any(|p| s.cell(p) == c))
-            .count();
-        assert_eq!(m.over, with_nodes, "cells over against cells holding nodes");
-        assert_eq!(m.tiles_over, m.tiles);
     }
 }

@@ -168,50 +168,13 @@ pub struct ContactReport {
     pub lazy_boxes: u64,
 }
 
-/// Over the stale tests that triggered a build: how local the staleness was, the gate of
-/// a design that would rebuild only tiles of the staleness grid
-/// ([`GATE_TILE`](super::staleness::GATE_TILE)² cells in-plane, every cell across, plus
-/// one ring of cells; see [`Staleness::stale_cells`]).
+/// The stale tests that triggered a build (after the setup's).
 #[derive(Debug, Clone, Copy, Default)]
 pub struct TriggerStats {
     /// Tests that found the lists stale, and of them those where a node had gone past
     /// the absolute bound U (the others: a neighbourhood's spread past the skin).
     pub triggers: u64,
     pub far: u64,
-    /// Per trigger, the fraction of the cells with an occupied neighbourhood whose
-    /// spread was past the skin (or that held a node past U) ...
-    pub cells: MeanMax,
-    /// ... the fraction of the tiles holding nodes that hold such a cell ...
-    pub tiles: MeanMax,
-    /// ... and the fraction of the slaves (over all sides) in those tiles and their ring.
-    pub slaves: MeanMax,
-    /// At the last trigger: the cells with an occupied neighbourhood and the tiles
-    /// holding nodes (the denominators above).
-    pub cells_held: usize,
-    pub tiles_held: usize,
-}
-
-/// The sum and the largest of a series of values (the mean is the sum over the count).
-#[derive(Debug, Clone, Copy, Default)]
-pub struct MeanMax {
-    pub sum: f64,
-    pub max: f64,
-}
-
-impl MeanMax {
-    fn push(&mut self, v: f64) {
-        self.sum += v;
-        self.max = self.max.max(v);
-    }
-
-    /// The mean over `n` values (0 when none).
-    pub fn mean(&self, n: u64) -> f64 {
-        if n == 0 {
-            0.0
-        } else {
-            self.sum / n as f64
-        }
-    }
 }
 
 /// Wall time of the contact's phases [s] (see [`ContactReport::phases`]).
@@ -595,28 +558,11 @@ impl SurfaceContact {
         self.motion.stale(x)
     }
 
-    /// Books what the stale test that has just triggered a build found: which cells went
-    /// stale, and the slaves of the tiles around them (measured on the slaves' cells of
-    /// the last build, before the build replaces them).
+    /// Counts the stale test that has just triggered a build.
     fn record_trigger(&mut self) {
-        let m = self.motion.stale_cells();
-        let fraction = |a: usize, b: usize| if b == 0 { 0.0 } else { a as f64 / b as f64 };
-        let (mut inside, mut all) = (0usize, 0usize);
-        for s in &self.sides {
-            all += s.slave_cell.len();
-            inside += s
-                .slave_cell
-                .iter()
-                .filter(|&&c| m.affected.get(c as usize).copied().unwrap_or(false))
-                .count();
-        }
         let t = &mut self.triggers;
         t.triggers += 1;
         t.far += u64::from(self.motion.last_far());
-        t.cells.push(fraction(m.over, m.occupied));
-        t.tiles.push(fraction(m.tiles_over, m.tiles));
-        t.slaves.push(fraction(inside, all));
-        (t.cells_held, t.tiles_held) = (m.occupied, m.tiles);
     }
 
     /// Setup at the start positions `x` (the reference plus any initial displacement):
