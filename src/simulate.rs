@@ -12,6 +12,7 @@ use crate::error::{Result, WeftError};
 use crate::model::io::read_tables;
 use crate::model::striker::check_striking_speed;
 use crate::model::{ElementKind, Model, ValidatedModel};
+use crate::solver::failure::FailureEvent;
 use crate::solver::output::ParquetSink;
 use crate::solver::{RunStats, Solver};
 use crate::table::{batch, write_table, Col, Provenance};
@@ -183,16 +184,21 @@ pub fn run(c: &Config, progress: &mut (dyn FnMut(f64) + Send)) -> Result<Report>
     };
     stats.threads = pool.current_num_threads();
     stats.times.setup = setup;
-    let t_write = Instant::now();
-    sink.finish(&c.out, &prov)?;
-    write_element_results(&c.out, elements, &prov)?;
-    write_failures(&c.out, &m, &solver, &prov)?;
-    stats.times.output += t_write.elapsed();
-    let report = Report::of(c, &solver, stats);
     let status = match &stopped {
         None => Status::Completed,
         Some(e) => Status::Stopped(e.to_string()),
     };
+    let t_write = Instant::now();
+    sink.finish(&c.out, &prov)?;
+    write_element_results(&c.out, elements, &prov)?;
+    write_failures(
+        &c.out,
+        &m,
+        failure_events(&solver, &status, stats.end_time),
+        &prov,
+    )?;
+    stats.times.output += t_write.elapsed();
+    let report = Report::of(c, &solver, stats);
     write_summary(&c.out, &report, &solver, &m, &status, &prov)?;
     if let Some(e) = stopped {
         return Err(e.context(format!(
@@ -311,20 +317,43 @@ pub enum Status {
     Stopped(String),
 }
 
-/// `failures.parquet`: one row per failure, in the order they happened, when the model
-/// can fail; otherwise a stale one from an earlier run into the same folder is removed.
-fn write_failures(out: &Path, m: &Model, s: &Solver, prov: &Provenance) -> Result<()> {
+/// The failures a run's tables report: every one of a completed run; of a stopped run,
+/// those up to its last output sample at `end` (the time its other tables end at), not
+/// those of the steps between that sample and the stop. `None` when the model cannot fail.
+fn failure_events<'a>(s: &'a Solver, status: &Status, end: f64) -> Option<&'a [FailureEvent]> {
+    let log = s.failure_log();
+    if !log.active {
+        return None;
+    }
+    Some(match status {
+        Status::Completed => &log.events,
+        // The log is in the order of the failures, so in time.
+        Status::Stopped(_) => {
+            let n = log.events.partition_point(|e| e.time <= end);
+            &log.events[..n]
+        }
+    })
+}
+
+/// `failures.parquet`: one row per failure of `events`, in the order they happened, when
+/// the model can fail; otherwise (`None`) a stale one from an earlier run into the same
+/// folder is removed.
+fn write_failures(
+    out: &Path,
+    m: &Model,
+    events: Option<&[FailureEvent]>,
+    prov: &Provenance,
+) -> Result<()> {
     let path = out.join("failures.parquet");
-    if !s.failure_log().active {
+    let Some(ev) = events else {
         if path.exists() {
             std::fs::remove_file(&path).map_err(|e| WeftError::io(&path, e))?;
         }
         return Ok(());
-    }
-    let ev = &s.failure_log().events;
+    };
     // Each failure's element row in its table: the family's index for trusses and
     // membranes, the id's row for links (their families split the link table).
-    let row = |e: &crate::solver::failure::FailureEvent| -> Option<usize> {
+    let row = |e: &FailureEvent| -> Option<usize> {
         let b = m.block(e.failure.kind)?;
         if e.failure.kind == crate::model::ElementKind::Link {
             b.id.iter().position(|&i| i == e.id)
@@ -333,7 +362,7 @@ fn write_failures(out: &Path, m: &Model, s: &Solver, prov: &Provenance) -> Resul
         }
     };
     let rows: Vec<Option<usize>> = ev.iter().map(row).collect();
-    let block = |e: &crate::solver::failure::FailureEvent| m.block(e.failure.kind);
+    let block = |e: &FailureEvent| m.block(e.failure.kind);
     write_table(
         &path,
         &batch(vec![
@@ -479,7 +508,7 @@ pub fn write_summary(
 ) -> Result<()> {
     let st = &r.stats;
     let mut cols = run_columns(r, s, st);
-    cols.extend(ballistic_columns(s, m, status));
+    cols.extend(ballistic_columns(s, m, status, r.stats.end_time));
     write_table(&out.join("summary.parquet"), &batch(cols), prov)
 }
 
@@ -550,8 +579,9 @@ fn run_columns(r: &Report, s: &Solver, st: &RunStats) -> Vec<Col> {
 /// The summary's columns about how the run ended and what an armour engineer reads:
 /// status and stop reason; the first projectile's striking velocity, outcome, residual
 /// velocity, mass and radius (null without a projectile); the layers, failures, broken
-/// yarns, back-face deflection peak and energy absorbed (docs/tables.md).
-fn ballistic_columns(s: &Solver, m: &Model, status: &Status) -> Vec<Col> {
+/// yarns, back-face deflection peak and energy absorbed (docs/tables.md). The failures
+/// counted are those of failures.parquet: a stopped run's up to `end`, its last sample.
+fn ballistic_columns(s: &Solver, m: &Model, status: &Status, end: f64) -> Vec<Col> {
     use crate::solver::watch::Outcome;
     let w = s.watch();
     let p = m.projectiles.first();
@@ -576,18 +606,10 @@ fn ballistic_columns(s: &Solver, m: &Model, status: &Status) -> Vec<Col> {
         ),
     };
     let layered = w.n_layers > 0;
-    let first_failure = s
-        .failure_log()
-        .events
-        .iter()
-        .find(|e| e.failure.eroded)
-        .map(|e| e.time);
-    let eroded = s
-        .failure_log()
-        .events
-        .iter()
-        .filter(|e| e.failure.eroded)
-        .count();
+    // The failures of failures.parquet (a stopped run's up to its last sample).
+    let events = failure_events(s, status, end).unwrap_or(&[]);
+    let first_failure = events.iter().find(|e| e.failure.eroded).map(|e| e.time);
+    let eroded = events.iter().filter(|e| e.failure.eroded).count();
     let broken: u32 = (1..=w.n_layers).map(|l| w.counts(l).1).sum();
     let absorbed: f64 = w.last_rows.iter().map(|r| r[4]).sum();
     vec![

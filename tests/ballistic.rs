@@ -298,6 +298,161 @@ fn a_stopped_run_keeps_its_tables_and_says_why() {
     );
 }
 
+/// A stopped impact's tables end at one sample, and its runs stay out of the fits. The
+/// stop: an energy limit just below the balance error the same impact reaches at one of
+/// its samples, chosen (by runs in memory) so that the solver stops while yarns fail
+/// between its last sample and the stop. Its history, projectile, energy, per-ply and
+/// failures tables then end at the summary's `end_time`; its failures are those of the
+/// solver's log up to that time, value by value, and the summary counts those.
+/// `weft-ballistic fit` refuses it, naming the run and its reason, and `--skip-stopped`
+/// leaves it out (and says so).
+#[test]
+fn a_stopped_impact_ends_its_tables_at_one_sample_and_stays_out_of_fits() {
+    use weft::table::Table;
+    let dir = tempfile::tempdir().unwrap();
+    let mut p = patch(1, failing());
+    p.projectile_velocity = 400.0;
+    p.output_interval = 1e-6;
+    let (m, _) = woven(&p).unwrap();
+    let model = dir.path().join("patch");
+    let prov = weft::table::Provenance::new("t", serde_json::json!({}));
+    weft::model::io::write_model(&m, &model, &prov).unwrap();
+    let simulate = |name: &str, limit: Option<f64>| {
+        let out = dir.path().join(name);
+        let c = weft::simulate::Config {
+            model: model.clone(),
+            out: out.clone(),
+            max_energy_error: limit,
+            ..Default::default()
+        };
+        (out.clone(), weft::simulate::run(&c, &mut |_| {}))
+    };
+    let (full, r) = simulate("full", None);
+    r.unwrap();
+    let read = |run: &std::path::Path, table: &str| Table::read(&run.join(table)).unwrap();
+    // The limits to try: just below the balance error (relative to the scale so far) of
+    // each sample, largest first; kept: the first whose stop falls after a failure that
+    // is not yet in the last sample.
+    let e = read(&full, "energy.parquet");
+    let (b, scale) = (
+        e.f64("balance_error", "").unwrap(),
+        e.f64("energy_scale", "").unwrap(),
+    );
+    let mut limits: Vec<f64> = b
+        .iter()
+        .zip(&scale)
+        .map(|(b, s)| 0.999 * b.abs() / s)
+        .collect();
+    limits.sort_by(|a, b| b.total_cmp(a));
+    let stop_in_memory = |limit: f64| {
+        let mut m = m.clone();
+        m.analysis.max_energy_error = limit;
+        let mut s = weft::solver::Solver::new(&m).unwrap();
+        let mut sink = weft::solver::output::MemorySink::default();
+        let stopped = s.run(&mut sink, &mut |_| {}).is_err();
+        let end = s.stats_so_far().end_time;
+        let log: Vec<f64> = s.failure_log().events.iter().map(|e| e.time).collect();
+        (stopped, end, log)
+    };
+    let (limit, log) = limits
+        .iter()
+        .find_map(|&l| {
+            let (stopped, end, log) = stop_in_memory(l);
+            (stopped && log.iter().any(|&t| t <= end) && log.iter().any(|&t| t > end))
+                .then_some((l, log))
+        })
+        .expect("no limit stops the run while yarns fail between its last sample and the stop");
+    let (stopped, r) = simulate("stopped", Some(limit));
+    let err = r.unwrap_err().to_string();
+    assert!(err.contains("energy balance error"), "{err}");
+    let s = read(&stopped, "summary.parquet");
+    assert_eq!(s.str("status", "").unwrap(), vec!["stopped"]);
+    let end = s.f64("end_time", "").unwrap()[0];
+    let last = |run: &std::path::Path, table: &str| {
+        read(run, table)
+            .f64("t", "")
+            .unwrap()
+            .into_iter()
+            .fold(f64::NEG_INFINITY, f64::max)
+    };
+    for table in [
+        "history.parquet",
+        "projectile.parquet",
+        "energy.parquet",
+        "ballistic.parquet",
+    ] {
+        assert_eq!(
+            last(&stopped, table),
+            end,
+            "{table} ends at the last sample"
+        );
+    }
+    let kept = read(&stopped, "failures.parquet").f64("t", "").unwrap();
+    let before_end: Vec<f64> = log.iter().copied().filter(|&t| t <= end).collect();
+    println!(
+        "stopped at the sample {end:e} s (limit {limit:.3e}): {} failures in the table, {} in the solver's log by the stop; {err}",
+        kept.len(),
+        log.len()
+    );
+    assert!(before_end.len() < log.len(), "nothing to cut");
+    assert_eq!(
+        kept, before_end,
+        "a stopped run's failures: those up to its last sample"
+    );
+    assert_eq!(
+        s.i64("failed_elements", "").unwrap()[0] as usize,
+        kept.len(),
+        "the summary counts the failures of its table"
+    );
+    // The fit: refused, or left out with --skip-stopped.
+    let runs =
+        weft::ballistic::runs::read_folders(&[stopped.clone(), full.clone()], "layers").unwrap();
+    let e = weft::ballistic::runs::leave_out_stopped(runs.clone(), false, &mut |_| {})
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains(&stopped.display().to_string())
+            && e.contains("energy balance error")
+            && e.contains("--skip-stopped"),
+        "{e}"
+    );
+    let mut noted = vec![];
+    let kept =
+        weft::ballistic::runs::leave_out_stopped(runs, true, &mut |r| noted.push(r.source.clone()))
+            .unwrap();
+    assert_eq!(noted, vec![stopped.display().to_string()]);
+    assert_eq!(kept.len(), 1);
+    assert_eq!(kept[0].source, full.display().to_string());
+    let fit = |extra: &[&str]| {
+        let mut args = vec![
+            "fit",
+            "--runs",
+            stopped.to_str().unwrap(),
+            full.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        let out = dir.path().join("limit");
+        args.extend_from_slice(&["--out", out.to_str().unwrap()]);
+        let o = std::process::Command::new(BALLISTIC)
+            .args(&args)
+            .output()
+            .unwrap();
+        assert!(!o.status.success());
+        String::from_utf8_lossy(&o.stderr).to_string()
+    };
+    let refused = fit(&[]);
+    assert!(
+        refused.contains("stopped before its end") && refused.contains("--skip-stopped"),
+        "{refused}"
+    );
+    // Left out, the one complete run perforated: no bracket to fit, said as such.
+    let skipped = fit(&["--skip-stopped"]);
+    assert!(
+        skipped.contains("left out") && skipped.contains("every run perforated"),
+        "{skipped}"
+    );
+}
+
 /// Bad input, each named: a negative or non-finite failure strain (parts.parquet), a
 /// Weibull modulus ≤ 0 (the generator), velocities that cannot bracket a limit, runs of
 /// two models in one group.
@@ -333,6 +488,7 @@ fn bad_failure_input_is_named() {
         energy_absorbed: f64::NAN,
         signature: vec![("layers", 2.0), ("nodes", nodes)],
         cost: Default::default(),
+        stopped: None,
     };
     let fit = |runs: Vec<weft::ballistic::runs::Run>| -> String {
         match weft::ballistic::runs::group(runs) {

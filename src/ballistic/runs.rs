@@ -30,6 +30,9 @@ pub struct Run {
     pub signature: Vec<(&'static str, f64)>,
     /// What the impact cost (unknown parts `None`).
     pub cost: Cost,
+    /// Why the run stopped, when the solver stopped it (the summary's `status =
+    /// stopped` and `stop_reason`): its outcome is not one to fit ([`leave_out_stopped`]).
+    pub stopped: Option<String>,
 }
 
 /// What one impact cost: its solver steps and simulated time to its outcome, the
@@ -88,6 +91,7 @@ pub fn read_table(path: &Path, by: &str, label: &dyn Fn(usize) -> String) -> Res
     let absorbed = t.f64_opt("energy_absorbed")?.unwrap_or(vec![None; n]);
     let group = group_column(&t, by)?;
     let cost = costs(&t)?;
+    let stopped = stop_reasons(&t)?;
     let sig: Vec<(&'static str, Vec<f64>)> = SIGNATURE
         .iter()
         .filter(|c| t.has(c))
@@ -109,9 +113,37 @@ pub fn read_table(path: &Path, by: &str, label: &dyn Fn(usize) -> String) -> Res
             energy_absorbed: absorbed[row].unwrap_or(f64::NAN),
             signature: sig.iter().map(|(c, v)| (*c, v[row])).collect(),
             cost: cost[row],
+            stopped: stopped[row].clone(),
         });
     }
     Ok(runs)
+}
+
+/// Each row's stop reason: `Some` where `status` is `stopped` (the reason from
+/// `stop_reason`, or a placeholder where it is null); `None` where it is `completed` or
+/// the table has no `status` (a gathered `ballistic_runs.parquet`, whose runs were
+/// checked when it was written).
+fn stop_reasons(t: &Table) -> Result<Vec<Option<String>>> {
+    let n = t.num_rows();
+    if !t.has("status") {
+        return Ok(vec![None; n]);
+    }
+    let status = t.str("status", "status")?;
+    let reason = t.str_opt("stop_reason")?.unwrap_or(vec![None; n]);
+    status
+        .iter()
+        .zip(reason)
+        .enumerate()
+        .map(|(row, (s, r))| match s.as_str() {
+            "completed" => Ok(None),
+            "stopped" => Ok(Some(r.unwrap_or_else(|| "no reason recorded".into()))),
+            other => Err(t.value_error(
+                "status",
+                row,
+                format!("`status` = `{other}`: expected `completed` or `stopped` (weft-simulate's summary)"),
+            )),
+        })
+        .collect()
 }
 
 /// Each row's cost from a table of summaries: `steps`, `end_time`, `elements` and the
@@ -222,6 +254,33 @@ pub fn read_folders(dirs: &[PathBuf], by: &str) -> Result<Vec<Run>> {
         runs.extend(read_table(&path, by, &label)?);
     }
     Ok(runs)
+}
+
+/// The runs the solver did not stop. A stopped run (NaN, instability, an energy error)
+/// has an outcome, if any, of a run that went wrong: with `skip`, each is left out and
+/// told to `note`; without, the first is refused with its reason.
+pub fn leave_out_stopped(
+    runs: Vec<Run>,
+    skip: bool,
+    note: &mut dyn FnMut(&Run),
+) -> Result<Vec<Run>> {
+    let mut kept = Vec::with_capacity(runs.len());
+    for r in runs {
+        match &r.stopped {
+            None => kept.push(r),
+            Some(_) if skip => note(&r),
+            Some(why) => {
+                return Err(WeftError::input(format!(
+                    "run `{}` at {} m/s stopped before its end: {why}",
+                    r.source, r.striking_velocity
+                ))
+                .in_column("status")
+                .expected("runs with `status = completed` in their summary: a stopped run's outcome is not one to fit")
+                .hint("rerun it with a smaller time step (weft-simulate --dt-safety) or what its reason asks, or pass --skip-stopped to fit without it"))
+            }
+        }
+    }
+    Ok(kept)
 }
 
 /// The runs by group (in the groups' order: numeric when they all are), each group

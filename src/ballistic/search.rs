@@ -90,6 +90,8 @@ pub fn impact(m: &Model, v: f64, label: &str) -> Result<(Run, u64, f64)> {
                 elements: i64::try_from(stats.elements).ok(),
                 wall_time: Some(wall_time),
             },
+            // A run the solver stops is an error above, not a run.
+            stopped: None,
         },
         stats.steps,
         stats.end_time,

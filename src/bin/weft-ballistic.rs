@@ -95,6 +95,11 @@ struct FitArgs {
     /// The column that tells the groups apart (one limit per group).
     #[arg(long, default_value = "layers")]
     by: String,
+    /// Leave out the runs the solver stopped (`status = stopped` in their summary: NaN,
+    /// instability, an energy error), each named on stderr. Without it such a run is
+    /// refused: its outcome is not one to fit.
+    #[arg(long)]
+    skip_stopped: bool,
     #[command(flatten)]
     fit: FitOptions,
     /// Output folder for ballistic_runs.parquet and ballistic_limit.parquet.
@@ -235,10 +240,19 @@ fn fit(a: FitArgs) -> anyhow::Result<ExitCode> {
         Some(t) => runs::read_table(t, &a.by, &|row| format!("{} row {row}", t.display()))?,
         None => runs::read_folders(&a.runs, &a.by)?,
     };
+    let all = runs::leave_out_stopped(all, a.skip_stopped, &mut |r| {
+        eprintln!(
+            "  left out {} at {} m/s: the run stopped ({})",
+            r.source,
+            r.striking_velocity,
+            r.stopped.as_deref().unwrap_or_default()
+        )
+    })?;
     let groups = runs::group(all)?;
     let limits = limit::fit_groups(&groups, &a.by, &o)?;
     let params = serde_json::json!({
-        "runs": a.runs, "table": a.table, "by": a.by, "bootstrap": o.replicates, "seed": o.seed,
+        "runs": a.runs, "table": a.table, "by": a.by, "skip_stopped": a.skip_stopped,
+        "bootstrap": o.replicates, "seed": o.seed,
         "a_bounds": o.bounds.a, "p_bounds": o.bounds.p, "link": o.link.name(),
     });
     let by = GroupBy {

@@ -110,8 +110,8 @@ impl Solver {
         if e.balance_error_relative > a.max_energy_error && self.state.step >= ENERGY_CHECK_AFTER {
             return Err(WeftError::Numerical {
                 what: format!(
-                    "energy balance error {:.3e} J is {:.1} % of the reference energy {:.3e} J (limit {:.1} %): the run is unstable or a force is not conservative",
-                    e.balance_error, 100.0 * e.balance_error_relative, self.ledger.reference, 100.0 * a.max_energy_error
+                    "energy balance error {:.3e} J is {} of the reference energy {:.3e} J (limit {}, max_energy_error): the run is unstable or a force is not conservative",
+                    e.balance_error, percent(e.balance_error_relative), self.ledger.reference, percent(a.max_energy_error)
                 ),
                 step: self.state.step,
                 time: self.state.t,
@@ -122,5 +122,16 @@ impl Solver {
             });
         }
         Ok(())
+    }
+}
+
+/// A fraction as a percentage with three significant digits however small (0.1 → "10.0 %",
+/// 5e-6 → "4.99e-4 %"), so that a small limit does not read "0.0 %".
+fn percent(x: f64) -> String {
+    let p = 100.0 * x;
+    if p.abs() >= 0.1 || p == 0.0 {
+        format!("{p:.1} %")
+    } else {
+        format!("{p:.2e} %")
     }
 }
