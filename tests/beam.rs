@@ -105,8 +105,9 @@ fn cantilever_first_natural_frequency() {
     // Measured 5.1e-4 (40 elements, the period read from 4 zero crossings).
     assert!(rel(measured, w1) < 1e-3, "{measured} vs {w1}");
     let e = out.energy.last().unwrap();
+    // Energy balance: measured 1.52·10⁻⁴ of the energy at the end; tolerance 3.3×.
     assert!(
-        e.balance_error.abs() < 0.01 * (e.kinetic + e.internal),
+        e.balance_error.abs() < 5e-4 * (e.kinetic + e.internal),
         "{e:?}"
     );
 }

@@ -349,7 +349,8 @@ fn the_reduced_woven_model() {
         v > -0.999 * p.projectile_velocity,
         "the patch did not slow the projectile"
     );
-    assert!(e.balance_error.abs() < 0.01 * ke0, "{e:?}");
+    // Energy balance: measured 1.57·10⁻⁶ of the striking energy; tolerance 3.2×.
+    assert!(e.balance_error.abs() < 5e-6 * ke0, "{e:?}");
 }
 
 /// The striking speed is checked in one place (`model::striker::check_striking_speed`): both woven

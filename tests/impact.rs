@@ -150,5 +150,6 @@ fn hourglass_energy_stays_below_ten_percent_of_internal_energy_in_an_impact() {
         "hourglass energy reached {:.1} % of the internal energy",
         100.0 * worst
     );
-    assert!(e.balance_error.abs() < 0.01 * 0.5 * 2.5e-4 * 1e4, "{e:?}");
+    // Energy balance: measured 2.03·10⁻⁴ of the striking energy; tolerance 3×.
+    assert!(e.balance_error.abs() < 6e-4 * 0.5 * 2.5e-4 * 1e4, "{e:?}");
 }

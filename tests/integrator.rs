@@ -116,7 +116,8 @@ fn dashpot_decays_exponentially() {
     );
     // Dissipated energy equals the kinetic energy lost.
     let e = out.energy.last().unwrap();
-    assert!(e.balance_error.abs() / (0.5 * M * v0 * v0) < 0.01, "{e:?}");
+    // Measured 3.08·10⁻⁶ of the initial kinetic energy; tolerance 3.2×.
+    assert!(e.balance_error.abs() / (0.5 * M * v0 * v0) < 1e-5, "{e:?}");
 }
 
 #[test]
@@ -145,7 +146,11 @@ fn damped_oscillator_matches_closed_form() {
         v0 / w
     );
     let e = out.energy.last().unwrap();
-    assert!(e.balance_error.abs() / (0.5 * M * v0 * v0) < 0.01, "{e:?}");
+    // Measured 5.14·10⁻⁶ of the initial kinetic energy; tolerance 2.9×.
+    assert!(
+        e.balance_error.abs() / (0.5 * M * v0 * v0) < 1.5e-5,
+        "{e:?}"
+    );
 }
 
 #[test]

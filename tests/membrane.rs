@@ -87,7 +87,9 @@ fn measure(kind: ElementKind, p: PartProps, dir: usize, c_expect: f64) -> f64 {
     let ta = crossing(&out.t, &va, 0.5 * peak).unwrap();
     let tb = crossing(&out.t, &vb, 0.5 * peak).unwrap();
     let e = out.energy.last().unwrap();
-    assert!(e.balance_error.abs() < 0.01 * e.external_work, "{e:?}");
+    // Energy balance: measured at most 2.48·10⁻⁶ of the work done over the plane waves of
+    // this file (longitudinal, orthotropic, shear); tolerance 4×.
+    assert!(e.balance_error.abs() < 1e-5 * e.external_work, "{e:?}");
     0.1 / (tb - ta)
 }
 

@@ -181,7 +181,8 @@ fn free_projectile_on_a_pinned_string_conserves_momentum_and_energy() {
     eprintln!("momentum {ptot:.6e} vs {p0:.6e}; energy error {:.3e} of {ke0:.3e} J; projectile slowed to {:.1} m/s", e.balance_error, -out.projectile.last().unwrap().2[5]);
     assert!(pz_nodes.abs() > 0.05 * p0, "the string took up momentum");
     assert!(rel(ptot, p0) < 0.01, "momentum {ptot} vs {p0}");
-    assert!(e.balance_error.abs() < 0.01 * ke0, "{e:?}");
+    // Energy balance: measured 1.13·10⁻⁴ of the striking energy; tolerance 3.1×.
+    assert!(e.balance_error.abs() < 3.5e-4 * ke0, "{e:?}");
     assert!(e.contact > 0.0 || e.internal > 0.0);
 }
 
@@ -266,7 +267,8 @@ fn faces_stop_a_projectile_smaller_than_the_elements() {
         fmin >= 0.0,
         "the face pulled the projectile through ({fmin} N)"
     );
-    assert!(e.balance_error.abs() < 0.01 * 0.5 * 1e-4 * 1e4, "{e:?}");
+    // Energy balance: measured 1.16·10⁻³ of the striking energy; tolerance 3×.
+    assert!(e.balance_error.abs() < 3.5e-3 * 0.5 * 1e-4 * 1e4, "{e:?}");
     assert!(e.internal > 0.01, "the membrane was stretched: {e:?}");
 }
 

@@ -73,7 +73,8 @@ fn a_composite_model_round_trips_through_its_tables() {
         "{e:?}"
     );
     assert!(
-        e.balance_error.abs() < 0.01 * e.external_work.abs().max(0.5 * 1e-3 * 2500.0),
+        // Measured 1.06·10⁻³ of the energy scale; tolerance 2.8×.
+        e.balance_error.abs() < 3e-3 * e.external_work.abs().max(0.5 * 1e-3 * 2500.0),
         "{e:?}"
     );
     assert!(dir.path().join("out/projectile.parquet").exists());

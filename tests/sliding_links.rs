@@ -205,10 +205,16 @@ fn without_a_slider_the_link_is_a_spring_along_the_yarn() {
         e.balance_error_relative,
         s.operator().el.sliding_link.state[0].xi
     );
-    // Measured: 4.2·10⁻³ of the amplitude (the central difference's phase error over 1.25
-    // periods); energy balance 3.7·10⁻³ (its O((ωΔt)²) swing, ω the normal spring's).
+    // Measured: 3.1·10⁻³ of the amplitude (the central difference's phase error over 1.25
+    // periods); tolerance 1.6×. The energy balance, at its worst over the samples:
+    // 6.4·10⁻¹⁶, round-off (a linear spring's work booked step by step); tolerance 5×.
     assert!(err < 5e-3 * v0 / w);
-    assert!(e.balance_error_relative.abs() < 1e-2);
+    let worst = out
+        .energy
+        .iter()
+        .map(|e| e.balance_error_relative.abs())
+        .fold(0.0, f64::max);
+    assert!(worst < 3e-15, "balance {worst:e}");
     assert_eq!(s.operator().el.sliding_link.state[0].xi, [4.0, 1.0]);
 }
 
