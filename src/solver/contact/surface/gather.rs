@@ -57,7 +57,10 @@ fn for_each_contribution(p: &ChunkParts, mut each: impl FnMut(usize, [f64; 3])) 
         );
     }
     for r in p.reactions {
-        let f = &p.outs[r.slave as usize - p.first].f;
+        let f = r
+            .own
+            .as_ref()
+            .unwrap_or(&p.outs[r.slave as usize - p.first].f);
         let face = &p.faces[r.face as usize];
         for a in 0..p.nf {
             each(

@@ -69,10 +69,11 @@
 //!   fails; the pairs on them held ½ k g² and would have done a half step of work, which
 //!   a second narrow phase with the faces still in measures and the ledger books as
 //!   eroded energy (as `failure::taken_energy` does for the element itself). From the
-//!   first failure on, each slave's contact is its deepest face's alone, the exact
-//!   gradient of the ½ k g² booked: the shared normal and reaction above are not, and
-//!   broken yarn ends that slide through the crossings at hundreds of m/s gained energy
-//!   by them (`Side::deepest_only`).
+//!   first failure on, each face a slave penetrates is a pair of its own, k_F g_F
+//!   (n_F − ½∇t_F) on the slave and its reaction on the face, the exact gradient of the
+//!   Σ ½ k_F g_F² booked; friction acts along the resultant (`Side::per_face`). The
+//!   shared normal and reaction above are not a gradient, and broken yarn ends that
+//!   slide through the crossings at hundreds of m/s gained energy by them.
 //! - **determinism**: slaves are processed in parallel fixed chunks, each writing only its
 //!   own result slot and its chunk's list of reaction shares; the results are gathered
 //!   onto the nodes in chunk order (the slaves, then their reactions), so 1 and N threads
@@ -377,11 +378,11 @@ impl SurfaceContact {
 
     /// Element `e` of kind `kind` has failed: its faces (or segments) leave every side
     /// whose master surface they belong to, at the next force evaluation (which books
-    /// what they held into `eroded`); from now on every slave's contact is its deepest
-    /// face's alone (see [`Side::deepest_only`]).
+    /// what they held into `eroded`); from now on each face a slave penetrates is a
+    /// pair of its own (see [`Side::per_face`]).
     pub fn erode(&mut self, kind: ElementKind, e: usize) {
         for s in self.sides.iter_mut() {
-            s.deepest_only = true;
+            s.per_face = true;
             if s.master_kind == kind {
                 s.erode(e);
             }

@@ -157,7 +157,11 @@ struct Found {
 /// by 0.10 of the crossing force at the vertex's neighbours, and drifted when left alone).
 /// Scratch of a chunk of slaves (only the first `Found::n_pen` entries are read): declared
 /// once per chunk, not zeroed per slave.
-type Shares = [(u32, [f64; 4], f64); MAX_SHARED];
+type Shares = [Share; MAX_SHARED];
+
+/// A face a slave penetrates: (face, the foot's weights, g, the direction n − ½∇t_F of
+/// its own force −∂(½kg²)/∂x_s; the last read only by the per-face law).
+type Share = (u32, [f64; 4], f64, [f64; 3]);
 
 impl Found {
     /// Nothing found yet.
@@ -186,8 +190,13 @@ impl Found {
             tg,
             flat,
         } = hit;
+        let dir = if dist > 0.0 {
+            std::array::from_fn(|d| r[d] / dist - 0.5 * tg[d])
+        } else {
+            flat
+        };
         if self.n_pen < MAX_SHARED {
-            pen[self.n_pen] = (fi, w, g);
+            pen[self.n_pen] = (fi, w, g, dir);
             self.n_pen += 1;
         } else {
             // Full: replace the shallowest (the first of equals).
@@ -198,7 +207,7 @@ impl Found {
                 }
             }
             if g > pen[k].2 {
-                pen[k] = (fi, w, g);
+                pen[k] = (fi, w, g, dir);
             }
         }
         if dist > 0.0 {
@@ -218,28 +227,6 @@ impl Found {
             self.best = Some((fi, g, n));
             self.best_w = w;
             self.best_tg = if dist > 0.0 { tg } else { [0.0; 3] };
-        }
-    }
-
-    /// The deepest face alone (the law after a failure, see [`Side::deepest_only`]): its
-    /// share the whole reaction, its normal and thickness gradient the sums', so that the
-    /// force is −∂(½kg²)/∂x of its penetration g.
-    fn deepest(&self, pen: &mut Shares) -> Found {
-        let (fi, g, n) = self.best.expect("a penetrated face");
-        pen[0] = (fi, self.best_w, g);
-        Found {
-            best: self.best,
-            best_w: self.best_w,
-            best_tg: self.best_tg,
-            n_sum: [g * n[0], g * n[1], g * n[2]],
-            n_count: 1,
-            tg_sum: [
-                g * self.best_tg[0],
-                g * self.best_tg[1],
-                g * self.best_tg[2],
-            ],
-            g_sum: g,
-            n_pen: 1,
         }
     }
 }
@@ -279,8 +266,8 @@ struct Narrow<'a> {
     eta: f64,
     /// A solid's faces: their contact thickness t_F (see [`super::solid`]; 0 otherwise).
     solid_t: f64,
-    /// The deepest face alone takes the contact (see [`Side::deepest_only`]).
-    deepest_only: bool,
+    /// Every penetrated face is a pair of its own (see [`Side::per_face`]).
+    per_face: bool,
     /// Nodes per face, and whether the faces are a solid's (one-sided).
     nf: usize,
     one_sided: bool,
@@ -373,7 +360,7 @@ impl Side {
             on_initial,
             box_margin,
             solid,
-            deepest_only,
+            per_face,
             nf,
             ref mut out,
             ref mut state,
@@ -409,7 +396,7 @@ impl Side {
             keep: on_initial == InitialPenetration::Keep,
             eta: box_margin,
             solid_t: solid.unwrap_or(0.0),
-            deepest_only,
+            per_face,
             nf,
             one_sided: solid.is_some(),
         };
@@ -516,7 +503,7 @@ impl Narrow<'_> {
         *sums = ChunkSums::default();
         // Scratch of the slaves (only the first n_pen, nn entries are read):
         // declared once per chunk, not zeroed per slave.
-        let mut pen: Shares = [(0u32, [0.0f64; 4], 0.0f64); MAX_SHARED];
+        let mut pen: Shares = [(0u32, [0.0f64; 4], 0.0f64, [0.0f64; 3]); MAX_SHARED];
         let mut near = [0u32; 32];
         // (A slave that is open and holds no state is not written: its output is
         // read only while it is in contact, and its state is the default one. At the
@@ -543,7 +530,7 @@ impl Narrow<'_> {
                 continue;
             }
             let s = self.slaves[si] as usize;
-            let mut found = self.search::<NF, SOLID>(si, &self.x[s], &mut near, &mut pen, sums);
+            let found = self.search::<NF, SOLID>(si, &self.x[s], &mut near, &mut pen, sums);
             let mut out = PairOut {
                 face: u32::MAX,
                 ..Default::default()
@@ -569,10 +556,11 @@ impl Narrow<'_> {
             }
             let g = g_raw - st.g0;
             match found.best {
+                Some((fi, _, _)) if g > 0.0 && self.per_face => {
+                    let pen = &pen[..found.n_pen];
+                    out = self.per_face_contact::<NF>(si, s, fi, pen, st, reactions);
+                }
                 Some((fi, _, n)) if g > 0.0 => {
-                    if self.deepest_only {
-                        found = found.deepest(&mut pen);
-                    }
                     // Shares λ_F = g_F/Σg of the penetrated faces.
                     let pen = &pen[..found.n_pen];
                     let g_pen: f64 = pen.iter().map(|e| e.2).sum();
@@ -681,7 +669,7 @@ impl Narrow<'_> {
         mut n: [f64; 3],
         g: f64,
         found: &Found,
-        pen: &[(u32, [f64; 4], f64)],
+        pen: &[Share],
         g_pen: f64,
         st: &mut SlaveState,
     ) -> PairOut {
@@ -729,15 +717,130 @@ impl Narrow<'_> {
         }
     }
 
+    /// The contact of slave `si` (node `s`, deepest face `fi`) under the per-face law
+    /// ([`Side::per_face`]): each face F it penetrates (`pen`) by g_F (beyond its tracked
+    /// initial depth g₀) is a pair of its own, the penalty k_F = κ_c min(m_s, m_F)/Δt² of
+    /// its foot's mass, its force k_F g_F (n_F − ½∇t_F) = −∂(½k_F g_F²)/∂x_s and its
+    /// nodes the reaction by the foot's weights: the forces are the exact gradient of the
+    /// stored Σ ½ k_F g_F², whatever the faces' normals. Friction (and the normal
+    /// dashpot) act along the resultant's direction n̄ with f_n its length, against the
+    /// λ-weighted foot (λ_F = g_F/Σg) as the shared law's, the deepest face's k for the
+    /// stick spring; their reaction is shared in λ_F.
+    #[inline(always)]
+    fn per_face_contact<const NF: usize>(
+        &self,
+        si: usize,
+        s: usize,
+        fi: u32,
+        pen: &[Share],
+        st: &mut SlaveState,
+        reactions: &mut Vec<Reaction>,
+    ) -> PairOut {
+        let ms = self.slave_m[si];
+        let at = reactions.len();
+        let (mut fsum, mut stored_n, mut g_pen) = ([0.0f64; 3], 0.0f64, 0.0f64);
+        let (mut g_best, mut k_best, mut m_best) = (0.0f64, 0.0f64, 0.0f64);
+        for &(fj, wj, gj, dir) in pen {
+            let g = gj - st.g0;
+            if !(g > 0.0) {
+                continue;
+            }
+            let fm = &self.face_m[fj as usize];
+            let mf: f64 = (0..NF).map(|a| wj[a] * fm[a]).sum();
+            let mstar = if ms > 0.0 { ms.min(mf) } else { mf };
+            let k = self.kappa * mstar / self.dt2;
+            let own: [f64; 3] = std::array::from_fn(|d| k * g * dir[d]);
+            for d in 0..3 {
+                fsum[d] += own[d];
+            }
+            stored_n += 0.5 * k * g * g;
+            g_pen += g;
+            if g > g_best {
+                (g_best, k_best, m_best) = (g, k, mstar);
+            }
+            reactions.push(Reaction {
+                slave: si as u32,
+                face: fj,
+                w: wj,
+                own: Some(own),
+            });
+        }
+        let fn_ = dot(&fsum, &fsum).sqrt();
+        if !(k_best > 0.0 && fn_ > 0.0) {
+            // Massless pairs (tie slaves): no force, as `pair_force` gives them.
+            reactions.truncate(at);
+            return PairOut {
+                face: u32::MAX,
+                dissipated: release(st),
+                ..Default::default()
+            };
+        }
+        let nbar = [fsum[0] / fn_, fsum[1] / fn_, fsum[2] / fn_];
+        // The foot in the shares λ_F = g_F/Σg of the faces that push.
+        let (mut vf, mut lam) = ([0.0f64; 3], [0.0f64; MAX_SHARED]);
+        for (j, &(fj, wj, gj, _)) in pen.iter().enumerate() {
+            let g = gj - st.g0;
+            if !(g > 0.0) {
+                continue;
+            }
+            lam[j] = g / g_pen;
+            let fnodes = &self.faces[fj as usize];
+            for a in 0..NF {
+                let va = &self.v[fnodes[a] as usize];
+                for d in 0..3 {
+                    vf[d] += lam[j] * wj[a] * va[d];
+                }
+            }
+        }
+        let vr = sub(&self.v[s], &vf);
+        let vn = dot(&vr, &nbar);
+        let vt = [
+            vr[0] - vn * nbar[0],
+            vr[1] - vn * nbar[1],
+            vr[2] - vn * nbar[2],
+        ];
+        // Friction through the pair kernel at the penetration that gives f_n with the
+        // deepest face's k; its normal part, ½ k g², replaced by the faces' own.
+        let g_eff = fn_ / k_best;
+        let (force, stored_pf, mut diss) =
+            pair_force(g_eff, &nbar, k_best, &vt, self.dt_prev, &self.fr, st);
+        let mut shared: [f64; 3] = std::array::from_fn(|d| force[d] - fn_ * nbar[d]);
+        if self.zeta > 0.0 {
+            let c = 2.0 * self.zeta * (k_best * m_best).sqrt();
+            let fd = (-c * vn).max(-fn_);
+            for d in 0..3 {
+                shared[d] += fd * nbar[d];
+            }
+            diss -= fd * vn * self.dt_prev;
+        }
+        let mut j = 0;
+        for (i, &(_, _, gj, _)) in pen.iter().enumerate() {
+            if gj - st.g0 > 0.0 {
+                let r = &mut reactions[at + j];
+                for d in 0..3 {
+                    r.own.as_mut().expect("own force")[d] += lam[i] * shared[d];
+                }
+                j += 1;
+            }
+        }
+        PairOut {
+            face: fi,
+            f: std::array::from_fn(|d| fsum[d] + shared[d]),
+            stored: stored_pf - 0.5 * k_best * g_eff * g_eff + stored_n,
+            dissipated: diss,
+            g: g_best,
+        }
+    }
+
     /// The foot's mass and velocity: over the penetrated faces `pen` (of total
     /// penetration `g_pen`) in the shares λ_F = g_F/Σg, their nodes' masses and
     /// velocities interpolated at their feet, so that the penalty and the friction slip
     /// are continuous as faces come and go, and the power of the shared reaction is
     /// −f·v_foot.
     #[inline(always)]
-    fn foot<const NF: usize>(&self, pen: &[(u32, [f64; 4], f64)], g_pen: f64) -> (f64, [f64; 3]) {
+    fn foot<const NF: usize>(&self, pen: &[Share], g_pen: f64) -> (f64, [f64; 3]) {
         let (mut mf, mut vf) = (0.0f64, [0.0f64; 3]);
-        for &(fj, wj, gj) in pen {
+        for &(fj, wj, gj, _) in pen {
             let lam = gj / g_pen;
             let fn_ = &self.faces[fj as usize];
             let fm = &self.face_m[fj as usize];
@@ -756,19 +859,14 @@ impl Narrow<'_> {
     /// The shares of slave `si`'s reaction over the faces it penetrates (`pen`, of total
     /// penetration `g_pen`), in the same shares λ_F = g_F/Σg as its foot.
     #[inline(always)]
-    fn share_reaction(
-        &self,
-        si: usize,
-        pen: &[(u32, [f64; 4], f64)],
-        g_pen: f64,
-        reactions: &mut Vec<Reaction>,
-    ) {
-        for &(fj, wj, gj) in pen {
+    fn share_reaction(&self, si: usize, pen: &[Share], g_pen: f64, reactions: &mut Vec<Reaction>) {
+        for &(fj, wj, gj, _) in pen {
             let lam = gj / g_pen;
             reactions.push(Reaction {
                 slave: si as u32,
                 face: fj,
                 w: std::array::from_fn(|a| lam * wj[a]),
+                own: None,
             });
         }
     }
