@@ -22,7 +22,7 @@
 //!   narrow phases can read: the equality checks that too.
 //!
 //! Models: a band patch, a chain patch, two chain layers (contact between the layers),
-//! a chain patch whose yarns fail and are perforated (erosion, the deepest-face law, the
+//! a chain patch whose yarns fail and are perforated (erosion, the per-face law, the
 //! erosion probe), and a chain patch struck by a deformable bullet (a solid's boundary
 //! faces as the master surface); and two chain layers whose master surfaces each serve
 //! sides of two reaches.
