@@ -440,6 +440,13 @@ part_properties! {
         aliases: [],
         meaning: "delay τ of the failure: the strain is compared after a low-pass filter dε̄/dt = (ε − ε̄)/τ, so that the transient of a discrete yarn struck by a nose (its first elements overshoot the strain of Smith's theory by about 40 % for a few steps) does not break it",
     },
+    failure_length: f64 {
+        unit: "m",
+        kinds: [Truss: Rule::NonNegative],
+        null: null("0", "each truss's own strain is compared with the failure strain"),
+        aliases: [],
+        meaning: "length ℓ of yarn a chain's strain is averaged over before it is compared with the failure strain: each truss's is the length-weighted mean over the trusses of its chain (the part's trusses joined end to end) within ℓ/2 of its centre, so that the few elements a discrete yarn overshoots under a nose do not break it, whatever the mesh (weft-weave: the crossing spacing)",
+    },
     failure_force: f64 {
         unit: "N",
         kinds: [Link: Rule::Positive],

@@ -33,6 +33,7 @@
 //! of threads. Buffers are allocated once at setup; the step allocates nothing.
 
 pub mod beam;
+pub mod chain_strain;
 pub mod collapse;
 pub mod contact;
 pub mod energy;

@@ -82,6 +82,7 @@ pub fn strain_and_rate(
     ((l - l0) / l0, rate)
 }
 
+use super::chain_strain::Windows;
 use super::failure::{taken_energy, Criterion, Erosion, Failure, FailureLaw};
 use super::family::{
     chunk_partials, for_chunks, for_chunks_of, Build, EnergyGroup, EnergyPartial, Family, ForceCtx,
@@ -103,6 +104,9 @@ pub struct TrussGroup {
     pub tension_only: Vec<bool>,
     /// Failure laws and fates (empty when no truss can fail).
     pub erosion: Erosion,
+    /// The windows over which a chain's strain is averaged for its failure (empty when
+    /// no part has a `failure_length`; see [`super::chain_strain`]).
+    pub windows: Windows,
     partials: Vec<EnergyPartial>,
 }
 
@@ -131,8 +135,29 @@ impl TrussGroup {
             l0,
             tension_only,
             erosion,
+            windows,
             ..
         } = self;
+        if !windows.is_empty() {
+            // Every truss's own strain first (in element order: the same bits on any
+            // thread count), then each compares its window's mean.
+            for (e, own) in windows.own.iter_mut().enumerate() {
+                let [a, b] = nodes[e];
+                *own = if erosion.fate[e].eroded {
+                    f64::NAN
+                } else {
+                    strain_and_rate(
+                        &x[a as usize],
+                        &x[b as usize],
+                        &v[a as usize],
+                        &v[b as usize],
+                        l0[e],
+                    )
+                    .0
+                };
+            }
+        }
+        let windows = &*windows;
         let Erosion { law, fate, any, .. } = erosion;
         let (nodes, k, l0, tension_only, law, any) =
             (&*nodes, &*k, &*l0, &*tension_only, &*law, &*any);
@@ -152,7 +177,10 @@ impl TrussGroup {
                     let (a, b) = (a as usize, b as usize);
                     let lw = &law[e];
                     if lw.can_fail() {
-                        let (eps, rate) = strain_and_rate(&x[a], &x[b], &v[a], &v[b], l0[e]);
+                        let (mut eps, rate) = strain_and_rate(&x[a], &x[b], &v[a], &v[b], l0[e]);
+                        if !windows.is_empty() {
+                            eps = windows.mean(e);
+                        }
                         let eps = lw.filter(eps, ctx.dt_prev, &mut fate.filtered[0]);
                         let limit = lw.threshold(rate);
                         if eps >= limit {
@@ -203,6 +231,11 @@ impl Family for TrussGroup {
             return Ok(g);
         };
         let mut laws = Vec::with_capacity(b.len());
+        let length: Vec<f64> = m
+            .parts
+            .iter()
+            .map(|p| p.props.failure_length.unwrap_or(0.0))
+            .collect();
         for e in 0..b.len() {
             let p = &m.parts[b.part[e]].props;
             let (a, c) = (b.nodes[2 * e], b.nodes[2 * e + 1]);
@@ -226,6 +259,9 @@ impl Family for TrussGroup {
             laws.push(failure_law(p, b.failure_factor(e)));
         }
         g.erosion = Erosion::new(laws);
+        if g.erosion.active() {
+            g.windows = Windows::new(&g.nodes, &g.l0, &b.part, &length);
+        }
         Ok(g)
     }
     fn len(&self) -> usize {

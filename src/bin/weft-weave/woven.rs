@@ -111,6 +111,10 @@ pub struct WovenBandArgs {
     /// The rate law's reference rate ε̇₀ [1/s].
     #[arg(long, default_value_t = YarnFailure::default().reference_rate)]
     failure_reference_rate: f64,
+    /// Length of yarn [m] a chain's strain is averaged over before it is compared with
+    /// the failure strain (chains only) [default: 0, each element's own].
+    #[arg(long)]
+    failure_length: Option<f64>,
     #[command(flatten)]
     ballistic: BallisticArgs,
 }
@@ -163,6 +167,7 @@ impl WovenBandArgs {
                 reference_rate: self.failure_reference_rate,
                 delay: self.ballistic.failure_delay,
                 contact_damping: self.ballistic.projectile_contact_damping,
+                length: self.failure_length,
             },
             stop_on_outcome: self.ballistic.stop_on_outcome,
             // (Checked in `weave`, before the model is built.)

@@ -309,6 +309,9 @@ fn tag_yarns(m: &mut Model, p: &WovenBandParams, w: &yarns::Weave, b: &Built) {
                 let props = &mut m.parts[part].props;
                 props.failure_strain = Some(f.strain);
                 props.failure_delay = Some(p.failure_delay());
+                if w.section.chain {
+                    props.failure_length = f.length.filter(|&l| l > 0.0);
+                }
                 if f.rate_coefficient > 0.0 {
                     props.failure_rate_coefficient = Some(f.rate_coefficient);
                     props.failure_reference_rate = Some(f.reference_rate);

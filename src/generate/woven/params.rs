@@ -67,6 +67,9 @@ pub struct YarnFailure {
     pub delay: Option<f64>,
     /// The projectile's contact damping ζ (None: 0.5 when the yarns can fail, else 0).
     pub contact_damping: Option<f64>,
+    /// Length ℓ of yarn a chain's strain is averaged over for its failure [m]
+    /// (`failure_length` in docs/tables.md; None: 0, each element's own strain).
+    pub length: Option<f64>,
 }
 
 impl Default for YarnFailure {
@@ -83,6 +86,7 @@ impl Default for YarnFailure {
             reference_rate: 1.0,
             delay: None,
             contact_damping: None,
+            length: None,
         }
     }
 }
