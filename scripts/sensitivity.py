@@ -25,12 +25,26 @@ import sys
 import pyarrow as pa
 import pyarrow.parquet as pq
 
+# The regularisations off: no failure delay, no contact damping at the nose.
+OFF = ["--failure-delay", "0", "--projectile-contact-damping", "0"]
+
 # (name, group, weft-weave flags changed from the base). The default failure delay is ten
 # element transits (0.335 us on the default mesh), the contact damping 0.5.
 CASES = [
     ("default", "mesh", []),
     ("8 elements a spacing", "mesh", ["--per-spacing", "8"]),
     ("16 elements a spacing", "mesh", ["--per-spacing", "16"]),
+    ("nonlocal: 4 elements a spacing", "nonlocal", ["--failure-length", "0.001"] + OFF),
+    (
+        "nonlocal: 8 elements a spacing",
+        "nonlocal",
+        ["--failure-length", "0.001", "--per-spacing", "8"] + OFF,
+    ),
+    (
+        "nonlocal: 16 elements a spacing",
+        "nonlocal",
+        ["--failure-length", "0.001", "--per-spacing", "16"] + OFF,
+    ),
     ("time-step safety 0.45", "numerical", ["--dt-safety", "0.45"]),
     ("failure delay x2", "numerical", ["--failure-delay", "6.708203932499369e-07"]),
     ("failure delay x1/2", "numerical", ["--failure-delay", "1.6770509831248424e-07"]),
@@ -45,8 +59,8 @@ CASES = [
     ("yarn friction 0", "physical", ["--friction", "0"]),
     ("yarn friction 0.3", "physical", ["--friction", "0.3"]),
     ("projectile friction 0", "physical", ["--projectile-friction", "0"]),
-    ("span 0.025 m", "physical", ["--membrane-length", "0.025"]),
-    ("span 0.1 m", "physical", ["--membrane-length", "0.1"]),
+    ("membrane to 0.025 m (panel 0.05 m)", "physical", ["--membrane-length", "0.025"]),
+    ("membrane to 0.1 m (panel 0.2 m)", "physical", ["--membrane-length", "0.1"]),
     ("patch 15 yarns", "physical", ["--yarns", "15"]),
 ]
 
@@ -114,7 +128,9 @@ def main():
     p.add_argument("--lo", type=float, default=15.0)
     p.add_argument("--hi", type=float, default=80.0)
     p.add_argument("--tolerance", type=float, default=1.0)
-    p.add_argument("--cases", default="mesh,numerical,physical", help="groups to run")
+    p.add_argument(
+        "--cases", default="mesh,nonlocal,numerical,physical", help="groups to run"
+    )
     a = p.parse_args()
     groups = a.cases.split(",")
     rows = []
@@ -123,7 +139,8 @@ def main():
             continue
         if name == "patch 15 yarns" and a.yarns != 8:
             continue
-        folder = os.path.join(a.out, f"{a.layers}ply", name.replace(" ", "_").replace("/", "-"))
+        slug = "".join(c if c.isalnum() or c in ".-" else "_" for c in name)
+        folder = os.path.join(a.out, f"{a.layers}ply", slug)
         r = one_case(a, name, flags, folder)
         r.update(group=group, layers=a.layers)
         rows.append(r)

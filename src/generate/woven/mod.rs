@@ -205,6 +205,15 @@ fn check_failure(f: &YarnFailure) -> Result<()> {
     if !(f.reference_rate.is_finite() && f.reference_rate > 0.0) {
         return bad("failure-reference-rate", f.reference_rate, "ε̇₀ > 0 in 1/s");
     }
+    if let Some(l) = f.length {
+        if !(l.is_finite() && l >= 0.0) {
+            return bad(
+                "failure-length",
+                l,
+                "a length ≥ 0 in m of yarn to average the strain over (0: none)",
+            );
+        }
+    }
     check_delay_and_damping(f.delay, f.contact_damping)
 }
 
