@@ -37,6 +37,15 @@ impl Solver {
                 r[7] = r[7].max(dot(&u, &axis));
             }
         }
+        // The yarn-to-yarn contact springs: a pair's stored energy to its slave's layer.
+        for side in &self.op.surfaces.sides {
+            for (o, &s) in side.out.iter().zip(&side.slaves) {
+                let l = w.node_layer(s as usize) as usize;
+                if l > 0 && o.face != u32::MAX {
+                    rows[l - 1][1] += o.stored;
+                }
+            }
+        }
         self.op.el.for_layer_energies(xn, |kind, e, energies| {
             let l = w.element_layer(kind, e) as usize;
             if l > 0 {
