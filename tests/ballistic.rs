@@ -825,6 +825,117 @@ fn the_search_costs_what_weft_simulate_runs_cost() {
     );
 }
 
+/// An impact undecided at the model's end time is run again with twice the end time.
+/// The 4 × 4 patch woven to end at 30 µs: at 400 m/s it is perforated at 24 µs, within
+/// the end time; at 40 m/s it is arrested at 98 µs (weft-simulate with a 1 ms end time),
+/// so the search runs it to 30 µs, to 60 µs (both undecided) and to 120 µs, where it
+/// decides. Its outcome and simulated time are those of weft-simulate on the patch woven
+/// to end at 120 µs, its steps the sum of weft-simulate's to 30 µs, to 60 µs and to the
+/// outcome. With `--extensions 1` the search stops at 60 µs, naming the impact.
+#[test]
+fn an_undecided_impact_is_run_again_with_twice_the_end_time() {
+    use weft::table::Table;
+    let dir = tempfile::tempdir().unwrap();
+    let weave = |name: &str, end: &str| {
+        let m = dir.path().join(name);
+        run_ok(
+            WEAVE,
+            &[
+                "woven",
+                "--yarns",
+                "4",
+                "--yarn-model",
+                "chain",
+                "--failure-strain",
+                "0.036",
+                "--stop-on-outcome",
+                "--end-time",
+                end,
+                "--out",
+                m.to_str().unwrap(),
+            ],
+        );
+        m
+    };
+    let short = weave("short", "3e-5");
+    let out = dir.path().join("search");
+    let search = |extensions: &str| {
+        std::process::Command::new(BALLISTIC)
+            .args([
+                "search",
+                "--model",
+                short.to_str().unwrap(),
+                "--lo",
+                "40",
+                "--hi",
+                "400",
+                "--tolerance",
+                "1000",
+                "--per-round",
+                "2",
+                "--max-rounds",
+                "1",
+                "--threads",
+                "1",
+                "--bootstrap",
+                "10",
+                "--extensions",
+                extensions,
+                "--out",
+                out.to_str().unwrap(),
+            ])
+            .output()
+            .unwrap()
+    };
+    let o = search("1");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success(), "{err}");
+    assert!(
+        err.contains(
+            "the impact at 40 m/s was neither arrested nor free of the fabric by 6.000e-5 s"
+        ),
+        "{err}"
+    );
+    assert!(!out.join("ballistic_runs.parquet").exists());
+
+    let o = search("2");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let t = Table::read(&out.join("ballistic_runs.parquet")).unwrap();
+    assert_eq!(t.f64("striking_velocity", "").unwrap(), vec![40.0, 400.0]);
+    let outcome = t.str("outcome", "").unwrap();
+    let (steps, sim) = (opt_i(&t, "steps"), opt_f(&t, "simulated_time"));
+    let summary = |model: &std::path::Path, v: f64, name: &str| {
+        let r = dir.path().join(name);
+        simulate(model, &r, v);
+        let s = Table::read(&r.join("summary.parquet")).unwrap();
+        (
+            s.i64("steps", "").unwrap()[0],
+            s.f64("end_time", "").unwrap()[0],
+            s.str("outcome", "").unwrap()[0].clone(),
+        )
+    };
+    let double = weave("double", "6e-5");
+    let long = weave("long", "1.2e-4");
+    let (n1, t1, o1) = summary(&short, 40.0, "s40");
+    let (n2, t2, o2) = summary(&double, 40.0, "d40");
+    let (n4, t4, o4) = summary(&long, 40.0, "l40");
+    println!("40 m/s: {n1} steps to {t1:e} s ({o1}), {n2} to {t2:e} ({o2}), {n4} to {t4:e} ({o4}); search {:?} steps, {:?} s", steps[0], sim[0]);
+    assert_eq!(
+        (o1.as_str(), o2.as_str(), o4.as_str()),
+        ("undecided", "undecided", "arrested")
+    );
+    assert_eq!(outcome[0], "arrested");
+    assert_eq!(sim[0], Some(t4));
+    assert_eq!(steps[0], Some(n1 + n2 + n4));
+    // The perforation at 400 m/s decided within the model's own end time: one attempt.
+    let (n, end, o400) = summary(&short, 400.0, "s400");
+    assert_eq!(
+        (outcome[1].as_str(), o400.as_str()),
+        ("perforated", "perforated")
+    );
+    assert_eq!((steps[1], sim[1]), (Some(n), Some(end)));
+}
+
 /// A search names its group by the model folder, as text whatever the name reads like:
 /// a search over `models/6` and one over `models/reference` gather into one table
 /// (`weft gather` refuses instances whose columns differ in type), so `model` is a string

@@ -152,6 +152,11 @@ struct SearchArgs {
     /// At most this many rounds.
     #[arg(long, default_value_t = 12)]
     max_rounds: usize,
+    /// An impact still undecided at the model's end time (near the limit a nose can drag
+    /// through the broken yarns for long) is run again with twice the end time, at most
+    /// this many times.
+    #[arg(long, default_value_t = 2)]
+    extensions: usize,
     /// Worker threads [default: all cores]. Results do not depend on it.
     #[arg(long)]
     threads: Option<usize>,
@@ -276,6 +281,7 @@ fn search_cmd(a: SearchArgs) -> anyhow::Result<ExitCode> {
         tolerance: a.tolerance,
         per_round,
         max_rounds: a.max_rounds,
+        extensions: a.extensions,
     };
     let impacts = pool.install(|| {
         search::search(&m, &so, |round, lo, hi| {
@@ -298,7 +304,7 @@ fn search_cmd(a: SearchArgs) -> anyhow::Result<ExitCode> {
     let limits = limit::fit_groups(&groups, "model", &o)?;
     let params = serde_json::json!({
         "model": a.model, "lo": a.lo, "hi": a.hi, "tolerance": a.tolerance,
-        "per_round": per_round, "max_rounds": a.max_rounds, "bootstrap": o.replicates, "seed": o.seed,
+        "per_round": per_round, "max_rounds": a.max_rounds, "extensions": a.extensions, "bootstrap": o.replicates, "seed": o.seed,
         "a_bounds": o.bounds.a, "p_bounds": o.bounds.p, "link": o.link.name(),
     });
     // The model folder's name, as text whatever it reads like, so that every search's
