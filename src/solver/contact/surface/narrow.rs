@@ -740,11 +740,14 @@ impl Narrow<'_> {
         let at = reactions.len();
         let (mut fsum, mut stored_n, mut g_pen) = ([0.0f64; 3], 0.0f64, 0.0f64);
         let (mut g_best, mut k_best, mut m_best) = (0.0f64, 0.0f64, 0.0f64);
-        for &(fj, wj, gj, dir) in pen {
+        // Each face's penetration beyond g₀ where it pushes, 0 where it does not.
+        let mut gs = [0.0f64; MAX_SHARED];
+        for (j, &(fj, wj, gj, dir)) in pen.iter().enumerate() {
             let g = gj - st.g0;
             if !(g > 0.0) {
                 continue;
             }
+            gs[j] = g;
             let fm = &self.face_m[fj as usize];
             let mf: f64 = (0..NF).map(|a| wj[a] * fm[a]).sum();
             let mstar = if ms > 0.0 { ms.min(mf) } else { mf };
@@ -766,7 +769,7 @@ impl Narrow<'_> {
             });
         }
         let fn_ = dot(&fsum, &fsum).sqrt();
-        if !(k_best > 0.0 && fn_ > 0.0) {
+        if !(k_best > 0.0) {
             // Massless pairs (tie slaves): no force, as `pair_force` gives them.
             reactions.truncate(at);
             return PairOut {
@@ -775,15 +778,26 @@ impl Narrow<'_> {
                 ..Default::default()
             };
         }
+        if !(fn_ > 0.0) {
+            // The faces' pushes cancel exactly on the slave: no direction for friction,
+            // which lets go; the faces keep their own reactions and the springs their
+            // energy.
+            return PairOut {
+                face: fi,
+                f: fsum,
+                stored: stored_n,
+                dissipated: release(st),
+                g: g_best,
+            };
+        }
         let nbar = [fsum[0] / fn_, fsum[1] / fn_, fsum[2] / fn_];
         // The foot in the shares λ_F = g_F/Σg of the faces that push.
         let (mut vf, mut lam) = ([0.0f64; 3], [0.0f64; MAX_SHARED]);
-        for (j, &(fj, wj, gj, _)) in pen.iter().enumerate() {
-            let g = gj - st.g0;
-            if !(g > 0.0) {
+        for (j, &(fj, wj, _, _)) in pen.iter().enumerate() {
+            if !(gs[j] > 0.0) {
                 continue;
             }
-            lam[j] = g / g_pen;
+            lam[j] = gs[j] / g_pen;
             let fnodes = &self.faces[fj as usize];
             for a in 0..NF {
                 let va = &self.v[fnodes[a] as usize];
@@ -814,8 +828,8 @@ impl Narrow<'_> {
             diss -= fd * vn * self.dt_prev;
         }
         let mut j = 0;
-        for (i, &(_, _, gj, _)) in pen.iter().enumerate() {
-            if gj - st.g0 > 0.0 {
+        for i in 0..pen.len() {
+            if gs[i] > 0.0 {
                 let r = &mut reactions[at + j];
                 for d in 0..3 {
                     r.own.as_mut().expect("own force")[d] += lam[i] * shared[d];
