@@ -258,8 +258,10 @@ pub struct ProjectileContact {
     pub node_friction: Option<Vec<f64>>,
     /// Work done by projectiles with prescribed velocity [J].
     pub prescribed_work: f64,
-    /// Directions normal to the symmetry planes: projectiles cannot move along them.
-    fixed: [bool; 3],
+    /// Per projectile, the directions normal to the symmetry planes through its tip: it
+    /// cannot move along them (a plane elsewhere, a clay box's wall or floor, leaves it
+    /// free).
+    fixed: Vec<[bool; 3]>,
     /// Per projectile, the face triangles (indices into `face_tris`) that may touch its
     /// spherical nose, with the node positions and nose centres they were listed at.
     near: Vec<Vec<u32>>,
@@ -356,7 +358,17 @@ impl ProjectileContact {
             pending: vec![],
             node_friction: None,
             prescribed_work: 0.0,
-            fixed: std::array::from_fn(|d| m.symmetry.iter().any(|sp| sp.normal == d)),
+            fixed: m
+                .projectiles
+                .iter()
+                .map(|p| {
+                    std::array::from_fn(|d| {
+                        m.symmetry.iter().any(|sp| {
+                            sp.normal == d && (sp.position - p.tip[d]).abs() <= sp.tolerance
+                        })
+                    })
+                })
+                .collect(),
             near: vec![],
             near_x: vec![],
             near_c: vec![],
@@ -727,20 +739,15 @@ impl ProjectileContact {
     /// kinetic energy at t_n (free ones) and keeps their velocity at t_n in `v_full`.
     pub fn advance(&mut self, dt_prev: f64, dt_next: f64) -> f64 {
         let mut ke = 0.0;
-        for p in self.projectiles.iter_mut() {
+        for (p, fixed) in self.projectiles.iter_mut().zip(&self.fixed) {
             if p.prescribed {
                 // The work the imposed motion does on the system.
                 self.prescribed_work -= dt_next * dot(&p.force, &p.v);
                 p.v_full = p.v;
             } else {
                 // In a symmetric model the projectile stays on the symmetry planes.
-                let a: [f64; 3] = std::array::from_fn(|d| {
-                    if self.fixed[d] {
-                        0.0
-                    } else {
-                        p.force[d] / p.mass
-                    }
-                });
+                let a: [f64; 3] =
+                    std::array::from_fn(|d| if fixed[d] { 0.0 } else { p.force[d] / p.mass });
                 let vn: [f64; 3] = std::array::from_fn(|d| p.v[d] + 0.5 * dt_prev * a[d]);
                 let v_new: [f64; 3] = std::array::from_fn(|d| vn[d] + 0.5 * dt_next * a[d]);
                 // ½ M v^{n−½}·v^{n+½}, as the nodes' (`integrator::advance_nodes`).
