@@ -6,6 +6,7 @@
 //! The physics and the practice behind them: docs/theory.md, "Failure, perforation and
 //! the ballistic limit".
 
+pub mod clay;
 pub mod lambert_jonas;
 pub mod limit;
 pub mod probability;

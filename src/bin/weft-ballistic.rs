@@ -1,5 +1,6 @@
 //! `weft-ballistic`: ballistic limits from impact runs (`fit`), or by running the impacts
-//! (`search`), and the failed zone of impact runs (`zone`).
+//! (`search`), the failed zone of impact runs (`zone`), and the backing clay's drop
+//! calibration (`clay-calibration`).
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -9,7 +10,7 @@ use weft::ballistic::lambert_jonas::Bounds;
 use weft::ballistic::limit::{self, Options};
 use weft::ballistic::probability::Link;
 use weft::ballistic::runs::{GroupBy, GroupType};
-use weft::ballistic::{runs, search, zone};
+use weft::ballistic::{clay, runs, search, zone};
 use weft::table::Provenance;
 
 #[derive(Parser)]
@@ -67,6 +68,35 @@ enum Command {
         after_help = "Example:\n  weft-weave woven --yarns 10 --failure-strain 0.036 --stop-on-outcome --out runs/patch\n  weft-simulate --model runs/patch --projectile-velocity 400 --out runs/v400\n  weft-ballistic zone --run runs/v400 --model runs/patch --out runs/zone"
     )]
     Zone(ZoneArgs),
+    /// The backing clay's drop calibration: runs drop models (weft-weave clay-drop) and
+    /// says whether each indentation lies in NIJ Standard-0101.06's band (19 ± 3 mm).
+    #[command(
+        long_about = "The backing clay's drop calibration (NIJ Standard-0101.06): each model of \
+                      `weft-weave clay-drop` (the standard's steel sphere, 63.5 mm and 1043 g, \
+                      striking at the speed of a 2.0 m drop) is run to its end time, past the \
+                      sphere's rebound; the indentation is the crater's depth on the axis then, \
+                      as the standard measures it, and lies in the band when it is 19 ± 3 mm \
+                      (docs/theory.md, \"The backing clay\").\n\n\
+                      Writes clay_calibration.parquet (one row per model: the indentation, the \
+                      band, the clay's constants, the run's cost and balance) and clay_drop.parquet \
+                      (the crater's and the sphere's depth against time) into --out \
+                      (docs/tables.md). Exits with 1 when an indentation lies outside the band.",
+        after_help = "Example:\n  weft-weave clay-drop --out runs/drop\n  weft-ballistic clay-calibration --model runs/drop --out runs/clay"
+    )]
+    ClayCalibration(ClayArgs),
+}
+
+#[derive(clap::Args)]
+struct ClayArgs {
+    /// A drop model folder (weft-weave clay-drop); repeat it for several.
+    #[arg(long, required = true, num_args = 1..)]
+    model: Vec<PathBuf>,
+    /// Worker threads [default: all cores]. Results do not depend on it.
+    #[arg(long)]
+    threads: Option<usize>,
+    /// Output folder for clay_calibration.parquet and clay_drop.parquet.
+    #[arg(long)]
+    out: PathBuf,
 }
 
 #[derive(clap::Args)]
@@ -208,7 +238,54 @@ fn run_cli() -> anyhow::Result<ExitCode> {
         Command::Fit(a) => fit(a),
         Command::Search(a) => search_cmd(a),
         Command::Zone(a) => zone_cmd(a),
+        Command::ClayCalibration(a) => clay_cmd(a),
     }
+}
+
+fn clay_cmd(a: ClayArgs) -> anyhow::Result<ExitCode> {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(a.threads.unwrap_or(0))
+        .build()?;
+    let mut drops = Vec::new();
+    let mut prov = Provenance::new("ballistic", serde_json::json!({ "models": a.model }));
+    for path in &a.model {
+        let m = weft::model::io::read_model(path)?;
+        prov = prov.with_input(&path.join("parts.parquet"))?;
+        let d = pool
+            .install(|| clay::drop(&m))
+            .map_err(|e| e.context(format!("the drop of `{}`", path.display())))?;
+        let (lo, hi) = weft::generate::clay::DROP_BAND;
+        eprintln!(
+            "{}: indentation {:.2} mm (deepest {:.2} mm, the sphere off at {:.2} ms, {:.3} m/s up): {} the band {:.0}–{:.0} mm; balance {:.1e}, {} steps",
+            path.display(),
+            1e3 * d.indentation,
+            1e3 * d.indentation_max,
+            1e3 * d.separation_time,
+            d.rebound_velocity,
+            if d.indentation >= lo && d.indentation <= hi { "within" } else { "OUTSIDE" },
+            1e3 * lo,
+            1e3 * hi,
+            d.max_balance_error_relative,
+            d.steps
+        );
+        drops.push((path.display().to_string(), d));
+    }
+    std::fs::create_dir_all(&a.out).map_err(|e| weft::WeftError::io(&a.out, e))?;
+    clay::write_calibration(&a.out.join("clay_calibration.parquet"), &drops, &prov)?;
+    clay::write_history(&a.out.join("clay_drop.parquet"), &drops, &prov)?;
+    eprintln!(
+        "  wrote {}/{{clay_calibration,clay_drop}}.parquet",
+        a.out.display()
+    );
+    let (lo, hi) = weft::generate::clay::DROP_BAND;
+    let all_in = drops
+        .iter()
+        .all(|(_, d)| d.indentation >= lo && d.indentation <= hi);
+    Ok(if all_in {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(1)
+    })
 }
 
 fn zone_cmd(a: ZoneArgs) -> anyhow::Result<ExitCode> {

@@ -3,6 +3,7 @@
 
 pub mod block;
 pub mod bullet;
+pub mod clay;
 pub mod cylinder;
 pub mod failure;
 pub mod grid;

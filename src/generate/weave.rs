@@ -3,6 +3,7 @@
 
 use std::path::Path;
 
+use super::clay::{clay_drop, ClayDropParams};
 use super::rod::{build, RodParams};
 use super::square::{girder, membrane, GirderParams, MembraneParams};
 use super::taylor::{taylor, TaylorParams};
@@ -24,11 +25,12 @@ pub enum Spec {
     WovenReduced(WovenParams),
     Woven(WovenBandParams),
     Taylor(TaylorParams),
+    ClayDrop(ClayDropParams),
 }
 
 impl Spec {
     /// The subcommand's name: `rod`, `girder`, `membrane`, `combined`, `woven-reduced`,
-    /// `woven`, `taylor`.
+    /// `woven`, `taylor`, `clay-drop`.
     pub fn name(&self) -> &'static str {
         match self {
             Spec::Rod(_) => "rod",
@@ -38,6 +40,7 @@ impl Spec {
             Spec::WovenReduced(_) => "woven-reduced",
             Spec::Woven(_) => "woven",
             Spec::Taylor(_) => "taylor",
+            Spec::ClayDrop(_) => "clay-drop",
         }
     }
 }
@@ -53,10 +56,12 @@ pub fn run(spec: &Spec, out: &Path, on_warning: &mut dyn FnMut(&str)) -> Result<
         Spec::WovenReduced(_) => "the reduced woven model",
         Spec::Woven(_) => "the yarn-level woven patch",
         Spec::Taylor(_) => "the Taylor rod",
+        Spec::ClayDrop(_) => "the clay's drop calibration",
     };
     let built = match spec {
         Spec::Rod(p) => build(p),
         Spec::Taylor(p) => taylor(p),
+        Spec::ClayDrop(p) => clay_drop(p),
         Spec::Girder(p) => girder(p).map(|(m, warnings)| {
             warnings.iter().for_each(|w| on_warning(w));
             m
@@ -96,6 +101,7 @@ pub fn run(spec: &Spec, out: &Path, on_warning: &mut dyn FnMut(&str)) -> Result<
         Spec::WovenReduced(p) => serde_json::to_value(p),
         Spec::Woven(p) => serde_json::to_value(p),
         Spec::Taylor(p) => serde_json::to_value(p),
+        Spec::ClayDrop(p) => serde_json::to_value(p),
     }
     .expect("parameters serialise");
     let prov = Provenance::new(&format!("weave {}", spec.name()), parameters);

@@ -17,11 +17,14 @@
 //! - [`j2`]: J2 (von Mises) plasticity with isotropic hardening, bilinear or tabulated;
 //! - [`johnson_cook`]: Johnson–Cook (strain hardening, strain rate, thermal softening)
 //!   with adiabatic heating from plastic work;
+//! - [`plasticine`]: the backing clay: a flow stress rising as a power of the plastic
+//!   strain rate;
 //! - [`radial_return`]: what the J2-type laws share: the elastic predictor, the radial
 //!   return onto a von Mises surface, the plastic work, and the stress measures.
 //!
 //! Which law a part takes: the one its `material` column names, or else the one whose
-//! selecting column the part sets (`yield_stress`: j2, `jc_a`: johnson_cook), or else the
+//! selecting column the part sets (`yield_stress`: j2, `jc_a`: johnson_cook,
+//! `plasticine_a`: plasticine), or else the
 //! elastic law ([`Law::of_part`]). A law reads its constants by column name through
 //! [`Columns`] (the model's part properties implement it), so the laws sit below the
 //! model and the solver, and the model's checks build a part's material exactly as the
@@ -37,6 +40,7 @@ pub mod elastic;
 pub mod j2;
 pub mod johnson_cook;
 mod law;
+pub mod plasticine;
 pub mod radial_return;
 
 pub use law::{Columns, Elastic, MaterialLaw, PointState, Selection, DEFAULT_TEMPERATURE};
@@ -116,6 +120,7 @@ laws! {
     Elastic: elastic::ElasticLaw,
     J2: j2::J2,
     JohnsonCook: johnson_cook::JohnsonCook,
+    Plasticine: plasticine::Plasticine,
 }
 
 impl Law {

@@ -546,6 +546,41 @@ part_properties! {
         aliases: [],
         meaning: "Taylor–Quinney coefficient χ: the fraction of the plastic work that heats the material",
     },
+    plasticine_a: f64 {
+        unit: "Pa",
+        kinds: [Hex: Rule::Positive],
+        null: null("no plasticine", "a solid is Johnson–Cook with `jc_a`, J2 with `yield_stress`, or elastic"),
+        aliases: [],
+        meaning: "plasticine (the backing clay) A: σ_y = (A + B ε_pⁿ) max(ε̇_p/ε̇₀, 1)ᵐ, a flow stress rising as a power of the plastic strain rate (src/material/plasticine.rs)",
+    },
+    plasticine_b: f64 {
+        unit: "Pa",
+        kinds: [Hex: Rule::NonNegative],
+        null: null("0", "no strain hardening"),
+        aliases: [],
+        meaning: "plasticine B",
+    },
+    plasticine_n: f64 {
+        unit: "",
+        kinds: [Hex: Rule::Positive],
+        null: null("1", "linear hardening"),
+        aliases: [],
+        meaning: "plasticine hardening exponent n (0 < n ≤ 1)",
+    },
+    plasticine_m: f64 {
+        unit: "",
+        kinds: [Hex: Rule::NonNegative],
+        null: null("0", "rate-independent"),
+        aliases: [],
+        meaning: "plasticine rate exponent m (0 ≤ m < 1): the flow stress rises by 10ᵐ per decade of plastic strain rate above ε̇₀",
+    },
+    plasticine_reference_rate: f64 {
+        unit: "1/s",
+        kinds: [Hex: Rule::Positive],
+        null: null("1", "1/s"),
+        aliases: [],
+        meaning: "plasticine reference strain rate ε̇₀: below it the flow stress is (A + B ε_pⁿ)",
+    },
     erosion_plastic_strain: f64 {
         unit: "",
         kinds: [Hex: Rule::Positive],
@@ -559,10 +594,10 @@ part_properties! {
         kinds: [Hex: Rule::Free],
         null: null(
             "the law the part's columns select",
-            "`yield_stress` selects j2, `jc_a` johnson_cook, neither the elastic law; the column is written only when some part names a law",
+            "`yield_stress` selects j2, `jc_a` johnson_cook, `plasticine_a` plasticine, none the elastic law; the column is written only when some part names a law",
         ),
         aliases: [],
-        meaning: "the material law of a solid part, by name: `elastic`, `j2`, `johnson_cook` (src/material/)",
+        meaning: "the material law of a solid part, by name: `elastic`, `j2`, `johnson_cook`, `plasticine` (src/material/)",
     },
 }
 
