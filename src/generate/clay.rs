@@ -224,11 +224,12 @@ pub fn clay_block(
         }
     }
     let part = m.add_part(part_id, "clay", ElementKind::Hex, clay.part_props());
-    // Hexahedron ids after any the model has (a bullet's).
+    // Element ids after every id the model has (they are unique across the tables).
     let e0 = m
         .elements
-        .get(&ElementKind::Hex)
-        .and_then(|b| b.id.iter().copied().max())
+        .values()
+        .filter_map(|b| b.id.iter().copied().max())
+        .max()
         .unwrap_or(0);
     let mut e = e0 + 1;
     let mut count = 0;
