@@ -17,7 +17,7 @@ use weft::table::Provenance;
 #[command(
     name = "weft-ballistic",
     version,
-    about = "Ballistic limits (V50, the Lambert–Jonas fit) from impact runs, or by running them; the failed zone of impact runs",
+    about = "Ballistic limits (V50, the Lambert–Jonas fit) from impact runs, or by running them; the failed zone of impact runs; the backing clay's drop calibration",
     long_about = "The ballistic limit of a fabric from impacts at several striking velocities \
                   (docs/theory.md, \"Failure, perforation and the ballistic limit\").\n\n\
                   `fit` gathers impact runs (the weft-simulate output folders, or one table that \
@@ -31,9 +31,13 @@ use weft::table::Provenance;
                   with what its impacts cost) into --out (docs/tables.md).\n\n\
                   `zone` measures where the elements of impact runs failed: the failed zone's \
                   radius and diameter per run and layer (failure_zone.parquet).\n\n\
+                  `clay-calibration` runs the armour test's clay drop (weft-weave clay-drop) \
+                  and judges its indentation against NIJ Standard-0101.06's band \
+                  (clay_calibration.parquet).\n\n\
                   Example:\n  weft-ballistic fit --runs runs/v300 runs/v350 runs/v400 --out runs/limit\n  \
                   weft-ballistic search --model runs/patch --lo 50 --hi 400 --tolerance 5 --out runs/search\n  \
-                  weft-ballistic zone --run runs/v400 --model runs/patch --out runs/zone"
+                  weft-ballistic zone --run runs/v400 --model runs/patch --out runs/zone\n  \
+                  weft-ballistic clay-calibration --model runs/drop --out runs/clay"
 )]
 struct Cli {
     #[command(subcommand)]
