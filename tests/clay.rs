@@ -151,6 +151,7 @@ fn bad_clay_input_is_named() {
         ("--clay-m", "1.5", "--clay-m = `1.5`"),
         ("--clay-density", "0", "--clay-density = `0`"),
         ("--clay-fine-depth", "0.5", "--clay-fine-depth = `0.5`"),
+        ("--clay-growth", "0.9", "--clay-growth = `0.9`"),
         ("--clay-half-width", "0.02", "not smaller than the clay box"),
         ("--mass", "0", "--mass = `0`"),
     ] {

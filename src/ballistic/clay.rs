@@ -48,7 +48,7 @@ pub struct Drop {
 }
 
 /// Runs the drop model `m` (weft-weave clay-drop) and measures it.
-pub fn drop(m: &Model) -> Result<Drop> {
+pub fn run_drop(m: &Model) -> Result<Drop> {
     let hint = "a model of `weft-weave clay-drop`";
     let axis = *m
         .node_sets

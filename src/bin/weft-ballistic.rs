@@ -256,7 +256,7 @@ fn clay_cmd(a: ClayArgs) -> anyhow::Result<ExitCode> {
         let m = weft::model::io::read_model(path)?;
         prov = prov.with_input(&path.join("parts.parquet"))?;
         let d = pool
-            .install(|| clay::drop(&m))
+            .install(|| clay::run_drop(&m))
             .map_err(|e| e.context(format!("the drop of `{}`", path.display())))?;
         let (lo, hi) = weft::generate::clay::DROP_BAND;
         eprintln!(

@@ -205,10 +205,22 @@ pub fn clay_block(
             &format!("0 < fine depth < the block's depth {} m", b.depth),
         );
     }
+    if !(b.growth >= 1.0 && b.growth.is_finite()) {
+        return bad(
+            "clay-growth",
+            b.growth,
+            "a growth ratio ≥ 1 of the cells beyond the fine zone (1: uniform)",
+        );
+    }
     // The fine zones as whole cells.
     let cells = |len: f64| ((len / b.fine).round() as usize).max(1) as f64 * b.fine;
-    let xs = graded_lines(cells(b.fine_half), b.fine, b.half_width, b.growth)?;
-    let zd = graded_lines(cells(b.fine_depth), b.fine, b.depth, b.growth)?;
+    let lines = |fine_len: f64, outer: f64| {
+        graded_lines(cells(fine_len), b.fine, outer, b.growth).map_err(|e| {
+            e.context("cannot grade the clay block (--clay-fine, --clay-fine-half, --clay-fine-depth, --clay-half-width, --clay-depth, --clay-growth)")
+        })
+    };
+    let xs = lines(b.fine_half, b.half_width)?;
+    let zd = lines(b.fine_depth, b.depth)?;
     // z from the floor up to the top.
     let zs: Vec<f64> = zd.iter().rev().map(|d| top - d).collect();
     let (nx, nz) = (xs.len(), zs.len());
