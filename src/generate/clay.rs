@@ -56,6 +56,8 @@ pub struct Clay {
     pub reference_rate: f64,
     /// Hourglass coefficient Q_hg of the one-point hexahedra.
     pub hourglass: f64,
+    /// Erosion of the cells at this equivalent plastic strain (None: none).
+    pub erosion_plastic_strain: Option<f64>,
 }
 
 impl Clay {
@@ -73,6 +75,7 @@ impl Clay {
             m: 0.2,
             reference_rate: 1.0,
             hourglass: 0.1,
+            erosion_plastic_strain: None,
         }
     }
 
@@ -87,6 +90,7 @@ impl Clay {
             plasticine_n: Some(self.n),
             plasticine_m: Some(self.m),
             plasticine_reference_rate: Some(self.reference_rate),
+            erosion_plastic_strain: self.erosion_plastic_strain,
             ..Default::default()
         }
     }
@@ -129,6 +133,11 @@ impl Clay {
         }
         if !pos(self.hourglass) {
             return bad("clay-hourglass", self.hourglass, "Q_hg > 0");
+        }
+        if let Some(e) = self.erosion_plastic_strain {
+            if !pos(e) {
+                return bad("clay-erosion-strain", e, "an equivalent plastic strain > 0");
+            }
         }
         Ok(())
     }

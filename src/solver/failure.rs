@@ -121,6 +121,8 @@ pub enum Criterion {
     /// A membrane's own stable step, at its current shape, below half the run's step
     /// ([`super::collapse`]): the value is that step, the limit half the run's [s].
     TimeStep,
+    /// A hexahedron's equivalent plastic strain (its part's `erosion_plastic_strain`).
+    PlasticStrain,
 }
 
 impl Criterion {
@@ -133,6 +135,7 @@ impl Criterion {
             Criterion::Force => "force",
             Criterion::Opening => "opening",
             Criterion::TimeStep => "time_step",
+            Criterion::PlasticStrain => "plastic_strain",
         }
     }
 }

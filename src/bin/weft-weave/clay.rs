@@ -38,6 +38,11 @@ pub struct ClayArgs {
     /// Hourglass coefficient Q_hg of the clay's hexahedra.
     #[arg(long, default_value_t = Clay::roma().hourglass)]
     clay_hourglass: f64,
+    /// Erode (remove) a clay cell when its equivalent plastic strain reaches this
+    /// [default: never]: the cells a narrow load crushes toward inversion
+    /// (docs/theory.md, "The backing clay").
+    #[arg(long)]
+    clay_erosion_strain: Option<f64>,
     /// Half the clay box's width [m] (quarter model: the block spans 0 to it in x and y).
     #[arg(long, default_value_t = ClayBlock::default().half_width)]
     clay_half_width: f64,
@@ -70,6 +75,7 @@ impl ClayArgs {
             m: self.clay_m,
             reference_rate: self.clay_reference_rate,
             hourglass: self.clay_hourglass,
+            erosion_plastic_strain: self.clay_erosion_strain,
         }
     }
     pub fn block(&self) -> ClayBlock {

@@ -41,6 +41,7 @@ use crate::error::Result;
 use crate::material::{Material, PointState};
 use crate::model::ElementKind;
 use crate::shape::hex8::{self, HexGeometry};
+use crate::solver::failure::{Criterion, Erosion, Failure, FailureLaw};
 use crate::solver::family::{
     chunk_partials, for_chunks_of, Build, EnergyGroup, EnergyPartial, Family, ForceCtx, Per,
     StateValues, StiffCtx, Stiffened, CHUNK,
@@ -73,6 +74,11 @@ pub struct HexGroup {
     /// table) whose state the run's output samples carry ([`Family::sample_states`]);
     /// empty (the default): none, and sampling costs nothing.
     pub output: Vec<u32>,
+    /// The failure log's view of the erosion at `erosion_plastic_strain` (which the
+    /// material flags at its point): active when some part has one; each element that
+    /// erodes is reported as a `plastic_strain` failure taking no energy (its work stays
+    /// in the internal energy, which its zero forces no longer change).
+    pub erosion: Erosion,
     partials: Vec<EnergyPartial>,
 }
 
@@ -138,10 +144,10 @@ fn element_step(
     v: &[Vec3; 8],
     dt: f64,
     out: &mut [Vec3],
-) {
+) -> bool {
     if st.eroded {
         out.iter_mut().for_each(|f| *f = [0.0; 3]);
-        return;
+        return false;
     }
     // 1–3: the stress at tⁿ from the increment over the last step.
     let mut d_mid = [0.0; 6];
@@ -205,6 +211,8 @@ fn element_step(
         prev.hourglass = cq;
     }
     out.copy_from_slice(&f);
+    // Its material flagged it at this step's update (its forces at tⁿ are its last).
+    st.eroded
 }
 
 impl Family for HexGroup {
@@ -326,6 +334,12 @@ impl Family for HexGroup {
             let (lam, mu) = mat.lame();
             g.rows.push(gershgorin_rows(&geo, lam, mu));
         }
+        if g.materials
+            .iter()
+            .any(|m| m.erosion_plastic_strain.is_some())
+        {
+            g.erosion = Erosion::watching(vec![FailureLaw::NONE; g.id.len()]);
+        }
         Ok(g)
     }
     fn len(&self) -> usize {
@@ -349,24 +363,59 @@ impl Family for HexGroup {
             state,
             work,
             previous,
+            erosion,
             ..
         } = self;
         let (nodes, material, materials, q_hg) = (&*nodes, &*material, &*materials, &*q_hg);
-        // Each chunk of force slots travels with its elements' state, previous forces
-        // and work.
+        if !erosion.active() {
+            // Each chunk of force slots travels with its elements' state, previous forces
+            // and work.
+            let slices = (
+                (Per(fe, 8), Per(&mut state[..], 1)),
+                (Per(&mut previous[..], 1), Per(&mut work[..], 1)),
+            );
+            for_chunks_of(nodes.len(), slices, |ci, ((out, st), (pv, wk))| {
+                let e0 = ci * CHUNK;
+                for (j, slots) in out.chunks_exact_mut(8).enumerate() {
+                    let e = e0 + j;
+                    let ns = &nodes[e];
+                    let x: [Vec3; 8] = std::array::from_fn(|a| ctx.x[ns[a] as usize]);
+                    let v: [Vec3; 8] = std::array::from_fn(|a| ctx.v[ns[a] as usize]);
+                    element_step(
+                        &materials[material[e] as usize],
+                        q_hg[e],
+                        &mut st[j],
+                        &mut pv[j],
+                        &mut wk[j],
+                        &x,
+                        &v,
+                        ctx.dt_prev,
+                        slots,
+                    );
+                }
+            });
+            return;
+        }
+        // With erosion: the same, and each element that erodes this step is reported.
+        let Erosion { fate, any, .. } = erosion;
+        let any = &*any;
         let slices = (
             (Per(fe, 8), Per(&mut state[..], 1)),
-            (Per(&mut previous[..], 1), Per(&mut work[..], 1)),
+            (
+                (Per(&mut previous[..], 1), Per(&mut work[..], 1)),
+                Per(&mut fate[..], 1),
+            ),
         );
-        for_chunks_of(nodes.len(), slices, |ci, ((out, st), (pv, wk))| {
+        for_chunks_of(nodes.len(), slices, |ci, ((out, st), ((pv, wk), fates))| {
             let e0 = ci * CHUNK;
             for (j, slots) in out.chunks_exact_mut(8).enumerate() {
                 let e = e0 + j;
                 let ns = &nodes[e];
                 let x: [Vec3; 8] = std::array::from_fn(|a| ctx.x[ns[a] as usize]);
                 let v: [Vec3; 8] = std::array::from_fn(|a| ctx.v[ns[a] as usize]);
-                element_step(
-                    &materials[material[e] as usize],
+                let mat = &materials[material[e] as usize];
+                let eroded = element_step(
+                    mat,
                     q_hg[e],
                     &mut st[j],
                     &mut pv[j],
@@ -376,8 +425,30 @@ impl Family for HexGroup {
                     ctx.dt_prev,
                     slots,
                 );
+                if eroded && !fates[j].eroded {
+                    let failure = Failure {
+                        kind: ElementKind::Hex,
+                        element: e,
+                        criterion: Criterion::PlasticStrain,
+                        value: st[j].plastic_strain,
+                        limit: mat.erosion_plastic_strain.unwrap_or(f64::NAN),
+                        eroded: true,
+                        energy: 0.0,
+                    };
+                    fates[j].fail(failure, any);
+                }
             }
         });
+    }
+    fn erosion(&self) -> Option<&Erosion> {
+        self.erosion.active().then_some(&self.erosion)
+    }
+    fn erosion_mut(&mut self) -> Option<&mut Erosion> {
+        if self.erosion.active() {
+            Some(&mut self.erosion)
+        } else {
+            None
+        }
     }
     fn stiffness_sums(&self, _ctx: &StiffCtx, s: &mut [f64], c: &mut [f64], _r: &mut [f64]) {
         for (e, ns) in self.nodes.iter().enumerate() {
