@@ -7,7 +7,7 @@
 use std::path::Path;
 
 use crate::error::{Result, WeftError};
-use crate::generate::clay::{DROP_BAND, DROP_TARGET, STANDARD_GRAVITY};
+use crate::generate::clay::{Clay, DROP_BAND, DROP_TARGET, STANDARD_GRAVITY};
 use crate::model::{ElementKind, Model};
 use crate::table::{batch, write_table, Col, Provenance};
 
@@ -27,15 +27,9 @@ pub struct Drop {
     pub mass: f64,
     pub velocity: f64,
     pub height: f64,
-    /// The clay's constants (`parts.parquet` of the part `clay`) and its finest cell [m].
-    pub density: f64,
-    pub youngs_modulus: f64,
-    pub poisson_ratio: f64,
-    pub a: f64,
-    pub b: f64,
-    pub n: f64,
-    pub m: f64,
-    pub reference_rate: f64,
+    /// The clay's constants (`parts.parquet` of the part `clay`, nulls as the part reads
+    /// them) and its finest cell [m].
+    pub clay: Clay,
     pub fine: f64,
     /// The run: its end time [s], steps, elements and worst balance error.
     pub end_time: f64,
@@ -138,14 +132,18 @@ pub fn run_drop(m: &Model) -> Result<Drop> {
         mass: 4.0 * p.mass,
         velocity: v,
         height: v * v / (2.0 * STANDARD_GRAVITY),
-        density,
-        youngs_modulus,
-        poisson_ratio: c.poisson_ratio.unwrap_or(0.3),
-        a,
-        b: c.plasticine_b.unwrap_or(0.0),
-        n: c.plasticine_n.unwrap_or(1.0),
-        m: c.plasticine_m.unwrap_or(0.0),
-        reference_rate: c.plasticine_reference_rate.unwrap_or(1.0),
+        clay: Clay {
+            density,
+            youngs_modulus,
+            poisson_ratio: c.poisson_ratio.unwrap_or(0.3),
+            a,
+            b: c.plasticine_b.unwrap_or(0.0),
+            n: c.plasticine_n.unwrap_or(1.0),
+            m: c.plasticine_m.unwrap_or(0.0),
+            reference_rate: c.plasticine_reference_rate.unwrap_or(1.0),
+            hourglass: c.hourglass_coefficient(),
+            erosion_plastic_strain: c.erosion_plastic_strain,
+        },
         fine,
         end_time: stats.end_time,
         steps: stats.steps,
@@ -181,14 +179,14 @@ pub fn write_calibration(path: &Path, drops: &[(String, Drop)], prov: &Provenanc
             Col::F64("sphere_mass", f(|d| d.mass)),
             Col::F64("drop_height", f(|d| d.height)),
             Col::F64("striking_velocity", f(|d| d.velocity)),
-            Col::F64("density", f(|d| d.density)),
-            Col::F64("youngs_modulus", f(|d| d.youngs_modulus)),
-            Col::F64("poisson_ratio", f(|d| d.poisson_ratio)),
-            Col::F64("plasticine_a", f(|d| d.a)),
-            Col::F64("plasticine_b", f(|d| d.b)),
-            Col::F64("plasticine_n", f(|d| d.n)),
-            Col::F64("plasticine_m", f(|d| d.m)),
-            Col::F64("plasticine_reference_rate", f(|d| d.reference_rate)),
+            Col::F64("density", f(|d| d.clay.density)),
+            Col::F64("youngs_modulus", f(|d| d.clay.youngs_modulus)),
+            Col::F64("poisson_ratio", f(|d| d.clay.poisson_ratio)),
+            Col::F64("plasticine_a", f(|d| d.clay.a)),
+            Col::F64("plasticine_b", f(|d| d.clay.b)),
+            Col::F64("plasticine_n", f(|d| d.clay.n)),
+            Col::F64("plasticine_m", f(|d| d.clay.m)),
+            Col::F64("plasticine_reference_rate", f(|d| d.clay.reference_rate)),
             Col::F64("cell_size", f(|d| d.fine)),
             Col::F64("end_time", f(|d| d.end_time)),
             Col::I64("steps", drops.iter().map(|(_, d)| d.steps as i64).collect()),
