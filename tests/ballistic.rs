@@ -572,7 +572,12 @@ const BALLISTIC: &str = env!("CARGO_BIN_EXE_weft-ballistic");
 /// A 4 × 4 chain patch (112 trusses) failing at 3.6 %, its runs ending at the outcome
 /// within 1 ms: at 40 and 80 m/s it stops, at 250 and 400 m/s it is perforated.
 fn small_patch(dir: &std::path::Path) -> std::path::PathBuf {
-    let m = dir.join("patch");
+    small_patch_ending(dir, "patch", "1e-3")
+}
+
+/// The same patch in `dir/name`, its runs ending at `end` [s] at the latest.
+fn small_patch_ending(dir: &std::path::Path, name: &str, end: &str) -> std::path::PathBuf {
+    let m = dir.join(name);
     run_ok(
         WEAVE,
         &[
@@ -585,7 +590,7 @@ fn small_patch(dir: &std::path::Path) -> std::path::PathBuf {
             "0.036",
             "--stop-on-outcome",
             "--end-time",
-            "1e-3",
+            end,
             "--out",
             m.to_str().unwrap(),
         ],
@@ -593,33 +598,41 @@ fn small_patch(dir: &std::path::Path) -> std::path::PathBuf {
     m
 }
 
-/// One round of `weft-ballistic search` on `model`, its two impacts at 40 and 400 m/s
-/// (the bracket's ends, --per-round 2), into `out`.
+/// The arguments of one round of `weft-ballistic search` on `model`, its two impacts at
+/// 40 and 400 m/s (the bracket's ends, --per-round 2), into `out`, then `extra`.
+fn search_args<'a>(
+    model: &'a std::path::Path,
+    out: &'a std::path::Path,
+    extra: &[&'a str],
+) -> Vec<&'a str> {
+    let mut a = vec![
+        "search",
+        "--model",
+        model.to_str().unwrap(),
+        "--lo",
+        "40",
+        "--hi",
+        "400",
+        "--tolerance",
+        "1000",
+        "--per-round",
+        "2",
+        "--max-rounds",
+        "1",
+        "--threads",
+        "1",
+        "--bootstrap",
+        "10",
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    a.extend_from_slice(extra);
+    a
+}
+
+/// One round of `weft-ballistic search` on `model` (`search_args`), into `out`.
 fn search_once(model: &std::path::Path, out: &std::path::Path) {
-    run_ok(
-        BALLISTIC,
-        &[
-            "search",
-            "--model",
-            model.to_str().unwrap(),
-            "--lo",
-            "40",
-            "--hi",
-            "400",
-            "--tolerance",
-            "1000",
-            "--per-round",
-            "2",
-            "--max-rounds",
-            "1",
-            "--threads",
-            "1",
-            "--bootstrap",
-            "10",
-            "--out",
-            out.to_str().unwrap(),
-        ],
-    );
+    run_ok(BALLISTIC, &search_args(model, out, &[]));
 }
 
 fn simulate(model: &std::path::Path, out: &std::path::Path, v: f64) {
@@ -836,54 +849,12 @@ fn the_search_costs_what_weft_simulate_runs_cost() {
 fn an_undecided_impact_is_run_again_with_twice_the_end_time() {
     use weft::table::Table;
     let dir = tempfile::tempdir().unwrap();
-    let weave = |name: &str, end: &str| {
-        let m = dir.path().join(name);
-        run_ok(
-            WEAVE,
-            &[
-                "woven",
-                "--yarns",
-                "4",
-                "--yarn-model",
-                "chain",
-                "--failure-strain",
-                "0.036",
-                "--stop-on-outcome",
-                "--end-time",
-                end,
-                "--out",
-                m.to_str().unwrap(),
-            ],
-        );
-        m
-    };
+    let weave = |name: &str, end: &str| small_patch_ending(dir.path(), name, end);
     let short = weave("short", "3e-5");
     let out = dir.path().join("search");
     let search = |extensions: &str| {
         std::process::Command::new(BALLISTIC)
-            .args([
-                "search",
-                "--model",
-                short.to_str().unwrap(),
-                "--lo",
-                "40",
-                "--hi",
-                "400",
-                "--tolerance",
-                "1000",
-                "--per-round",
-                "2",
-                "--max-rounds",
-                "1",
-                "--threads",
-                "1",
-                "--bootstrap",
-                "10",
-                "--extensions",
-                extensions,
-                "--out",
-                out.to_str().unwrap(),
-            ])
+            .args(search_args(&short, &out, &["--extensions", extensions]))
             .output()
             .unwrap()
     };

@@ -21,6 +21,7 @@
 
 use serde::Serialize;
 
+use super::block::add_hex_grid;
 use super::surround::graded_lines;
 use crate::error::{Result, WeftError};
 use crate::model::{
@@ -172,26 +173,10 @@ impl Default for ClayBlock {
     }
 }
 
-/// Which nodes of the model [`clay_block`] added: the top surface's, the top node on
-/// the axis, the top surface's nodes along the x axis (the crater's profile).
-#[derive(Debug, Clone)]
-pub struct ClayNodes {
-    pub top: Vec<usize>,
-    pub axis_top: usize,
-    pub profile: Vec<usize>,
-    pub elements: usize,
-}
-
 /// Adds the clay block (part `part_id`, named `clay`) under the plane z = `top`, with the
 /// box's walls and floor as symmetry planes (module docs); node sets `clay_top`,
 /// `clay_axis_top` and `clay_profile`.
-pub fn clay_block(
-    m: &mut Model,
-    part_id: i64,
-    clay: &Clay,
-    b: &ClayBlock,
-    top: f64,
-) -> Result<ClayNodes> {
+pub fn clay_block(m: &mut Model, part_id: i64, clay: &Clay, b: &ClayBlock, top: f64) -> Result<()> {
     clay.check()?;
     let pos = |v: f64| v > 0.0 && v.is_finite();
     let bad = |flag: &str, v: f64, exp: &str| {
@@ -233,18 +218,7 @@ pub fn clay_block(
     // z from the floor up to the top.
     let zs: Vec<f64> = zd.iter().rev().map(|d| top - d).collect();
     let (nx, nz) = (xs.len(), zs.len());
-    let n0 = m.num_nodes();
     let id0 = m.node_id.iter().copied().max().unwrap_or(0);
-    let at = |i: usize, j: usize, k: usize| n0 + (k * nx + j) * nx + i;
-    for (k, &z) in zs.iter().enumerate() {
-        for (j, &y) in xs.iter().enumerate() {
-            for (i, &x) in xs.iter().enumerate() {
-                let idx = at(i, j, k);
-                m.add_node(id0 + 1 + (idx - n0) as i64, [x, y, z]);
-            }
-        }
-    }
-    let part = m.add_part(part_id, "clay", ElementKind::Hex, clay.part_props());
     // Element ids after every id the model has (they are unique across the tables).
     let e0 = m
         .elements
@@ -252,27 +226,9 @@ pub fn clay_block(
         .filter_map(|b| b.id.iter().copied().max())
         .max()
         .unwrap_or(0);
-    let mut e = e0 + 1;
-    let mut count = 0;
-    for k in 0..nz - 1 {
-        for j in 0..nx - 1 {
-            for i in 0..nx - 1 {
-                let ns = [
-                    at(i, j, k),
-                    at(i + 1, j, k),
-                    at(i + 1, j + 1, k),
-                    at(i, j + 1, k),
-                    at(i, j, k + 1),
-                    at(i + 1, j, k + 1),
-                    at(i + 1, j + 1, k + 1),
-                    at(i, j + 1, k + 1),
-                ];
-                m.add_element(e, part, &ns);
-                e += 1;
-                count += 1;
-            }
-        }
-    }
+    let part = m.add_part(part_id, "clay", ElementKind::Hex, clay.part_props());
+    let n0 = add_hex_grid(m, part, [&xs, &xs, &zs], id0 + 1, e0 + 1);
+    let at = |i: usize, j: usize, k: usize| n0 + (k * nx + j) * nx + i;
     let tol = 1e-6 * b.fine;
     for (normal, position) in [
         (0, 0.0),
@@ -292,17 +248,14 @@ pub fn clay_block(
         .flat_map(|j| (0..nx).map(move |i| (i, j)))
         .map(|(i, j)| at(i, j, kt))
         .collect();
-    let profile: Vec<usize> = (0..nx).map(|i| at(i, 0, kt)).collect();
-    let axis_top = at(0, 0, kt);
-    m.node_sets.insert("clay_top".into(), top_nodes.clone());
-    m.node_sets.insert("clay_axis_top".into(), vec![axis_top]);
-    m.node_sets.insert("clay_profile".into(), profile.clone());
-    Ok(ClayNodes {
-        top: top_nodes,
-        axis_top,
-        profile,
-        elements: count,
-    })
+    m.node_sets.insert("clay_top".into(), top_nodes);
+    m.node_sets
+        .insert("clay_axis_top".into(), vec![at(0, 0, kt)]);
+    m.node_sets.insert(
+        "clay_profile".into(),
+        (0..nx).map(|i| at(i, 0, kt)).collect(),
+    );
+    Ok(())
 }
 
 /// The drop calibration's parameters: the clay, its block, and the standard's drop.
