@@ -160,6 +160,30 @@ pub struct ClayBlock {
     pub growth: f64,
 }
 
+impl ClayBlock {
+    /// The block under a pack (`weft-weave woven --backing clay`): 1 mm cells to 15 mm
+    /// from the axis and 30 mm deep. A pack pressed in by a 9 mm nose loads the clay
+    /// over a few millimetres; measured on 4 plies of the 8 × 8 chain patch at 150 m/s
+    /// (docs/theory.md, "The pack on the clay"), 3 mm and 2 mm cells there go unstable
+    /// within 25–60 µs, 1 mm cells run on.
+    pub fn under_pack() -> ClayBlock {
+        ClayBlock {
+            fine: 1e-3,
+            fine_half: 15e-3,
+            fine_depth: 30e-3,
+            ..ClayBlock::default()
+        }
+    }
+}
+
+/// The hourglass coefficient of the clay under a pack: the yarns press the clay's top at
+/// points 2 mm apart, and at the drop's Q_hg = 0.1 its surface corrugates cell by cell
+/// until a yarn node slips behind a face (energy jumps of 0.1–0.2 J from 160 µs, 4 plies
+/// at 150 m/s); 0.3 keeps it smooth. Not the drop's default: there the step is the
+/// clay's own, which the hourglass viscosity (not in the stable-step estimate) then
+/// exceeds (docs/theory.md, "The pack on the clay").
+pub const PACK_HOURGLASS: f64 = 0.3;
+
 impl Default for ClayBlock {
     fn default() -> Self {
         ClayBlock {
@@ -256,6 +280,13 @@ pub fn clay_block(m: &mut Model, part_id: i64, clay: &Clay, b: &ClayBlock, top: 
         (0..nx).map(|i| at(i, 0, kt)).collect(),
     );
     Ok(())
+}
+
+/// A pack's backing: the clay and its block.
+#[derive(Debug, Clone, Copy, Serialize, PartialEq)]
+pub struct Backing {
+    pub clay: Clay,
+    pub block: ClayBlock,
 }
 
 /// The drop calibration's parameters: the clay, its block, and the standard's drop.

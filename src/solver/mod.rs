@@ -215,6 +215,11 @@ impl Solver {
     pub fn failure_log(&self) -> &FailureLog {
         &self.failures
     }
+    /// Node `i`'s displacement now, from its reference position [m].
+    pub fn displacement(&self, i: usize) -> [f64; 3] {
+        let (x, x0) = (self.state.xn[i], self.x0[i]);
+        [x[0] - x0[0], x[1] - x0[1], x[2] - x0[2]]
+    }
     /// The layers of a fabric and the projectile's outcome.
     pub fn watch(&self) -> &watch::Watch {
         &self.watch

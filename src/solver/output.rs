@@ -251,6 +251,70 @@ pub struct ParquetSink {
     cols: [Vec<f64>; 7],
     ids: Vec<i64>,
     rest: MemorySink,
+    crater: Option<Crater>,
+}
+
+/// The backing clay's crater (`bfs.parquet`): the top surface's points along a radius
+/// from the shot's axis (node set `clay_profile`, which must be a history set), sampled
+/// at every output time.
+pub struct Crater {
+    /// The points' model node indices, and their reference positions.
+    nodes: Vec<usize>,
+    x0: Vec<[f64; 3]>,
+    /// Where each point sits in the history's node list (found at the first sample).
+    at: Vec<usize>,
+    t: Vec<f64>,
+    r0: Vec<f64>,
+    r: Vec<f64>,
+    depth: Vec<f64>,
+}
+
+impl Crater {
+    /// The crater along `nodes` (model indices, outwards from the axis at x = y = 0),
+    /// with their reference positions `x0` (all on the clay's undisturbed top).
+    pub fn new(nodes: Vec<usize>, x0: Vec<[f64; 3]>) -> Crater {
+        Crater {
+            nodes,
+            x0,
+            at: vec![],
+            t: vec![],
+            r0: vec![],
+            r: vec![],
+            depth: vec![],
+        }
+    }
+
+    fn sample(&mut self, t: f64, nodes: &[usize], u: &[[f64; 3]]) {
+        if self.at.is_empty() {
+            self.at = self
+                .nodes
+                .iter()
+                .map(|n| {
+                    nodes
+                        .iter()
+                        .position(|m| m == n)
+                        .expect("clay_profile is a history set")
+                })
+                .collect();
+        }
+        for (k, &j) in self.at.iter().enumerate() {
+            let x = self.x0[k];
+            self.t.push(t);
+            self.r0.push(x[0].hypot(x[1]));
+            self.r.push((x[0] + u[j][0]).hypot(x[1] + u[j][1]));
+            self.depth.push(-u[j][2]);
+        }
+    }
+
+    /// `bfs.parquet`'s columns: one row per output time and point.
+    fn table(&self) -> RecordBatch {
+        batch(vec![
+            Col::F64("t", self.t.clone()),
+            Col::F64("r0", self.r0.clone()),
+            Col::F64("r", self.r.clone()),
+            Col::F64("depth", self.depth.clone()),
+        ])
+    }
 }
 
 impl ParquetSink {
@@ -261,7 +325,14 @@ impl ParquetSink {
             cols: Default::default(),
             ids: Vec::new(),
             rest: MemorySink::default(),
+            crater: None,
         })
+    }
+
+    /// Also writes `bfs.parquet`, the crater along `crater`'s points.
+    pub fn with_crater(mut self, crater: Crater) -> Self {
+        self.crater = Some(crater);
+        self
     }
 
     /// `ballistic.parquet`: one row per output time and layer (see [`super::watch`]).
@@ -393,7 +464,27 @@ impl ParquetSink {
             }
             None => None,
         };
+        let bfs = out.join("bfs.parquet");
+        let cw = match &self.crater {
+            Some(c) => {
+                let b = c.table();
+                let mut w = AtomicTableWriter::create(&bfs, b.schema(), prov)?;
+                w.write(&b)?;
+                Some(w)
+            }
+            // A stale one from an earlier run into the same folder would read as this
+            // run's.
+            None => {
+                if bfs.exists() {
+                    std::fs::remove_file(&bfs).map_err(|e| crate::error::WeftError::io(&bfs, e))?;
+                }
+                None
+            }
+        };
         ew.finish()?;
+        if let Some(w) = cw {
+            w.finish()?;
+        }
         if let Some(w) = pw {
             w.finish()?;
         }
@@ -413,6 +504,9 @@ impl Sink for ParquetSink {
         self.rest.layers(t, rows)
     }
     fn history(&mut self, t: f64, nodes: &[usize], u: &[[f64; 3]], v: &[[f64; 3]]) -> Result<()> {
+        if let Some(c) = &mut self.crater {
+            c.sample(t, nodes, u);
+        }
         for (j, &i) in nodes.iter().enumerate() {
             self.cols[0].push(t);
             self.ids.push(self.node_id[i]);

@@ -35,36 +35,41 @@ pub struct ClayArgs {
     /// Plasticine reference strain rate ε̇₀ [1/s].
     #[arg(long, default_value_t = Clay::roma().reference_rate)]
     clay_reference_rate: f64,
-    /// Hourglass coefficient Q_hg of the clay's hexahedra.
-    #[arg(long, default_value_t = Clay::roma().hourglass)]
-    clay_hourglass: f64,
+    /// Hourglass coefficient Q_hg of the clay's hexahedra [default: 0.1 for the drop,
+    /// 0.3 under a pack (woven --backing clay)].
+    #[arg(long)]
+    clay_hourglass: Option<f64>,
     /// Erode (remove) a clay cell when its equivalent plastic strain reaches this
     /// [default: never]: the cells a narrow load crushes toward inversion
     /// (docs/theory.md, "The backing clay").
     #[arg(long)]
     clay_erosion_strain: Option<f64>,
-    /// Half the clay box's width [m] (quarter model: the block spans 0 to it in x and y).
-    #[arg(long, default_value_t = ClayBlock::default().half_width)]
-    clay_half_width: f64,
-    /// The clay block's depth [m].
-    #[arg(long, default_value_t = ClayBlock::default().depth)]
-    clay_depth: f64,
-    /// The cells' size under the shot [m].
-    #[arg(long, default_value_t = ClayBlock::default().fine)]
-    clay_fine: f64,
-    /// Half-width of the fine zone [m] (from the axis).
-    #[arg(long, default_value_t = ClayBlock::default().fine_half)]
-    clay_fine_half: f64,
-    /// Depth of the fine zone [m].
-    #[arg(long, default_value_t = ClayBlock::default().fine_depth)]
-    clay_fine_depth: f64,
-    /// Growth ratio of the cells beyond the fine zone.
-    #[arg(long, default_value_t = ClayBlock::default().growth)]
-    clay_growth: f64,
+    /// Half the clay box's width [m] (quarter model: the block spans 0 to it in x and y)
+    /// [default: 0.305, the standard's box].
+    #[arg(long)]
+    clay_half_width: Option<f64>,
+    /// The clay block's depth [m] [default: 0.14, the standard's box].
+    #[arg(long)]
+    clay_depth: Option<f64>,
+    /// The cells' size under the shot [m] [default: 3 mm for the drop, 1 mm under a
+    /// pack].
+    #[arg(long)]
+    clay_fine: Option<f64>,
+    /// Half-width of the fine zone [m] (from the axis) [default: 40 mm for the drop,
+    /// 15 mm under a pack].
+    #[arg(long)]
+    clay_fine_half: Option<f64>,
+    /// Depth of the fine zone [m] [default: 40 mm for the drop, 30 mm under a pack].
+    #[arg(long)]
+    clay_fine_depth: Option<f64>,
+    /// Growth ratio of the cells beyond the fine zone [default: 1.4].
+    #[arg(long)]
+    clay_growth: Option<f64>,
 }
 
 impl ClayArgs {
-    pub fn clay(&self) -> Clay {
+    /// The clay, with `hourglass` where --clay-hourglass is not given.
+    pub fn clay(&self, hourglass: f64) -> Clay {
         Clay {
             density: self.clay_density,
             youngs_modulus: self.clay_modulus,
@@ -74,18 +79,19 @@ impl ClayArgs {
             n: self.clay_n,
             m: self.clay_m,
             reference_rate: self.clay_reference_rate,
-            hourglass: self.clay_hourglass,
+            hourglass: self.clay_hourglass.unwrap_or(hourglass),
             erosion_plastic_strain: self.clay_erosion_strain,
         }
     }
-    pub fn block(&self) -> ClayBlock {
+    /// The block, `d`'s values where the flags are not given.
+    pub fn block(&self, d: ClayBlock) -> ClayBlock {
         ClayBlock {
-            half_width: self.clay_half_width,
-            depth: self.clay_depth,
-            fine: self.clay_fine,
-            fine_half: self.clay_fine_half,
-            fine_depth: self.clay_fine_depth,
-            growth: self.clay_growth,
+            half_width: self.clay_half_width.unwrap_or(d.half_width),
+            depth: self.clay_depth.unwrap_or(d.depth),
+            fine: self.clay_fine.unwrap_or(d.fine),
+            fine_half: self.clay_fine_half.unwrap_or(d.fine_half),
+            fine_depth: self.clay_fine_depth.unwrap_or(d.fine_depth),
+            growth: self.clay_growth.unwrap_or(d.growth),
         }
     }
 }
@@ -120,8 +126,8 @@ pub struct ClayDropArgs {
 impl ClayDropArgs {
     pub fn params(&self) -> ClayDropParams {
         ClayDropParams {
-            clay: self.clay.clay(),
-            block: self.clay.block(),
+            clay: self.clay.clay(Clay::roma().hourglass),
+            block: self.clay.block(ClayBlock::default()),
             diameter: self.diameter,
             mass: self.mass,
             height: self.height,

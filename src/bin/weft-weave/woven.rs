@@ -117,6 +117,23 @@ pub struct WovenBandArgs {
     failure_length: Option<f64>,
     #[command(flatten)]
     ballistic: BallisticArgs,
+    /// The armour test's backing (NIJ Standard-0101.06): `clay` lays the pack on a block
+    /// of Roma Plastilina No. 1 (the --clay-* flags; `weft-weave clay-drop` calibrates
+    /// it), its edges then free; the summary gains `bfs`, the crater's depth on the axis
+    /// at the end.
+    #[arg(long, value_enum, default_value_t = Backing::None)]
+    backing: Backing,
+    #[command(flatten)]
+    clay: super::clay::ClayArgs,
+}
+
+/// What the pack lies on.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Backing {
+    /// Nothing: the pack in air, held at its edges.
+    None,
+    /// A block of the calibrated clay.
+    Clay,
 }
 
 impl WovenBandArgs {
@@ -172,6 +189,12 @@ impl WovenBandArgs {
             stop_on_outcome: self.ballistic.stop_on_outcome,
             // (Checked in `weave`, before the model is built.)
             bullet: pr.bullet.params().ok().flatten(),
+            backing: (self.backing == Backing::Clay).then(|| weft::generate::clay::Backing {
+                clay: self.clay.clay(weft::generate::clay::PACK_HOURGLASS),
+                block: self
+                    .clay
+                    .block(weft::generate::clay::ClayBlock::under_pack()),
+            }),
         }
     }
 

@@ -249,6 +249,7 @@ pub fn woven(p: &WovenBandParams) -> Result<(Model, WovenInfo)> {
         }
     }
     let yarn_parts: Vec<usize> = built.parts.iter().flat_map(|&(a, b)| [a, b]).collect();
+    let back_ply = *built.parts.last().expect("at least one layer");
     match &p.bullet {
         None => add_projectile(&mut m, p, &weave.section, built.top),
         Some(b) => {
@@ -299,8 +300,67 @@ pub fn woven(p: &WovenBandParams) -> Result<(Model, WovenInfo)> {
     if let Some(s) = &p.surround {
         surround(&mut m, p, s, &info)?;
     }
+    if let Some(b) = &p.backing {
+        back_with_clay(&mut m, p, b, &weave.section, back_ply)?;
+    }
     m.validate()?;
     Ok((m, info))
+}
+
+/// Lays the pack on the clay (`clay::clay_block`, part id 80): the clay's top a layer
+/// gap below the back ply's surface (its lowest node less half the contact thickness),
+/// the back ply's yarns and its membrane sheet against the clay's faces with the
+/// yarns' friction, and the pack's edges free (the clay holds it; the standard's straps
+/// hold nothing in a shot's fraction of a millisecond). The crater's profile is a
+/// history set.
+fn back_with_clay(
+    m: &mut Model,
+    p: &WovenBandParams,
+    b: &crate::generate::clay::Backing,
+    s: &Section,
+    (warp, weft): (usize, usize),
+) -> Result<()> {
+    let panel = p
+        .surround
+        .as_ref()
+        .map_or((p.yarns as f64 - 0.5) * p.spacing, |s| s.length);
+    if !(panel < b.block.half_width) {
+        return Err(WeftError::input(format!(
+            "the panel's half-size {panel} m is not inside the clay box's half-width {} m",
+            b.block.half_width
+        ))
+        .expected("a panel smaller than the clay box")
+        .hint("--clay-half-width, or a smaller --membrane-length"));
+    }
+    if !(panel > p.projectile_radius) {
+        return Err(WeftError::input(format!(
+            "the panel's half-size {panel} m is not larger than the projectile's radius {} m: the shot would miss the pack",
+            p.projectile_radius
+        ))
+        .expected("a panel wider than the bullet")
+        .hint("more --yarns, or --membrane-length for a panel beyond the woven patch"));
+    }
+    let zmin = m.coords.iter().map(|x| x[2]).fold(f64::INFINITY, f64::min);
+    let top = zmin - 0.5 * s.t_centre - p.layer_gap.max(1e-5);
+    m.constraints.clear();
+    crate::generate::clay::clay_block(m, 80, &b.clay, &b.block, top)?;
+    let clay = m.parts.len() - 1;
+    let mut slaves = vec![warp, weft];
+    let sheet = format!("coarse_membrane_{}", p.layers);
+    slaves.extend(m.parts.iter().position(|q| q.name == sheet));
+    let mut cid = m.contacts.iter().map(|c| c.id).max().unwrap_or(0);
+    for part in slaves {
+        cid += 1;
+        let mut c = ContactDef::new(cid, Slave::Part(part), clay).with_friction(p.friction);
+        if s.chain && (part == warp || part == weft) {
+            // The chains' nodes carry the bands' centre thickness (as between yarns).
+            c.slave_thickness = Some(s.t_centre);
+        }
+        c.master_thickness = Some(0.0);
+        m.contacts.push(c);
+    }
+    m.analysis.history_sets.push("clay_profile".into());
+    Ok(())
 }
 
 /// Each yarn element's layer and yarn (`layer`, `yarn` columns: the yarn's index within

@@ -172,6 +172,9 @@ pub struct WovenBandParams {
     /// twice `projectile_radius`, its mass `projectile_mass`, at `projectile_velocity`,
     /// friction `projectile_friction`): [`crate::generate::bullet`]. None: rigid.
     pub bullet: Option<crate::generate::bullet::BulletParams>,
+    /// The armour test's backing: the pack laid on a block of clay (its edges then free:
+    /// the clay holds it), [`crate::generate::clay`]. None: the pack in air.
+    pub backing: Option<crate::generate::clay::Backing>,
 }
 
 /// A graded orthotropic membrane around a quarter patch (the paper's §3: a small woven
@@ -250,6 +253,7 @@ impl Default for WovenBandParams {
             failure: YarnFailure::default(),
             stop_on_outcome: false,
             bullet: None,
+            backing: None,
         }
     }
 }
