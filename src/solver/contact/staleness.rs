@@ -67,7 +67,10 @@ pub fn cell_counts(lo: &[f64; 3], hi: &[f64; 3], mut h: f64, cap: usize) -> ([us
     let mut dims = [1usize; 3];
     loop {
         for d in 0..3 {
-            dims[d] = ((hi[d] - lo[d]) / h).floor() as usize + 1;
+            // Saturating: a span of 2^64 cells (positions running away, before the
+            // run's health check stops it) must not wrap to 0 cells.
+            let n = ((hi[d] - lo[d]) / h).floor();
+            dims[d] = if n < cap as f64 { n as usize + 1 } else { cap + 1 };
         }
         if dims[0].saturating_mul(dims[1]).saturating_mul(dims[2]) <= cap {
             break;
@@ -89,11 +92,11 @@ pub struct CellGrid {
 impl CellGrid {
     /// Cells of size at least `h_min` from `lo` covering up to `hi` (the nodes' bounds),
     /// grown by 1.5 until there are at most 4 per node (+64). Without nodes, or with a
-    /// non-finite bound or size: one cell.
+    /// non-finite bound, span or size: one cell.
     pub fn covering(lo: [f64; 3], hi: [f64; 3], h_min: f64, nodes: usize) -> CellGrid {
         let mut h = h_min;
         let mut origin = lo;
-        if nodes == 0 || !(h > 0.0) || !(0..3).all(|d| lo[d].is_finite() && hi[d].is_finite()) {
+        if nodes == 0 || !(h > 0.0) || !(0..3).all(|d| (hi[d] - lo[d]).is_finite()) {
             origin = [0.0; 3];
             h = f64::INFINITY;
         }
@@ -345,7 +348,7 @@ mod tests {
     /// only while there are more cells than the cap (so h/1.5 would give too many), and
     /// `CellGrid::covering` puts the lower bound in the first cell, the upper in the last
     /// and every node in a cell whose box holds it (indices by hand from the origin and
-    /// h); without nodes or with a non-finite bound, one cell.
+    /// h); without nodes or with a non-finite bound or span, one cell.
     #[test]
     fn cells_cover_the_nodes_within_the_cap() {
         let (lo, hi) = ([0.0, -1.0, 0.0], [10.0, 1.0, 0.1]);
@@ -382,6 +385,13 @@ mod tests {
         let one = CellGrid::covering([0.0; 3], [f64::NAN, 0.0, 0.0], 0.05, 10);
         assert_eq!((one.cells(), one.cell(&[3.0, 4.0, 5.0])), (1, 0));
         assert_eq!(CellGrid::covering(lo, hi, 0.05, 0).cells(), 1);
+        // Finite bounds whose span is not (positions running away before the health
+        // check stops the run): one cell, not a count that wrapped to none (it did,
+        // and the build indexed past its table).
+        let far = CellGrid::covering([-1e308, 0.0, 0.0], [1e308, 1.0, 1.0], 0.05, 10);
+        assert_eq!((far.cells(), far.cell(&[1e300, 0.5, 0.5])), (1, 0));
+        let (dims, _) = cell_counts(&[0.0; 3], &[1e300, 1.0, 1.0], 1e-3, 500);
+        assert!((1..=500).contains(&dims.iter().product::<usize>()), "{dims:?}");
     }
 
     /// What "not stale" promises, checked by brute force over every pair of nodes (the

@@ -37,7 +37,7 @@ struct Grid {
 impl Grid {
     fn new(boxes: &[([f64; 3], [f64; 3])]) -> Grid {
         let (lo, hi, h) = extent(boxes);
-        if boxes.is_empty() || !(0..3).all(|d| lo[d].is_finite() && hi[d].is_finite()) {
+        if boxes.is_empty() || !(0..3).all(|d| (hi[d] - lo[d]).is_finite()) {
             return Grid {
                 origin: [0.0; 3],
                 h: 1.0,
