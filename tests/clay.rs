@@ -304,12 +304,13 @@ fn an_eroded_clay_cell_is_a_reported_failure() {
 /// without interpenetration or lift-off requires: the crater's depth on the axis
 /// (`bfs.parquet`) equals the back ply's deflection (`ballistic.parquet`) to within the
 /// initial separation of the two surfaces (half the chains' contact thickness and the
-/// layer gap, 93 µm: it can at most close; a lift-off opens it), measured 24 µm. The
+/// layer gap, 93 µm: it can at most close; a lift-off opens it), measured 19 µm. The
 /// crater is a crater: its depth falls from the axis outwards to its rim, not rising by
 /// more than 3 % of the axis depth between neighbouring points (measured 0.9 %, at
 /// 15 µs; a surface that corrugates cell by cell under the yarns, as the drop's
-/// Q_hg = 0.1 lets it under 4 plies, rises by 17 %). The energy balance 2.0e-4 (tolerance
-/// 1e-3); `bfs` in the summary is the crater's deepest point at the end.
+/// Q_hg = 0.1 lets it under 4 plies, rises by 17 %). The energy balance 7.8e-5 (tolerance
+/// 1.5e-4: 2.0e-4 under the per-face contact law, an experiment not kept);
+/// `bfs` in the summary is the crater's deepest point at the end.
 #[test]
 fn a_ply_on_the_clay_presses_a_crater_that_follows_its_back_face() {
     let dir = tempfile::tempdir().unwrap();
@@ -361,7 +362,7 @@ fn a_ply_on_the_clay_presses_a_crater_that_follows_its_back_face() {
     );
     let s = Table::read(&r.join("summary.parquet")).unwrap();
     let balance = one(&s, "max_balance_error_relative");
-    assert!(balance < 1e-3, "energy balance {balance}");
+    assert!(balance < 1.5e-4, "energy balance {balance}");
     let b = Table::read(&r.join("bfs.parquet")).unwrap();
     let (t, r0, depth) = (
         b.f64("t", "").unwrap(),

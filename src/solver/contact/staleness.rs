@@ -70,7 +70,11 @@ pub fn cell_counts(lo: &[f64; 3], hi: &[f64; 3], mut h: f64, cap: usize) -> ([us
             // Saturating: a span of 2^64 cells (positions running away, before the
             // run's health check stops it) must not wrap to 0 cells.
             let n = ((hi[d] - lo[d]) / h).floor();
-            dims[d] = if n < cap as f64 { n as usize + 1 } else { cap + 1 };
+            dims[d] = if n < cap as f64 {
+                n as usize + 1
+            } else {
+                cap + 1
+            };
         }
         if dims[0].saturating_mul(dims[1]).saturating_mul(dims[2]) <= cap {
             break;
@@ -391,7 +395,10 @@ mod tests {
         let far = CellGrid::covering([-1e308, 0.0, 0.0], [1e308, 1.0, 1.0], 0.05, 10);
         assert_eq!((far.cells(), far.cell(&[1e300, 0.5, 0.5])), (1, 0));
         let (dims, _) = cell_counts(&[0.0; 3], &[1e300, 1.0, 1.0], 1e-3, 500);
-        assert!((1..=500).contains(&dims.iter().product::<usize>()), "{dims:?}");
+        assert!(
+            (1..=500).contains(&dims.iter().product::<usize>()),
+            "{dims:?}"
+        );
     }
 
     /// What "not stale" promises, checked by brute force over every pair of nodes (the

@@ -550,6 +550,14 @@ impl Narrow<'_> {
                 // nothing changes.
                 continue;
             }
+            if SOLID && !*hd && g_raw > 0.5 * (self.slave_t[si] + self.solid_t) {
+                // Open at the last step and now behind a solid's face (g > c): it came
+                // in beside the face, past an edge of a crease, not through its front
+                // (from open, crossing c takes many steps at any impact speed). Pushed
+                // out by the full depth it would take the energy ½ k g² of a spring it
+                // never compressed; tracked as an initial penetration instead.
+                st.g0 = g_raw;
+            }
             // The tracked initial penetration shrinks as the node leaves.
             if g_raw < st.g0 {
                 st.g0 = g_raw.max(0.0);
