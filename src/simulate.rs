@@ -660,8 +660,8 @@ fn ballistic_columns(s: &Solver, m: &Model, status: &Status, end: f64) -> Vec<Co
             vec![layered.then_some(w.back_face_peak)],
         ),
         Col::OptF64("energy_absorbed", vec![layered.then_some(absorbed)]),
-        // The back-face signature: the backing clay's crater on the shot's axis at the
-        // run's end (a model with clay: node set `clay_axis_top`).
+        // The back-face signature: the backing clay's crater at the run's end, its
+        // deepest point along `clay_profile` (a model with clay).
         Col::OptF64(
             "bfs",
             vec![crater_points(m).map(|p| {

@@ -164,8 +164,8 @@ impl ClayBlock {
     /// The block under a pack (`weft-weave woven --backing clay`): 1 mm cells to 15 mm
     /// from the axis and 30 mm deep. A pack pressed in by a 9 mm nose loads the clay
     /// over a few millimetres; measured on 4 plies of the 8 × 8 chain patch at 150 m/s
-    /// (docs/theory.md, "The pack on the clay"), 3 mm and 2 mm cells there go unstable
-    /// within 25–60 µs, 1 mm cells run on.
+    /// (docs/theory.md, "The pack on the clay"), 3 mm cells there go unstable within
+    /// 25–60 µs, 1 mm cells run to 236 µs.
     pub fn under_pack() -> ClayBlock {
         ClayBlock {
             fine: 1e-3,
@@ -177,9 +177,9 @@ impl ClayBlock {
 }
 
 /// The hourglass coefficient of the clay under a pack: the yarns press the clay's top at
-/// points 2 mm apart, and at the drop's Q_hg = 0.1 its surface corrugates cell by cell
-/// until a yarn node slips behind a face (energy jumps of 0.1–0.2 J from 160 µs, 4 plies
-/// at 150 m/s); 0.3 keeps it smooth. Not the drop's default: there the step is the
+/// points a spacing apart, and at the drop's Q_hg = 0.1 its surface corrugates cell by
+/// cell (±1 mm at 6 mm deep, the balance 6 % at 200 µs: 4 plies at 150 m/s); 0.3 keeps it
+/// smooth (the crater 1.1 % shallower). Not the drop's default: there the step is the
 /// clay's own, which the hourglass viscosity (not in the stable-step estimate) then
 /// exceeds (docs/theory.md, "The pack on the clay").
 pub const PACK_HOURGLASS: f64 = 0.3;

@@ -261,8 +261,10 @@ pub struct Crater {
     /// The points' model node indices, and their reference positions.
     nodes: Vec<usize>,
     x0: Vec<[f64; 3]>,
-    /// Where each point sits in the history's node list (found at the first sample).
-    at: Vec<usize>,
+    /// Each point's index in `nodes` and where it sits in the history's node list
+    /// (found at the first sample; every point is there, `clay_profile` being a history
+    /// set, and one that were not would be left out rather than stop the run).
+    at: Vec<(usize, usize)>,
     t: Vec<f64>,
     r0: Vec<f64>,
     r: Vec<f64>,
@@ -289,15 +291,11 @@ impl Crater {
             self.at = self
                 .nodes
                 .iter()
-                .map(|n| {
-                    nodes
-                        .iter()
-                        .position(|m| m == n)
-                        .expect("clay_profile is a history set")
-                })
+                .enumerate()
+                .filter_map(|(k, n)| Some((k, nodes.iter().position(|m| m == n)?)))
                 .collect();
         }
-        for (k, &j) in self.at.iter().enumerate() {
+        for &(k, j) in &self.at {
             let x = self.x0[k];
             self.t.push(t);
             self.r0.push(x[0].hypot(x[1]));

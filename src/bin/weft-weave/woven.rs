@@ -119,8 +119,8 @@ pub struct WovenBandArgs {
     ballistic: BallisticArgs,
     /// The armour test's backing (NIJ Standard-0101.06): `clay` lays the pack on a block
     /// of Roma Plastilina No. 1 (the --clay-* flags; `weft-weave clay-drop` calibrates
-    /// it), its edges then free; the summary gains `bfs`, the crater's depth on the axis
-    /// at the end.
+    /// it), its edges then free; weft-simulate then writes bfs.parquet (the crater
+    /// against time) and the summary's `bfs` (its deepest point at the end).
     #[arg(long, value_enum, default_value_t = Backing::None)]
     backing: Backing,
     #[command(flatten)]
