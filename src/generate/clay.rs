@@ -176,6 +176,47 @@ impl ClayBlock {
     }
 }
 
+impl ClayBlock {
+    /// Each size in its range, named by its flag.
+    pub fn check(&self) -> Result<()> {
+        let pos = |v: f64| v > 0.0 && v.is_finite();
+        let bad = |flag: &str, v: f64, exp: &str| {
+            Err(WeftError::input(format!("clay block --{flag} = `{v}`")).expected(exp.to_string()))
+        };
+        if !pos(self.half_width) {
+            return bad("clay-half-width", self.half_width, "a half-width > 0 in m");
+        }
+        if !pos(self.depth) {
+            return bad("clay-depth", self.depth, "a depth > 0 in m");
+        }
+        if !pos(self.fine) {
+            return bad("clay-fine", self.fine, "a cell size > 0 in m");
+        }
+        if !(pos(self.fine_half) && self.fine_half < self.half_width) {
+            return bad(
+                "clay-fine-half",
+                self.fine_half,
+                &format!("0 < fine zone < the box's half-width {} m", self.half_width),
+            );
+        }
+        if !(pos(self.fine_depth) && self.fine_depth < self.depth) {
+            return bad(
+                "clay-fine-depth",
+                self.fine_depth,
+                &format!("0 < fine depth < the block's depth {} m", self.depth),
+            );
+        }
+        if !(self.growth >= 1.0 && self.growth.is_finite()) {
+            return bad(
+                "clay-growth",
+                self.growth,
+                "a growth ratio ≥ 1 of the cells beyond the fine zone (1: uniform)",
+            );
+        }
+        Ok(())
+    }
+}
+
 /// The hourglass coefficient of the clay under a pack: the yarns press the clay's top at
 /// points a spacing apart, and at the drop's Q_hg = 0.1 its surface corrugates cell by
 /// cell (±1 mm at 6 mm deep, the balance 6 % at 200 µs: 4 plies at 150 m/s); 0.3 keeps it
@@ -202,34 +243,7 @@ impl Default for ClayBlock {
 /// `clay_axis_top` and `clay_profile`.
 pub fn clay_block(m: &mut Model, part_id: i64, clay: &Clay, b: &ClayBlock, top: f64) -> Result<()> {
     clay.check()?;
-    let pos = |v: f64| v > 0.0 && v.is_finite();
-    let bad = |flag: &str, v: f64, exp: &str| {
-        Err(WeftError::input(format!("clay block --{flag} = `{v}`")).expected(exp.to_string()))
-    };
-    if !pos(b.fine) {
-        return bad("clay-fine", b.fine, "a cell size > 0 in m");
-    }
-    if !(pos(b.fine_half) && b.fine_half < b.half_width) {
-        return bad(
-            "clay-fine-half",
-            b.fine_half,
-            &format!("0 < fine zone < the box's half-width {} m", b.half_width),
-        );
-    }
-    if !(pos(b.fine_depth) && b.fine_depth < b.depth) {
-        return bad(
-            "clay-fine-depth",
-            b.fine_depth,
-            &format!("0 < fine depth < the block's depth {} m", b.depth),
-        );
-    }
-    if !(b.growth >= 1.0 && b.growth.is_finite()) {
-        return bad(
-            "clay-growth",
-            b.growth,
-            "a growth ratio ≥ 1 of the cells beyond the fine zone (1: uniform)",
-        );
-    }
+    b.check()?;
     // The fine zones as whole cells.
     let cells = |len: f64| ((len / b.fine).round() as usize).max(1) as f64 * b.fine;
     let lines = |fine_len: f64, outer: f64| {

@@ -1,6 +1,7 @@
 //! `weft-weave woven`'s flags: the yarn-level patch's own, and the groups it shares with
 //! `woven-reduced` ([`super::fabric`]).
 
+use weft::generate::clay;
 use weft::generate::weave::Spec;
 use weft::generate::woven::{Edge, StrengthPer, Surround, WovenBandParams, YarnFailure, YarnModel};
 
@@ -189,17 +190,19 @@ impl WovenBandArgs {
             stop_on_outcome: self.ballistic.stop_on_outcome,
             // (Checked in `weave`, before the model is built.)
             bullet: pr.bullet.params().ok().flatten(),
-            backing: (self.backing == Backing::Clay).then(|| weft::generate::clay::Backing {
-                clay: self.clay.clay(weft::generate::clay::PACK_HOURGLASS),
-                block: self
-                    .clay
-                    .block(weft::generate::clay::ClayBlock::under_pack()),
+            backing: (self.backing == Backing::Clay).then(|| clay::Backing {
+                clay: self.clay.clay(clay::PACK_HOURGLASS),
+                block: self.clay.block(clay::ClayBlock::under_pack()),
             }),
         }
     }
 
     pub fn weave(&self) -> anyhow::Result<()> {
         self.projectile.bullet.params()?;
+        // The --clay-* flags are checked with or without --backing clay: a bad one is a
+        // mistake either way.
+        self.clay.clay(clay::PACK_HOURGLASS).check()?;
+        self.clay.block(clay::ClayBlock::under_pack()).check()?;
         let out = &self.out.out;
         let m = super::weave(&Spec::Woven(self.params()), out)?;
         eprintln!(
