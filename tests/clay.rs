@@ -41,6 +41,31 @@ fn one(t: &Table, c: &str) -> f64 {
     t.f64(c, "").unwrap()[0]
 }
 
+/// Weaves `dir/m` (`weave`: the subcommand, then its flags) and runs weft-simulate on it
+/// on 2 threads with the flags `simulate` into `dir/r`; returns `dir/r`.
+fn weave_and_simulate(
+    dir: &std::path::Path,
+    weave: &[&str],
+    simulate: &[&str],
+) -> std::path::PathBuf {
+    let (m, r) = (dir.join("m"), dir.join("r"));
+    let mut a = vec![weave[0], "--out", m.to_str().unwrap()];
+    a.extend_from_slice(&weave[1..]);
+    run_ok(WEAVE, &a);
+    let mut a = vec![
+        "--model",
+        m.to_str().unwrap(),
+        "--out",
+        r.to_str().unwrap(),
+        "--threads",
+        "2",
+        "--quiet",
+    ];
+    a.extend_from_slice(simulate);
+    run_ok(env!("CARGO_BIN_EXE_weft-simulate"), &a);
+    r
+}
+
 /// The standard's sphere (63.5 mm, 1043 g) dropped 51 mm (1 m/s) on a block that does
 /// not yield (A = 10¹² Pa: the clay's elasticity alone, E = 20 MPa, ν = 0.45) is Hertz's
 /// impact of a rigid sphere on an elastic half-space (Hertz 1882; Johnson, *Contact
@@ -207,14 +232,10 @@ fn bad_clay_input_is_named() {
 #[test]
 fn an_eroded_clay_cell_is_a_reported_failure() {
     let dir = tempfile::tempdir().unwrap();
-    let m = dir.path().join("m");
-    let r = dir.path().join("r");
-    run_ok(
-        WEAVE,
+    let r = weave_and_simulate(
+        dir.path(),
         &[
             "clay-drop",
-            "--out",
-            m.to_str().unwrap(),
             "--clay-fine",
             "1e-3",
             "--clay-fine-half",
@@ -238,20 +259,7 @@ fn an_eroded_clay_cell_is_a_reported_failure() {
             "--output-interval",
             "5e-6",
         ],
-    );
-    run_ok(
-        env!("CARGO_BIN_EXE_weft-simulate"),
-        &[
-            "--model",
-            m.to_str().unwrap(),
-            "--out",
-            r.to_str().unwrap(),
-            "--element-results",
-            "clay",
-            "--threads",
-            "2",
-            "--quiet",
-        ],
+        &["--element-results", "clay"],
     );
     let f = Table::read(&r.join("failures.parquet")).unwrap();
     let kind = f.str("element_kind", "").unwrap();
@@ -314,14 +322,10 @@ fn an_eroded_clay_cell_is_a_reported_failure() {
 #[test]
 fn a_ply_on_the_clay_presses_a_crater_that_follows_its_back_face() {
     let dir = tempfile::tempdir().unwrap();
-    let m = dir.path().join("m");
-    let r = dir.path().join("r");
-    run_ok(
-        WEAVE,
+    let r = weave_and_simulate(
+        dir.path(),
         &[
             "woven",
-            "--out",
-            m.to_str().unwrap(),
             "--yarns",
             "8",
             "--yarn-model",
@@ -347,18 +351,7 @@ fn a_ply_on_the_clay_presses_a_crater_that_follows_its_back_face() {
             "--clay-depth",
             "0.06",
         ],
-    );
-    run_ok(
-        env!("CARGO_BIN_EXE_weft-simulate"),
-        &[
-            "--model",
-            m.to_str().unwrap(),
-            "--out",
-            r.to_str().unwrap(),
-            "--threads",
-            "2",
-            "--quiet",
-        ],
+        &[],
     );
     let s = Table::read(&r.join("summary.parquet")).unwrap();
     let balance = one(&s, "max_balance_error_relative");

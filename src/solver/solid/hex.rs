@@ -367,6 +367,29 @@ impl Family for HexGroup {
             ..
         } = self;
         let (nodes, material, materials, q_hg) = (&*nodes, &*material, &*materials, &*q_hg);
+        // Element e's step into its force slots (its node positions and velocities
+        // gathered); whether it has eroded.
+        let step = |e: usize,
+                    st: &mut PointState,
+                    pv: &mut Previous,
+                    wk: &mut [f64; 3],
+                    slots: &mut [Vec3]|
+         -> bool {
+            let ns = &nodes[e];
+            let x: [Vec3; 8] = std::array::from_fn(|a| ctx.x[ns[a] as usize]);
+            let v: [Vec3; 8] = std::array::from_fn(|a| ctx.v[ns[a] as usize]);
+            element_step(
+                &materials[material[e] as usize],
+                q_hg[e],
+                st,
+                pv,
+                wk,
+                &x,
+                &v,
+                ctx.dt_prev,
+                slots,
+            )
+        };
         if !erosion.active() {
             // Each chunk of force slots travels with its elements' state, previous forces
             // and work.
@@ -377,21 +400,7 @@ impl Family for HexGroup {
             for_chunks_of(nodes.len(), slices, |ci, ((out, st), (pv, wk))| {
                 let e0 = ci * CHUNK;
                 for (j, slots) in out.chunks_exact_mut(8).enumerate() {
-                    let e = e0 + j;
-                    let ns = &nodes[e];
-                    let x: [Vec3; 8] = std::array::from_fn(|a| ctx.x[ns[a] as usize]);
-                    let v: [Vec3; 8] = std::array::from_fn(|a| ctx.v[ns[a] as usize]);
-                    element_step(
-                        &materials[material[e] as usize],
-                        q_hg[e],
-                        &mut st[j],
-                        &mut pv[j],
-                        &mut wk[j],
-                        &x,
-                        &v,
-                        ctx.dt_prev,
-                        slots,
-                    );
+                    step(e0 + j, &mut st[j], &mut pv[j], &mut wk[j], slots);
                 }
             });
             return;
@@ -410,22 +419,9 @@ impl Family for HexGroup {
             let e0 = ci * CHUNK;
             for (j, slots) in out.chunks_exact_mut(8).enumerate() {
                 let e = e0 + j;
-                let ns = &nodes[e];
-                let x: [Vec3; 8] = std::array::from_fn(|a| ctx.x[ns[a] as usize]);
-                let v: [Vec3; 8] = std::array::from_fn(|a| ctx.v[ns[a] as usize]);
-                let mat = &materials[material[e] as usize];
-                let eroded = element_step(
-                    mat,
-                    q_hg[e],
-                    &mut st[j],
-                    &mut pv[j],
-                    &mut wk[j],
-                    &x,
-                    &v,
-                    ctx.dt_prev,
-                    slots,
-                );
+                let eroded = step(e, &mut st[j], &mut pv[j], &mut wk[j], slots);
                 if eroded && !fates[j].eroded {
+                    let mat = &materials[material[e] as usize];
                     let failure = Failure {
                         kind: ElementKind::Hex,
                         element: e,
