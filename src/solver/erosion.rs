@@ -126,6 +126,11 @@ impl Solver {
                     let a = &mut log.attached[n as usize];
                     *a = a.saturating_sub(1);
                 }
+                if f.kind == ElementKind::Hex {
+                    // A solid's faces leave the surfaces they belong to, uncovering its
+                    // neighbours' (an eroding solid's interior faces, `contact::surface::solid`).
+                    self.op.surfaces.erode(f.kind, f.element);
+                }
                 if matches!(
                     f.kind,
                     ElementKind::Truss | ElementKind::Tri | ElementKind::Quad

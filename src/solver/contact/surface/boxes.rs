@@ -149,6 +149,24 @@ impl Side {
             self.dead_faces += 1;
         }
     }
+
+    /// The faces uncovered at this step join the surface (an eroding solid's, see
+    /// [`Side::erode`]); whether any did: their boxes and envelope directions come with
+    /// the broad-phase build that must follow.
+    pub(super) fn wake_uncovered(&mut self) -> bool {
+        let mut any = false;
+        for f in std::mem::take(&mut self.waking) {
+            let f = f as usize;
+            // (Its own element may have eroded at the same step.)
+            if self.face_alive[f] || self.eroded_elems.contains(&self.face_elem[f]) {
+                continue;
+            }
+            self.face_alive[f] = true;
+            self.dead_faces -= 1;
+            any = true;
+        }
+        any
+    }
 }
 
 /// The faces' thickness boxes at `x` of each master surface in `surfaces` (with a side of

@@ -261,6 +261,8 @@ pub struct Deepest {
 #[derive(Debug, Clone, Default)]
 pub struct SurfaceContact {
     pub sides: Vec<Side>,
+    /// Faces joined a surface (an erosion uncovered them): the next broad phase builds.
+    force_build: bool,
     /// The distinct master surfaces of the sides: their faces' boxes and envelope
     /// directions, computed once per step for all the sides of each ([`MasterBoxes`]).
     masters: Vec<MasterBoxes>,
@@ -361,6 +363,7 @@ impl SurfaceContact {
             dissipated: 0.0,
             stored: 0.0,
             eroded: 0.0,
+            force_build: false,
             initial: vec![],
             ..Default::default()
         }
@@ -634,6 +637,12 @@ impl SurfaceContact {
         } else {
             None
         };
+        // Faces an erosion uncovered join the surface from the next step's build on.
+        for s in &mut self.sides {
+            if !s.waking.is_empty() && s.wake_uncovered() {
+                self.force_build = true;
+            }
+        }
         let before = self.oracle.then(|| self.sides.clone());
         let stored = self.narrow_phase(x, v, dt, dt_prev);
         if let Some(before) = before {
@@ -666,7 +675,7 @@ impl SurfaceContact {
             self.update_all_boxes(x);
         }
         let t_boxes = std::time::Instant::now();
-        let stale = self.stale(x);
+        let stale = self.stale(x) || std::mem::take(&mut self.force_build);
         if stale {
             self.record_trigger();
         }

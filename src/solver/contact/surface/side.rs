@@ -5,7 +5,7 @@
 //! surface, shared by its sides (`super::boxes::MasterBoxes`).
 
 use super::kernels::{bbox, Friction, SlaveState};
-use super::solid::{boundary_faces, boundary_nodes};
+use super::solid::{boundary_nodes, solid_faces};
 use crate::model::contacts::{ContactDef, InitialPenetration, Slave};
 use crate::model::{ElementKind, Model};
 use crate::solver::contact::projectile::PENALTY_FACTOR;
@@ -74,6 +74,15 @@ pub struct Side {
     /// thickness box (no slave passes its box test) and leaves the grid at the next build.
     pub(super) face_alive: Vec<bool>,
     pub(super) dead_faces: usize,
+    /// A solid's faces: the element across each (`u32::MAX`: the part's boundary); empty
+    /// for other masters. With erosion, interior faces are in the surface, dormant
+    /// (`face_alive` false) until the element across erodes.
+    pub(super) face_other: Vec<u32>,
+    /// The elements of an eroding solid that have eroded.
+    pub(super) eroded_elems: std::collections::HashSet<u32>,
+    /// Dormant faces uncovered at this step, alive from the next force evaluation (with
+    /// a broad-phase build).
+    pub(super) waking: Vec<u32>,
     pub(super) friction: Friction,
     pub(super) kappa: f64,
     /// Normal viscous damping as a fraction ζ of the pair's critical damping
@@ -263,6 +272,9 @@ struct MasterFaces {
     face_id: Vec<i64>,
     face_elem: Vec<u32>,
     solid: Option<f64>,
+    /// A solid's faces: the element across each (`u32::MAX`: on the boundary); empty
+    /// otherwise. An eroding solid's interior faces are in `faces` too, dormant.
+    face_other: Vec<u32>,
 }
 
 impl MasterFaces {
@@ -285,6 +297,7 @@ impl MasterFaces {
             face_id: vec![],
             face_elem: vec![],
             solid: None,
+            face_other: vec![],
         };
         for e in 0..b.len() {
             if b.part[e] != master {
@@ -319,7 +332,10 @@ impl MasterFaces {
     fn solid(m: &Model, d: &ContactDef, master: usize, mass: &[f64]) -> MasterFaces {
         let b = &m.elements[&ElementKind::Hex];
         let tf = d.master_thickness.unwrap_or(0.0);
-        let bf = boundary_faces(m, master);
+        // A part whose cells erode keeps its interior faces, dormant until a neighbour's
+        // erosion uncovers them (the eroding contact, `super::solid`).
+        let eroding = m.parts[master].props.erosion_plastic_strain.is_some();
+        let bf = solid_faces(m, master, eroding);
         MasterFaces {
             faces: bf.iter().map(|f| f.nodes).collect(),
             npe: 4,
@@ -334,6 +350,7 @@ impl MasterFaces {
             face_id: bf.iter().map(|f| b.id[f.elem as usize]).collect(),
             face_elem: bf.iter().map(|f| f.elem).collect(),
             solid: Some(tf),
+            face_other: bf.iter().map(|f| f.other).collect(),
         }
     }
 }
@@ -363,7 +380,16 @@ impl Side {
             face_id,
             face_elem,
             solid,
+            face_other,
         } = MasterFaces::new(m, d, master, mass);
+        // Dormant: an interior face of an eroding solid (its element's neighbour is still
+        // there).
+        let face_alive: Vec<bool> = if face_other.is_empty() {
+            vec![true; face_elem.len()]
+        } else {
+            face_other.iter().map(|&o| o == u32::MAX).collect()
+        };
+        let dead_faces = face_alive.iter().filter(|&&a| !a).count();
         let ts_max = slave_t.iter().cloned().fold(0.0, f64::max);
         let tf_box = face_t.iter().flatten().cloned().fold(0.0, f64::max);
         // (A solid's contact thickness is t_F; its `face_t` the boxes' 2R.)
@@ -395,10 +421,13 @@ impl Side {
             face_m,
             face_id,
             master_kind: m.parts[master].kind,
-            face_alive: vec![true; face_elem.len()],
+            face_alive,
             face_elem,
+            face_other,
+            eroded_elems: Default::default(),
+            waking: vec![],
             solid,
-            dead_faces: 0,
+            dead_faces,
             friction: Friction {
                 mu_s: d.static_friction,
                 mu_d: d.dynamic_friction,
@@ -441,11 +470,29 @@ impl Side {
     /// a solid's boundary faces of it: `face_elem` is ascending): pending until
     /// [`Side::drop_pending`].
     pub(super) fn erode(&mut self, e: usize) {
-        let lo = self.face_elem.partition_point(|&x| x < e as u32);
-        let hi = self.face_elem.partition_point(|&x| x <= e as u32);
-        for f in lo..hi {
+        let faces_of = |face_elem: &[u32], e: u32| {
+            face_elem.partition_point(|&x| x < e)..face_elem.partition_point(|&x| x <= e)
+        };
+        for f in faces_of(&self.face_elem, e as u32) {
             if self.face_alive[f] && !self.pending.contains(&(f as u32)) {
                 self.pending.push(f as u32);
+            }
+        }
+        if self.face_other.is_empty() {
+            return;
+        }
+        // An eroding solid: the faces `e` shared with live neighbours are uncovered, each
+        // the neighbour's copy (the one whose element across is `e`).
+        self.eroded_elems.insert(e as u32);
+        for f in faces_of(&self.face_elem, e as u32) {
+            let o = self.face_other[f];
+            if o == u32::MAX || self.eroded_elems.contains(&o) {
+                continue;
+            }
+            for g in faces_of(&self.face_elem, o) {
+                if self.face_other[g] == e as u32 && !self.face_alive[g] {
+                    self.waking.push(g as u32);
+                }
             }
         }
     }

@@ -44,9 +44,17 @@
 //! R + t_s/2 of q — while the penetration uses the true t_F. A node pushed deeper than
 //! that (half an element) is lost: the penalty's depth is a few micrometres at ballistic
 //! speeds, far less. Behind a concave crease of the surface a node may lie in neither
-//! face's prism (a bullet is convex). An eroded hexahedron's faces stay in the surface
-//! (the erosion hook passes only membranes and trusses), and the faces it would uncover
-//! are not added.
+//! face's prism (a bullet is convex).
+//!
+//! **Erosion.** An eroded hexahedron's faces leave the surface (as a failed membrane's:
+//! what they held is booked into `eroded`). A part whose cells can erode
+//! (`erosion_plastic_strain`) keeps its interior faces in the surface too, each twice (once
+//! per element, turned outward from it) and dormant; when a cell erodes, its live
+//! neighbours' copies of the faces it shared with them wake, and the next step's broad
+//! phase builds anew so that they are found (an eroding contact: the crater's floor under
+//! an eroded cell is the next cell's face). A slave that finds itself behind a woken face
+//! is tracked as above, not kicked out. The part's slaves stay its boundary nodes of the
+//! setup: an eroding solid that is also a slave does not gain the nodes erosion uncovers.
 
 use super::kernels::Hit;
 use crate::model::{ElementKind, Model};
@@ -69,10 +77,21 @@ pub(super) struct BoundaryFace {
     pub elem: u32,
     /// Half the element's depth across it at the setup [m] (D of the module doc).
     pub depth: f64,
+    /// The element on its other side (index in the hex block; `u32::MAX`: none, the
+    /// face is on the part's boundary).
+    pub other: u32,
 }
 
 /// The boundary faces of hexahedron part `part` (see the module doc), in element order.
 pub(super) fn boundary_faces(m: &Model, part: usize) -> Vec<BoundaryFace> {
+    solid_faces(m, part, false)
+}
+
+/// The faces of hexahedron part `part` in element order, then each element's face
+/// order: its boundary faces and, with `interior`, every face it shares with another
+/// element of the part too (each such face twice, once per element, turned outward from
+/// it: the face its neighbour's erosion uncovers).
+pub(super) fn solid_faces(m: &Model, part: usize, interior: bool) -> Vec<BoundaryFace> {
     let Some(b) = m.elements.get(&ElementKind::Hex) else {
         return vec![];
     };
@@ -82,10 +101,11 @@ pub(super) fn boundary_faces(m: &Model, part: usize) -> Vec<BoundaryFace> {
         k
     };
     let mine = |e: usize| b.part[e] == part;
-    let mut count: std::collections::HashMap<[usize; 4], u32> = Default::default();
+    // Per face, the elements that have it (two at most in a conforming mesh).
+    let mut owners: std::collections::HashMap<[usize; 4], Vec<u32>> = Default::default();
     for e in (0..b.len()).filter(|&e| mine(e)) {
         for f in &HEX_FACES {
-            *count.entry(key(e, f)).or_insert(0) += 1;
+            owners.entry(key(e, f)).or_default().push(e as u32);
         }
     }
     let x = &m.coords;
@@ -94,9 +114,12 @@ pub(super) fn boundary_faces(m: &Model, part: usize) -> Vec<BoundaryFace> {
         let ns = &b.nodes[8 * e..8 * e + 8];
         let ch: [f64; 3] = std::array::from_fn(|d| ns.iter().map(|&n| x[n][d]).sum::<f64>() / 8.0);
         for f in &HEX_FACES {
-            if count[&key(e, f)] != 1 {
-                continue;
-            }
+            let o = &owners[&key(e, f)];
+            let other = match o.len() {
+                1 => u32::MAX,
+                2 if interior => o[(o[0] == e as u32) as usize],
+                _ => continue,
+            };
             let mut nodes: [u32; 4] = std::array::from_fn(|a| ns[f[a]] as u32);
             let xf: [[f64; 3]; 4] = std::array::from_fn(|a| x[nodes[a] as usize]);
             let cf: [f64; 3] = std::array::from_fn(|d| xf.iter().map(|p| p[d]).sum::<f64>() / 4.0);
@@ -111,6 +134,7 @@ pub(super) fn boundary_faces(m: &Model, part: usize) -> Vec<BoundaryFace> {
                 nodes,
                 elem: e as u32,
                 depth,
+                other,
             });
         }
     }
