@@ -511,4 +511,7 @@ impl<S: Sink> Sink for WithElementResults<'_, S> {
         self.results.sample_solids(t, rows)?;
         self.inner.element_states(t, rows)
     }
+    fn crater(&mut self, t: f64, rows: &[crate::solver::crater::CraterRow]) -> Result<()> {
+        self.inner.crater(t, rows)
+    }
 }

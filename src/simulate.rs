@@ -13,7 +13,7 @@ use crate::model::io::read_tables;
 use crate::model::striker::check_striking_speed;
 use crate::model::{ElementKind, Model, ValidatedModel};
 use crate::solver::failure::FailureEvent;
-use crate::solver::output::{Crater, ParquetSink};
+use crate::solver::output::ParquetSink;
 use crate::solver::{RunStats, Solver};
 use crate::table::{batch, write_table, Col, Provenance};
 
@@ -159,9 +159,8 @@ pub fn run(c: &Config, progress: &mut (dyn FnMut(f64) + Send)) -> Result<Report>
     }
     let setup = t_setup.elapsed();
     let mut sink = ParquetSink::create(&c.out, solver.node_ids().to_vec(), &prov)?;
-    if let Some(nodes) = crater_points(&m) {
-        let x0 = nodes.iter().map(|&i| m.coords[i]).collect();
-        sink = sink.with_crater(Crater::new(nodes.to_vec(), x0));
+    if !solver.crater().is_empty() {
+        sink = sink.with_crater();
     }
     let (sink, result) = match elements.as_mut() {
         Some(results) => {
@@ -311,18 +310,6 @@ fn ballistic_line(s: &Solver) -> Option<String> {
         "failures: {eroded} elements, {broken} yarns broken over {} layers; {outcome}; back-face deflection peak {:.3e} m",
         w.n_layers, w.back_face_peak
     ))
-}
-
-/// The backing clay's crater points (node set `clay_profile`, from the shot's axis
-/// outwards along its top) when the model has clay and samples them.
-fn crater_points(m: &Model) -> Option<&[usize]> {
-    const SET: &str = "clay_profile";
-    m.analysis
-        .history_sets
-        .iter()
-        .any(|h| h == SET)
-        .then(|| m.node_sets.get(SET).map(|v| v.as_slice()))
-        .flatten()
 }
 
 /// How a run ended.
@@ -661,14 +648,13 @@ fn ballistic_columns(s: &Solver, m: &Model, status: &Status, end: f64) -> Vec<Co
         ),
         Col::OptF64("energy_absorbed", vec![layered.then_some(absorbed)]),
         // The back-face signature: the backing clay's crater at the run's end, its
-        // deepest point along `clay_profile` (a model with clay).
+        // deepest point along `clay_profile` (a model with clay; `solver::crater`).
         Col::OptF64(
             "bfs",
-            vec![crater_points(m).map(|p| {
-                p.iter()
-                    .map(|&i| -s.displacement(i)[2])
-                    .fold(f64::NEG_INFINITY, f64::max)
-            })],
+            vec![{
+                let c = s.crater();
+                (!c.is_empty()).then(|| c.iter().map(|r| r[2]).fold(f64::NEG_INFINITY, f64::max))
+            }],
         ),
     ]
 }

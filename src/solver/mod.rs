@@ -36,6 +36,7 @@ pub mod beam;
 pub mod chain_strain;
 pub mod collapse;
 pub mod contact;
+pub mod crater;
 pub mod energy;
 pub mod erosion;
 pub mod failure;
@@ -146,6 +147,8 @@ pub struct Solver {
     failures: FailureLog,
     /// Layers and the projectile's outcome (see [`watch`]).
     watch: watch::Watch,
+    /// The backing clay's crater, when the model has one ([`crater`]).
+    crater: Option<crater::CraterWatch>,
     /// The last output time sent to the sink (NaN before the first): where the tables of
     /// a run that stopped end.
     sampled_to: f64,
@@ -223,6 +226,15 @@ impl Solver {
     /// The layers of a fabric and the projectile's outcome.
     pub fn watch(&self) -> &watch::Watch {
         &self.watch
+    }
+    /// The backing clay's crater now, one row per point of `clay_profile` (see
+    /// [`crater::CraterRow`]); empty without clay.
+    pub fn crater(&self) -> Vec<crater::CraterRow> {
+        let mut rows = vec![];
+        if let Some(c) = &self.crater {
+            c.sample(&self.state.xn, &self.failures, &mut rows);
+        }
+        rows
     }
     /// The last output time sent to the sink (NaN before the first).
     pub fn sampled_to(&self) -> f64 {

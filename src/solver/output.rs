@@ -16,6 +16,7 @@ use std::sync::Arc;
 use arrow_array::{Float64Array, Int64Array, RecordBatch};
 use arrow_schema::{DataType, Field, Schema, SchemaRef};
 
+use super::crater::CraterRow;
 use super::energy::Energies;
 pub use super::family::StateValues;
 use super::watch::LayerValues;
@@ -41,6 +42,11 @@ pub trait Sink {
     fn element_states(&mut self, _t: f64, _rows: &[StateValues]) -> Result<()> {
         Ok(())
     }
+    /// The backing clay's crater at time t, one row per point of `clay_profile` (only
+    /// for a model with clay; see [`super::crater`]).
+    fn crater(&mut self, _t: f64, _rows: &[CraterRow]) -> Result<()> {
+        Ok(())
+    }
 }
 
 /// One snapshot of the output nodes at a step.
@@ -56,6 +62,8 @@ pub(super) struct Snapshot {
     pub(super) layers: Vec<LayerValues>,
     /// The sampled elements' states (see [`StateValues`]).
     pub(super) states: Vec<StateValues>,
+    /// The backing clay's crater (see [`CraterRow`]).
+    pub(super) crater: Vec<CraterRow>,
 }
 
 /// Linear interpolation of the step snapshots onto the fixed output grid t_k = k·Δt_out.
@@ -67,6 +75,7 @@ pub(super) struct Sampler {
     interp_v: Vec<[f64; 3]>,
     interp_layers: Vec<LayerValues>,
     interp_states: Vec<StateValues>,
+    interp_crater: Vec<CraterRow>,
 }
 
 impl Sampler {
@@ -84,6 +93,7 @@ impl Sampler {
             interp_v: vec![[0.0; 3]; nout],
             interp_layers: vec![],
             interp_states: vec![],
+            interp_crater: vec![],
         }
     }
 
@@ -161,6 +171,19 @@ impl Sampler {
                 };
                 sink.element_states(tk, rows)?;
             }
+            if !cur.crater.is_empty() {
+                let rows = if w >= 1.0 || prev.crater.len() != cur.crater.len() {
+                    &cur.crater
+                } else {
+                    self.interp_crater.clear();
+                    for (a, b) in prev.crater.iter().zip(&cur.crater) {
+                        self.interp_crater
+                            .push(std::array::from_fn(|c| a[c] + w * (b[c] - a[c])));
+                    }
+                    &self.interp_crater
+                };
+                sink.crater(tk, rows)?;
+            }
             progress(*k, tk);
             *k += 1;
         }
@@ -183,6 +206,8 @@ pub struct MemorySink {
     pub projectile: Vec<(f64, i64, [f64; 9])>,
     /// (t, per layer its values, layer 1 first).
     pub layers: Vec<(f64, Vec<LayerValues>)>,
+    /// (t, the crater's points: r0, r, depth), for a model with clay.
+    pub crater: Vec<(f64, Vec<CraterRow>)>,
 }
 
 impl Sink for MemorySink {
@@ -192,6 +217,10 @@ impl Sink for MemorySink {
     }
     fn layers(&mut self, t: f64, rows: &[LayerValues]) -> Result<()> {
         self.layers.push((t, rows.to_vec()));
+        Ok(())
+    }
+    fn crater(&mut self, t: f64, rows: &[CraterRow]) -> Result<()> {
+        self.crater.push((t, rows.to_vec()));
         Ok(())
     }
     fn history(&mut self, t: f64, nodes: &[usize], u: &[[f64; 3]], v: &[[f64; 3]]) -> Result<()> {
@@ -254,17 +283,10 @@ pub struct ParquetSink {
     crater: Option<Crater>,
 }
 
-/// The backing clay's crater (`bfs.parquet`): the top surface's points along a radius
-/// from the shot's axis (node set `clay_profile`, which must be a history set), sampled
-/// at every output time.
+/// The backing clay's crater (`bfs.parquet`): its points along a radius from the shot's
+/// axis (see [`super::crater`]) at every output time.
+#[derive(Debug, Clone, Default)]
 pub struct Crater {
-    /// The points' model node indices, and their reference positions.
-    nodes: Vec<usize>,
-    x0: Vec<[f64; 3]>,
-    /// Each point's index in `nodes` and where it sits in the history's node list
-    /// (found at the first sample; every point is there, `clay_profile` being a history
-    /// set, and one that were not would be left out rather than stop the run).
-    at: Vec<(usize, usize)>,
     t: Vec<f64>,
     r0: Vec<f64>,
     r: Vec<f64>,
@@ -272,35 +294,12 @@ pub struct Crater {
 }
 
 impl Crater {
-    /// The crater along `nodes` (model indices, outwards from the axis at x = y = 0),
-    /// with their reference positions `x0` (all on the clay's undisturbed top).
-    pub fn new(nodes: Vec<usize>, x0: Vec<[f64; 3]>) -> Crater {
-        Crater {
-            nodes,
-            x0,
-            at: vec![],
-            t: vec![],
-            r0: vec![],
-            r: vec![],
-            depth: vec![],
-        }
-    }
-
-    fn sample(&mut self, t: f64, nodes: &[usize], u: &[[f64; 3]]) {
-        if self.at.is_empty() {
-            self.at = self
-                .nodes
-                .iter()
-                .enumerate()
-                .filter_map(|(k, n)| Some((k, nodes.iter().position(|m| m == n)?)))
-                .collect();
-        }
-        for &(k, j) in &self.at {
-            let x = self.x0[k];
+    fn sample(&mut self, t: f64, rows: &[CraterRow]) {
+        for &[r0, r, depth] in rows {
             self.t.push(t);
-            self.r0.push(x[0].hypot(x[1]));
-            self.r.push((x[0] + u[j][0]).hypot(x[1] + u[j][1]));
-            self.depth.push(-u[j][2]);
+            self.r0.push(r0);
+            self.r.push(r);
+            self.depth.push(depth);
         }
     }
 
@@ -327,9 +326,9 @@ impl ParquetSink {
         })
     }
 
-    /// Also writes `bfs.parquet`, the crater along `crater`'s points.
-    pub fn with_crater(mut self, crater: Crater) -> Self {
-        self.crater = Some(crater);
+    /// Also writes `bfs.parquet`, the crater the solver samples ([`Sink::crater`]).
+    pub fn with_crater(mut self) -> Self {
+        self.crater = Some(Crater::default());
         self
     }
 
@@ -502,9 +501,6 @@ impl Sink for ParquetSink {
         self.rest.layers(t, rows)
     }
     fn history(&mut self, t: f64, nodes: &[usize], u: &[[f64; 3]], v: &[[f64; 3]]) -> Result<()> {
-        if let Some(c) = &mut self.crater {
-            c.sample(t, nodes, u);
-        }
         for (j, &i) in nodes.iter().enumerate() {
             self.cols[0].push(t);
             self.ids.push(self.node_id[i]);
@@ -520,5 +516,11 @@ impl Sink for ParquetSink {
     }
     fn energy(&mut self, t: f64, e: &Energies) -> Result<()> {
         self.rest.energy(t, e)
+    }
+    fn crater(&mut self, t: f64, rows: &[CraterRow]) -> Result<()> {
+        if let Some(c) = &mut self.crater {
+            c.sample(t, rows);
+        }
+        Ok(())
     }
 }

@@ -9,8 +9,8 @@ use super::energy::{energy_floor, Ledger};
 use super::family;
 use super::integrator::NodePartial;
 use super::{
-    contact, rotations, ties, watch, FailureLog, Families, Operator, Solver, StableStep, State,
-    CHUNK,
+    contact, crater, rotations, ties, watch, FailureLog, Families, Operator, Solver, StableStep,
+    State, CHUNK,
 };
 use crate::error::{Result, WeftError};
 use crate::model::{ElementKind, Model, ValidatedModel};
@@ -143,9 +143,11 @@ impl Solver {
             ledger: Ledger::default(),
             failures: FailureLog::default(),
             watch: watch::Watch::new(m),
+            crater: None,
             sampled_to: f64::NAN,
         };
         s.failures = FailureLog::new(&s.op.el, nn);
+        s.crater = crater::CraterWatch::new(m, &s.x0);
         let kappa = contact::surface::guard_kappa(m);
         s.set_time_step(kappa)?;
         // The membranes' collapse criterion reads the masses as the step was set with.

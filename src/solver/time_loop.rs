@@ -75,6 +75,9 @@ impl Solver {
                 if self.watch.is_active() {
                     self.watch_sample(&mut sampler.cur.layers);
                 }
+                if let Some(c) = &self.crater {
+                    c.sample(&self.state.xn, &self.failures, &mut sampler.cur.crater);
+                }
                 sampler.emit(
                     &mut k,
                     n_out,
