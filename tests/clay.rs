@@ -41,6 +41,17 @@ fn one(t: &Table, c: &str) -> f64 {
     t.f64(c, "").unwrap()[0]
 }
 
+/// The node id of the one node in node set `set` of the model `dir/m` next to the
+/// results folder `r` (`weave_and_simulate`'s).
+fn node_id_in_set(r: &std::path::Path, set: &str) -> i64 {
+    let t = Table::read(&r.with_file_name("m").join("node_sets.parquet")).unwrap();
+    let (names, ids) = (t.str("set", "").unwrap(), t.i64("node_id", "").unwrap());
+    let mut found = (0..ids.len()).filter(|&i| names[i] == set).map(|i| ids[i]);
+    let id = found.next().unwrap();
+    assert!(found.next().is_none(), "`{set}` holds more than one node");
+    id
+}
+
 /// Weaves `dir/m` (`weave`: the subcommand, then its flags) and runs weft-simulate on it
 /// on 2 threads with the flags `simulate` into `dir/r`; returns `dir/r`.
 fn weave_and_simulate(
@@ -228,7 +239,8 @@ fn bad_clay_input_is_named() {
 /// standard's sphere's size, 9 mm and 8 g, at 60 m/s into 1 mm cells, eroded at ε_p = 1.5
 /// (without erosion those cells invert at 130 µs). Measured: 25 cells eroded by 150 µs,
 /// the balance 4.7e-5 (tolerance 3e-4: the erosion's abrupt loss of a cell's elastic
-/// energy is bounded by the balance check, not booked).
+/// energy is bounded by the balance check, not booked). The crater's floor on the axis
+/// (`bfs.parquet`) is then the clay left under the eroded cells, not their orphaned node.
 #[test]
 fn an_eroded_clay_cell_is_a_reported_failure() {
     let dir = tempfile::tempdir().unwrap();
@@ -305,6 +317,53 @@ fn an_eroded_clay_cell_is_a_reported_failure() {
     let bal = s.f64("max_balance_error_relative", "").unwrap()[0];
     eprintln!("balance {bal:.2e}");
     assert!(bal < 3e-4, "balance {bal}");
+    // The crater is read from the clay that is left. The axis's top node belongs to one
+    // cell (a quarter model's corner); once that cell erodes the node is a free mass that
+    // the sphere kicks ahead of itself (history.parquet: faster than the sphere, deeper
+    // than its tip). The crater's floor there is the node below it, which a rigid sphere
+    // cannot have passed: no deeper than the sphere's tip, and behind it by at most a cell
+    // (1 mm; the contact lets the sphere travel v·Δt ≈ 0.2 mm a step of the clay's 4 µs
+    // into it before the penalty answers).
+    let last_of = |table: &Table| {
+        let t = table.f64("t", "").unwrap();
+        let end = t.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
+        (t, end)
+    };
+    let p = Table::read(&r.join("projectile.parquet")).unwrap();
+    let (pt, end) = last_of(&p);
+    let tip = -p.f64("z", "").unwrap()[pt.iter().position(|&x| x == end).unwrap()];
+    let h = Table::read(&r.join("history.parquet")).unwrap();
+    let (ht, _) = last_of(&h);
+    let hid = h.i64("node_id", "").unwrap();
+    let huz = h.f64("uz", "").unwrap();
+    let axis_node = node_id_in_set(&r, "clay_axis_top");
+    let orphan = (0..ht.len())
+        .find(|&i| ht[i] == end && hid[i] == axis_node)
+        .map(|i| -huz[i])
+        .unwrap();
+    let b = Table::read(&r.join("bfs.parquet")).unwrap();
+    let (bt, _) = last_of(&b);
+    let (r0, depth) = (b.f64("r0", "").unwrap(), b.f64("depth", "").unwrap());
+    let floor = depth[(0..bt.len())
+        .find(|&i| bt[i] == end && r0[i] == 0.0)
+        .unwrap()];
+    eprintln!(
+        "at {end:e} s: sphere's tip {tip:.4e} m deep, the axis's orphaned top node {orphan:.4e} m, the crater's floor {floor:.4e} m"
+    );
+    // Measured: tip 8.803 mm, orphan 12.03 mm, floor 8.424 mm.
+    assert!(
+        orphan > tip,
+        "the axis's top node did not fly ahead ({orphan} m, tip {tip} m)"
+    );
+    assert!(
+        floor <= tip + 1e-5 && floor > tip - 1e-3,
+        "the crater's floor {floor} m against the tip at {tip} m"
+    );
+    let summary_bfs = s.f64_opt("bfs").unwrap().unwrap()[0].unwrap();
+    assert!(
+        summary_bfs < tip + 1e-5,
+        "summary bfs {summary_bfs} m, tip {tip} m"
+    );
 }
 
 /// A ply on the clay (`weft-weave woven --backing clay`), struck at 100 m/s by the rigid
