@@ -80,6 +80,14 @@ enum Figure {
         after_help = "Example:\n  weft-plot bullet --model runs/lead --history runs/lead-out/history.parquet --label lead \\\n    --out bullet.png"
     )]
     Bullet(BulletArgs),
+    /// The backing clay's crater from bfs.parquet (weft-simulate of a pack on the clay,
+    /// weft-weave woven --backing clay): its depth on the shot's axis against time, or its
+    /// profile (the clay's surface height against the distance from the axis) at chosen
+    /// times; one series per run (and time), with the back-face signature's limit.
+    #[command(
+        after_help = "Examples:\n  weft-plot crater --bfs runs/pack-out/bfs.parquet --kind depth --limit 0.044 --out bfs.png\n  weft-plot crater --bfs runs/pack-out/bfs.parquet --kind profile --time 2e-4 --time 4e-4 \\\n    --max-radius 0.06 --out crater.png"
+    )]
+    Crater(CraterArgs),
     /// Colour map of a nodal quantity (uz, |u|, vx, ...) over the mesh at one output
     /// time, on the initial or deformed mesh, with a colour bar; several models side by
     /// side on one colour scale (the paper's Fig. 4).
@@ -109,6 +117,32 @@ struct BulletArgs {
     /// Legend label of each run (default: the folder name).
     #[arg(long)]
     label: Vec<String>,
+    #[command(flatten)]
+    common: Common,
+}
+
+#[derive(Args)]
+struct CraterArgs {
+    /// bfs.parquet of a run (repeat).
+    #[arg(long, required = true)]
+    bfs: Vec<PathBuf>,
+    /// Legend label of each run (default: its folder's name).
+    #[arg(long)]
+    label: Vec<String>,
+    /// depth (on the axis, against time) or profile (at --time).
+    #[arg(long, value_enum, default_value = "depth")]
+    kind: plot::crater::CraterKind,
+    /// profile: the output time [s] to draw (repeat; the nearest sample of each run)
+    /// [default: each run's last].
+    #[arg(long)]
+    time: Vec<f64>,
+    /// A limit on the depth [m] drawn as a line (NIJ Standard-0101.06's back-face
+    /// signature: 0.044).
+    #[arg(long)]
+    limit: Option<f64>,
+    /// profile: only points that started within this distance of the axis [m].
+    #[arg(long)]
+    max_radius: Option<f64>,
     #[command(flatten)]
     common: Common,
 }
@@ -441,6 +475,17 @@ fn run() -> anyhow::Result<()> {
                 model: a.model,
                 history: a.history,
                 label: a.label,
+            }),
+            a.common,
+        ),
+        Figure::Crater(a) => (
+            plot::Figure::Crater(plot::crater::CraterFigure {
+                bfs: a.bfs,
+                label: a.label,
+                kind: a.kind,
+                times: a.time,
+                limit: a.limit,
+                max_radius: a.max_radius,
             }),
             a.common,
         ),

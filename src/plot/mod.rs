@@ -10,6 +10,7 @@
 pub mod ballistic;
 pub mod bullet;
 mod chart;
+pub mod crater;
 pub mod field;
 mod history;
 mod output;
@@ -59,6 +60,8 @@ pub enum Figure {
     Ballistic(ballistic::BallisticFigure),
     /// A deformable bullet's length and diameter against time.
     Bullet(bullet::BulletFigure),
+    /// The backing clay's crater: its depth against time or its profile.
+    Crater(crater::CraterFigure),
 }
 
 /// What drawing a figure reports back to the binary.
@@ -82,6 +85,7 @@ pub fn run(c: &Config) -> anyhow::Result<Report> {
         Figure::Surrogate(a) => tables::surrogate(a)?,
         Figure::Ballistic(a) => ballistic::ballistic(a)?,
         Figure::Bullet(a) => bullet::bullet(a)?,
+        Figure::Crater(a) => crater::crater(a)?,
         Figure::Weave(a) => weave::weave(a)?,
         Figure::Field(a) => {
             let (f, report) = field::build(a)?;

@@ -39,9 +39,10 @@ pub struct ClayArgs {
     /// 0.3 under a pack (woven --backing clay)].
     #[arg(long)]
     clay_hourglass: Option<f64>,
-    /// Erode (remove) a clay cell when its equivalent plastic strain reaches this
-    /// [default: never]: the cells a narrow load crushes toward inversion
-    /// (docs/theory.md, "The backing clay").
+    /// Erode (remove) a clay cell when its equivalent plastic strain reaches this: the
+    /// cells a narrow load crushes toward inversion; the cells beneath then meet the pack
+    /// [default: never for the drop, 1.5 under a pack; 0: never] (docs/theory.md,
+    /// "The backing clay", "The pack on the clay").
     #[arg(long)]
     clay_erosion_strain: Option<f64>,
     /// Half the clay box's width [m] (quarter model: the block spans 0 to it in x and y)
@@ -68,8 +69,9 @@ pub struct ClayArgs {
 }
 
 impl ClayArgs {
-    /// The clay, with `hourglass` where --clay-hourglass is not given.
-    pub fn clay(&self, hourglass: f64) -> Clay {
+    /// The clay, with `hourglass` and `erosion` where --clay-hourglass and
+    /// --clay-erosion-strain are not given (an erosion strain of 0 is none).
+    pub fn clay(&self, hourglass: f64, erosion: Option<f64>) -> Clay {
         Clay {
             density: self.clay_density,
             youngs_modulus: self.clay_modulus,
@@ -80,7 +82,7 @@ impl ClayArgs {
             m: self.clay_m,
             reference_rate: self.clay_reference_rate,
             hourglass: self.clay_hourglass.unwrap_or(hourglass),
-            erosion_plastic_strain: self.clay_erosion_strain,
+            erosion_plastic_strain: self.clay_erosion_strain.or(erosion).filter(|&e| e != 0.0),
         }
     }
     /// The block, `d`'s values where the flags are not given.
@@ -126,7 +128,7 @@ pub struct ClayDropArgs {
 impl ClayDropArgs {
     pub fn params(&self) -> ClayDropParams {
         ClayDropParams {
-            clay: self.clay.clay(Clay::roma().hourglass),
+            clay: self.clay.clay(Clay::roma().hourglass, None),
             block: self.clay.block(ClayBlock::default()),
             diameter: self.diameter,
             mass: self.mass,

@@ -191,7 +191,9 @@ impl WovenBandArgs {
             // (Checked in `weave`, before the model is built.)
             bullet: pr.bullet.params().ok().flatten(),
             backing: (self.backing == Backing::Clay).then(|| clay::Backing {
-                clay: self.clay.clay(clay::PACK_HOURGLASS),
+                clay: self
+                    .clay
+                    .clay(clay::PACK_HOURGLASS, Some(clay::PACK_EROSION)),
                 block: self.clay.block(clay::ClayBlock::under_pack()),
             }),
         }
@@ -201,7 +203,9 @@ impl WovenBandArgs {
         self.projectile.bullet.params()?;
         // The --clay-* flags are checked with or without --backing clay: a bad one is a
         // mistake either way.
-        self.clay.clay(clay::PACK_HOURGLASS).check()?;
+        self.clay
+            .clay(clay::PACK_HOURGLASS, Some(clay::PACK_EROSION))
+            .check()?;
         self.clay.block(clay::ClayBlock::under_pack()).check()?;
         let out = &self.out.out;
         let m = super::weave(&Spec::Woven(self.params()), out)?;
