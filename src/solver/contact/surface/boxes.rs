@@ -77,7 +77,12 @@ impl MasterBoxes {
             let g = found.unwrap_or_else(|| {
                 let n = sides[k].faces.len();
                 out.push(MasterBoxes {
-                    face_box: vec![[0.0; 8]; n],
+                    // (A dormant face's box stays empty until it wakes.)
+                    face_box: sides[k]
+                        .face_alive
+                        .iter()
+                        .map(|&a| if a { [0.0; 8] } else { DEAD_BOX })
+                        .collect(),
                     face_dir: vec![[0.0; 6]; n],
                     stamp: Stamps((0..n).map(|_| AtomicU32::new(0)).collect()),
                     sides: vec![],
@@ -204,14 +209,13 @@ pub(super) fn update_surfaces<'a>(
         let (alive, any_dead) = (&sd.face_alive, sd.dead_faces > 0);
         for (j, b) in bs.iter_mut().enumerate() {
             let fi = c * FACE_CHUNK + j;
-            if stamp.is_some_and(|e| stamps[fi].load(Relaxed) != e) {
+            // (A face that has left the surface keeps the empty box `kill` gave it; a
+            // dormant one, an eroding solid's interior face, is in no grid and no list
+            // until it wakes, when the build that follows computes its box.)
+            if (any_dead && !alive[fi]) || stamp.is_some_and(|e| stamps[fi].load(Relaxed) != e) {
                 continue;
             }
-            *b = if any_dead && !alive[fi] {
-                DEAD_BOX
-            } else {
-                thickness_box(&faces[fi], &face_t[fi], &dirs[fi], nf, x)
-            };
+            *b = thickness_box(&faces[fi], &face_t[fi], &dirs[fi], nf, x);
         }
     });
 }
