@@ -539,3 +539,79 @@ fn a_ply_on_the_clay_presses_a_crater_that_follows_its_back_face() {
     assert!(lead < 1e-3 && lag < 93e-6, "lead {lead} m, lag {lag} m");
     assert!(balance < 4e-4, "energy balance {balance}");
 }
+
+/// A block thinner than the crater cannot measure it: the run stops once the crater
+/// reaches 90 % of the clay's depth under a point (its held floor would be shaping it),
+/// names the flag, and keeps its tables (`status = stopped`, bfs.parquet to the last
+/// sample). The 9 mm sphere at 60 m/s of the eroding drop into an 8 mm block: stopped at
+/// 135 µs with the crater 7.37 mm deep on the axis (92 %); in a 10 mm block it completes
+/// at 8.34 mm (83 %).
+#[test]
+fn a_crater_deeper_than_its_block_stops_the_run_naming_the_flag() {
+    let dir = tempfile::tempdir().unwrap();
+    let (m, r) = (dir.path().join("m"), dir.path().join("r"));
+    run_ok(
+        WEAVE,
+        &[
+            "clay-drop",
+            "--out",
+            m.to_str().unwrap(),
+            "--clay-fine",
+            "1e-3",
+            "--clay-fine-half",
+            "15e-3",
+            "--clay-fine-depth",
+            "6e-3",
+            "--clay-half-width",
+            "0.1",
+            "--clay-depth",
+            "0.008",
+            "--clay-erosion-strain",
+            "1.5",
+            "--diameter",
+            "9e-3",
+            "--mass",
+            "8e-3",
+            "--height",
+            "183.5",
+            "--end-time",
+            "1.5e-4",
+            "--output-interval",
+            "5e-6",
+        ],
+    );
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_weft-simulate"))
+        .args([
+            "--model",
+            m.to_str().unwrap(),
+            "--out",
+            r.to_str().unwrap(),
+            "--quiet",
+        ])
+        .output()
+        .unwrap();
+    let e = String::from_utf8_lossy(&o.stderr);
+    eprintln!("{e}");
+    assert!(!o.status.success());
+    for w in [
+        "thinner than the crater",
+        "--clay-depth",
+        "from the shot's axis",
+    ] {
+        assert!(e.contains(w), "`{w}` missing from: {e}");
+    }
+    let s = Table::read(&r.join("summary.parquet")).unwrap();
+    assert_eq!(s.str("status", "").unwrap()[0], "stopped");
+    let bfs = one(&s, "bfs");
+    assert!(bfs >= 0.9 * 0.008 && bfs < 0.008, "bfs {bfs}");
+    let t = Table::read(&r.join("bfs.parquet"))
+        .unwrap()
+        .f64("t", "")
+        .unwrap();
+    let end = one(&s, "end_time");
+    assert_eq!(
+        t.iter().cloned().fold(0.0, f64::max),
+        end,
+        "bfs.parquet ends at the last sample"
+    );
+}

@@ -11,6 +11,7 @@
 //! is the top's displacement.
 
 use super::FailureLog;
+use crate::error::{Result, WeftError};
 use crate::model::{ElementKind, Model};
 
 /// The node set whose points the crater is sampled at.
@@ -28,7 +29,14 @@ pub struct CraterWatch {
     /// Per point: the top's reference radius and height [m].
     r0: Vec<f64>,
     z_top: Vec<f64>,
+    /// Per point: the clay's depth under it at the setup (its column's top to bottom) [m].
+    block_depth: Vec<f64>,
 }
+
+/// The fraction of the clay's depth under a point that its crater may reach before the
+/// run stops: the block's floor (held, a symmetry plane of the box) would then be
+/// shaping the crater, which a block thinner than the crater cannot measure.
+pub const DEEPEST_FRACTION: f64 = 0.9;
 
 impl CraterWatch {
     /// The crater of `m` along `clay_profile`, with reference positions `x0`; `None`
@@ -76,6 +84,10 @@ impl CraterWatch {
             columns.push(col);
         }
         Some(CraterWatch {
+            block_depth: columns
+                .iter()
+                .map(|c| x0[c[0] as usize][2] - x0[c[c.len() - 1] as usize][2])
+                .collect(),
             r0: profile.iter().map(|&n| x0[n][0].hypot(x0[n][1])).collect(),
             z_top: profile.iter().map(|&n| x0[n][2]).collect(),
             columns,
@@ -103,5 +115,29 @@ impl CraterWatch {
                 .unwrap_or(col[col.len() - 1]) as usize;
             rows.push([self.r0[k], x[n][0].hypot(x[n][1]), self.z_top[k] - x[n][2]]);
         }
+    }
+
+    /// Stops the run (at `step`, time `t`) when the crater `rows` (from
+    /// [`CraterWatch::sample`]) reaches [`DEEPEST_FRACTION`] of the clay's depth under a
+    /// point: the block is thinner than the crater.
+    pub fn check_depth(&self, rows: &[CraterRow], step: u64, t: f64) -> Result<()> {
+        for (row, &h) in rows.iter().zip(&self.block_depth) {
+            if h > 0.0 && row[2] >= DEEPEST_FRACTION * h {
+                return Err(WeftError::Numerical {
+                    what: format!(
+                        "the crater {r0:.4e} m from the shot's axis is {d:.4e} m deep, {p:.0} % of the clay block's depth {h:.4e} m there: the block is thinner than the crater (its floor, held, shapes it)",
+                        r0 = row[0],
+                        d = row[2],
+                        p = 100.0 * row[2] / h
+                    ),
+                    step,
+                    time: t,
+                    hint: Some(
+                        "a deeper block: weft-weave --clay-depth (NIJ Standard-0101.06's box is 0.14 m deep)".into(),
+                    ),
+                });
+            }
+        }
+        Ok(())
     }
 }

@@ -75,8 +75,12 @@ impl Solver {
                 if self.watch.is_active() {
                     self.watch_sample(&mut sampler.cur.layers);
                 }
+                // The crater, and whether the clay is deep enough for it (the run stops
+                // after this sample is sent when it is not).
+                let mut too_deep = Ok(());
                 if let Some(c) = &self.crater {
                     c.sample(&self.state.xn, &self.failures, &mut sampler.cur.crater);
+                    too_deep = c.check_depth(&sampler.cur.crater, self.state.step, self.state.t);
                 }
                 sampler.emit(
                     &mut k,
@@ -95,6 +99,7 @@ impl Solver {
                     self.sampled_to = (k - 1) as f64 * a.output_interval;
                 }
                 times.output += t3.elapsed();
+                too_deep?;
             }
             self.ledger.mass_damping += 0.5 * dt_next * dp;
             self.state.t += dt_next;
