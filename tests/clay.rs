@@ -615,3 +615,90 @@ fn a_crater_deeper_than_its_block_stops_the_run_naming_the_flag() {
         "bfs.parquet ends at the last sample"
     );
 }
+
+/// The armour test's verdict follows NIJ Standard-0101.06's rules (as the NRC's review of
+/// 2012 restates them): a fair hit (the level's velocity ± 9.1 m/s) passes when the bullet
+/// is arrested and the back-face signature is at most 44 mm; a perforation or a deeper
+/// crater fails; a run that stopped, a shot off the level's velocity or a bullet not yet
+/// arrested (the crater may still deepen) gets no verdict. Summaries written here, one
+/// per case; the verdicts, margins and exit code checked against those rules.
+#[test]
+fn the_nij_verdict_follows_the_standards_rules() {
+    use weft::table::{batch, write_table, Col, Provenance};
+    let dir = tempfile::tempdir().unwrap();
+    let prov = Provenance::new("test", serde_json::json!({}));
+    // (name, status, outcome, striking velocity, bfs, expected pass)
+    let cases: [(&str, &str, &str, f64, f64, Option<bool>); 6] = [
+        ("pass", "completed", "arrested", 373.0, 0.030, Some(true)),
+        ("deep", "completed", "arrested", 370.0, 0.0445, Some(false)),
+        (
+            "through",
+            "completed",
+            "perforated",
+            380.0,
+            0.020,
+            Some(false),
+        ),
+        ("going", "completed", "undecided", 373.0, 0.030, None),
+        ("slow", "completed", "arrested", 363.0, 0.030, None),
+        ("broke", "stopped", "undecided", 373.0, 0.030, None),
+    ];
+    let mut args = vec!["nij".to_string(), "--level".into(), "IIA".into()];
+    for (name, status, outcome, v, bfs, _) in cases {
+        let run = dir.path().join(name);
+        std::fs::create_dir_all(&run).unwrap();
+        let b = batch(vec![
+            Col::Str("status", vec![status.into()]),
+            Col::OptStr("outcome", vec![Some(outcome.into())]),
+            Col::OptF64("striking_velocity", vec![Some(v)]),
+            Col::OptF64("bfs", vec![Some(bfs)]),
+        ]);
+        write_table(&run.join("summary.parquet"), &b, &prov).unwrap();
+        args.extend(["--run".into(), run.display().to_string()]);
+    }
+    let out = dir.path().join("verdict");
+    args.extend(["--out".into(), out.display().to_string()]);
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_weft-ballistic"))
+        .args(&args)
+        .output()
+        .unwrap();
+    eprintln!("{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(o.status.code(), Some(1), "not every shot passes: exit 1");
+    let t = Table::read(&out.join("nij.parquet")).unwrap();
+    let pass = t.bool_opt("pass").unwrap().unwrap();
+    let margin = t.f64("bfs_margin", "").unwrap();
+    for (k, case) in cases.iter().enumerate() {
+        assert_eq!(pass[k], case.5, "{}", case.0);
+        assert!((margin[k] - (0.044 - case.4)).abs() < 1e-12, "{}", case.0);
+    }
+    // Only the passing shot: exit 0.
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_weft-ballistic"))
+        .args(["nij", "--level", "IIA", "--run"])
+        .arg(dir.path().join("pass"))
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(o.status.success());
+    // A shot without clay: named.
+    let bare = dir.path().join("bare");
+    std::fs::create_dir_all(&bare).unwrap();
+    let b = batch(vec![
+        Col::Str("status", vec!["completed".into()]),
+        Col::OptF64("striking_velocity", vec![Some(398.0)]),
+        Col::OptF64("bfs", vec![None]),
+    ]);
+    write_table(&bare.join("summary.parquet"), &b, &prov).unwrap();
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_weft-ballistic"))
+        .args(["nij", "--level", "II", "--run"])
+        .arg(&bare)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success() && e.contains("bfs") && e.contains("--backing clay"),
+        "{e}"
+    );
+}

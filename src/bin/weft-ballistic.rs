@@ -88,6 +88,36 @@ enum Command {
         after_help = "Example:\n  weft-weave clay-drop --out runs/drop\n  weft-ballistic clay-calibration --model runs/drop --out runs/clay"
     )]
     ClayCalibration(ClayArgs),
+    /// The armour test's verdict (NIJ Standard-0101.06) on shots of packs on the clay:
+    /// no perforation and a back-face signature ≤ 44 mm, at the level's velocity.
+    #[command(
+        long_about = "The armour test's verdict (NIJ Standard-0101.06) on shots of a pack on the clay \
+                      (weft-simulate of weft-weave woven --backing clay): a shot at the level's \
+                      velocity (9 mm FMJ RN: IIA 373 m/s, II 398 m/s, ± 9.1 m/s) passes when the \
+                      bullet is arrested without perforating the pack and the back-face signature \
+                      (the summary's bfs, the crater's depth in the clay) is at most 44 mm; the \
+                      margin is 44 mm − BFS. A run that stopped, a shot outside the level's \
+                      velocities or one whose bullet was not yet arrested at the run's end (the \
+                      crater may still deepen) gets no verdict, with the reason.\n\n\
+                      Writes nij.parquet (one row per run) into --out (docs/tables.md). Exits with \
+                      1 unless every shot passes.",
+        after_help = "Example:\n  weft-weave woven --layers 24 --backing clay --projectile-velocity 398 --out runs/pack\n  weft-simulate --model runs/pack --out runs/pack-398 --end-time 1e-3\n  weft-ballistic nij --run runs/pack-398 --level II --out runs/verdict"
+    )]
+    Nij(NijArgs),
+}
+
+#[derive(clap::Args)]
+struct NijArgs {
+    /// A shot's run folder (weft-simulate --out, its summary.parquet); repeat it for
+    /// several.
+    #[arg(long, required = true, num_args = 1..)]
+    run: Vec<PathBuf>,
+    /// The protection level: IIA (373 m/s) or II (398 m/s).
+    #[arg(long, value_enum)]
+    level: weft::ballistic::nij::Level,
+    /// Output folder for nij.parquet.
+    #[arg(long)]
+    out: PathBuf,
 }
 
 #[derive(clap::Args)]
@@ -243,7 +273,48 @@ fn run_cli() -> anyhow::Result<ExitCode> {
         Command::Search(a) => search_cmd(a),
         Command::Zone(a) => zone_cmd(a),
         Command::ClayCalibration(a) => clay_cmd(a),
+        Command::Nij(a) => nij_cmd(a),
     }
+}
+
+fn nij_cmd(a: NijArgs) -> anyhow::Result<ExitCode> {
+    use weft::ballistic::nij;
+    let mut prov = Provenance::new(
+        "ballistic",
+        serde_json::json!({ "runs": a.run, "level": a.level.name() }),
+    );
+    let mut verdicts = vec![];
+    for run in &a.run {
+        prov = prov.with_input(&run.join("summary.parquet"))?;
+        let v = nij::judge(run, a.level)?;
+        eprintln!(
+            "{}: {:.1} m/s, {}, BFS {:.1} mm (margin {:+.1} mm): {}{}",
+            run.display(),
+            v.striking_velocity,
+            v.outcome,
+            1e3 * v.bfs,
+            1e3 * v.bfs_margin,
+            match v.pass {
+                Some(true) => "PASS",
+                Some(false) => "FAIL",
+                None => "no verdict",
+            },
+            if v.reason.is_empty() {
+                String::new()
+            } else {
+                format!(" ({})", v.reason)
+            }
+        );
+        verdicts.push(v);
+    }
+    std::fs::create_dir_all(&a.out).map_err(|e| weft::WeftError::io(&a.out, e))?;
+    nij::write(&a.out.join("nij.parquet"), a.level, &verdicts, &prov)?;
+    eprintln!("  wrote {}/nij.parquet", a.out.display());
+    Ok(if verdicts.iter().all(|v| v.pass == Some(true)) {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(1)
+    })
 }
 
 fn clay_cmd(a: ClayArgs) -> anyhow::Result<ExitCode> {
