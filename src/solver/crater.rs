@@ -3,14 +3,13 @@
 //! A model with clay names its top surface's points along a radius from the shot's axis
 //! (node set `clay_profile`, outwards). Each point stands on a column of the clay's grid:
 //! the nodes below it with the same reference x and y. The crater's floor at a point is
-//! the column's highest node that still belongs to a live cell (`FailureLog::attached`):
+//! the column's highest node that still belongs to a live cell (the failure log's live-element counts):
 //! the top node itself until every cell around it has eroded, then the next one down.
 //! An eroded cell's orphaned node flies on as a free mass and says nothing of the crater.
 //! Its depth is measured from the undisturbed top, −(z − Z_top), and its radius is where
 //! that node is now. Without erosion every column's top node is attached and the crater
 //! is the top's displacement.
 
-use super::FailureLog;
 use crate::error::{Result, WeftError};
 use crate::model::{ElementKind, Model};
 
@@ -103,15 +102,21 @@ impl CraterWatch {
         self.columns.is_empty()
     }
 
-    /// The crater now, one row per point (see [`CraterRow`]), at positions `x` with the
-    /// live elements of `failures`. A column eroded through reads its bottom node.
-    pub fn sample(&self, x: &[[f64; 3]], failures: &FailureLog, rows: &mut Vec<CraterRow>) {
+    /// The crater now, one row per point (see [`CraterRow`]), at positions `x`, with
+    /// `attached(n)` whether node n still belongs to a live element
+    /// (`FailureLog::is_attached`). A column eroded through reads its bottom node.
+    pub fn sample(
+        &self,
+        x: &[[f64; 3]],
+        attached: impl Fn(usize) -> bool,
+        rows: &mut Vec<CraterRow>,
+    ) {
         rows.clear();
         for (k, col) in self.columns.iter().enumerate() {
             let n = col
                 .iter()
                 .copied()
-                .find(|&n| failures.is_attached(n as usize))
+                .find(|&n| attached(n as usize))
                 .unwrap_or(col[col.len() - 1]) as usize;
             rows.push([self.r0[k], x[n][0].hypot(x[n][1]), self.z_top[k] - x[n][2]]);
         }

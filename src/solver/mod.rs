@@ -232,7 +232,7 @@ impl Solver {
     pub fn crater(&self) -> Vec<crater::CraterRow> {
         let mut rows = vec![];
         if let Some(c) = &self.crater {
-            c.sample(&self.state.xn, &self.failures, &mut rows);
+            c.sample(&self.state.xn, |n| self.failures.is_attached(n), &mut rows);
         }
         rows
     }

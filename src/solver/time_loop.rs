@@ -79,7 +79,12 @@ impl Solver {
                 // after this sample is sent when it is not).
                 let mut too_deep = Ok(());
                 if let Some(c) = &self.crater {
-                    c.sample(&self.state.xn, &self.failures, &mut sampler.cur.crater);
+                    let log = &self.failures;
+                    c.sample(
+                        &self.state.xn,
+                        |n| log.is_attached(n),
+                        &mut sampler.cur.crater,
+                    );
                     too_deep = c.check_depth(&sampler.cur.crater, self.state.step, self.state.t);
                 }
                 sampler.emit(
