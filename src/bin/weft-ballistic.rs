@@ -17,7 +17,7 @@ use weft::table::Provenance;
 #[command(
     name = "weft-ballistic",
     version,
-    about = "Ballistic limits (V50, the Lambert–Jonas fit) from impact runs, or by running them; the failed zone of impact runs; the backing clay's drop calibration",
+    about = "Ballistic limits (V50, the Lambert–Jonas fit) from impact runs, or by running them; the failed zone of impact runs; the backing clay's drop calibration; the armour test's verdict on shots on the clay",
     long_about = "The ballistic limit of a fabric from impacts at several striking velocities \
                   (docs/theory.md, \"Failure, perforation and the ballistic limit\").\n\n\
                   `fit` gathers impact runs (the weft-simulate output folders, or one table that \
@@ -34,10 +34,14 @@ use weft::table::Provenance;
                   `clay-calibration` runs the armour test's clay drop (weft-weave clay-drop) \
                   and judges its indentation against NIJ Standard-0101.06's band \
                   (clay_calibration.parquet).\n\n\
+                  `nij` judges shots of a pack on the clay as the standard does: no \
+                  perforation and a back-face signature of at most 44 mm at the level's \
+                  velocity (nij.parquet).\n\n\
                   Example:\n  weft-ballistic fit --runs runs/v300 runs/v350 runs/v400 --out runs/limit\n  \
                   weft-ballistic search --model runs/patch --lo 50 --hi 400 --tolerance 5 --out runs/search\n  \
                   weft-ballistic zone --run runs/v400 --model runs/patch --out runs/zone\n  \
-                  weft-ballistic clay-calibration --model runs/drop --out runs/clay"
+                  weft-ballistic clay-calibration --model runs/drop --out runs/clay\n  \
+                  weft-ballistic nij --run runs/pack-398 --level II --out runs/verdict"
 )]
 struct Cli {
     #[command(subcommand)]
