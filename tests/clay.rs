@@ -246,31 +246,7 @@ fn an_eroded_clay_cell_is_a_reported_failure() {
     let dir = tempfile::tempdir().unwrap();
     let r = weave_and_simulate(
         dir.path(),
-        &[
-            "clay-drop",
-            "--clay-fine",
-            "1e-3",
-            "--clay-fine-half",
-            "15e-3",
-            "--clay-fine-depth",
-            "20e-3",
-            "--clay-half-width",
-            "0.1",
-            "--clay-depth",
-            "0.06",
-            "--clay-erosion-strain",
-            "1.5",
-            "--diameter",
-            "9e-3",
-            "--mass",
-            "8e-3",
-            "--height",
-            "183.5",
-            "--end-time",
-            "1.5e-4",
-            "--output-interval",
-            "5e-6",
-        ],
+        &eroding_drop("20e-3", "0.06"),
         &["--element-results", "clay"],
     );
     let f = Table::read(&r.join("failures.parquet")).unwrap();
@@ -364,6 +340,37 @@ fn an_eroded_clay_cell_is_a_reported_failure() {
         summary_bfs < tip + 1e-5,
         "summary bfs {summary_bfs} m, tip {tip} m"
     );
+}
+
+/// `weft-weave clay-drop`'s flags for the standard's sphere's size, 9 mm and 8 g, at
+/// 60 m/s (dropped 183.5 m) into 1 mm cells eroded at ε_p = 1.5, in a block
+/// `depth` deep whose fine cells reach `fine_depth` [m], to 150 µs.
+fn eroding_drop(fine_depth: &'static str, depth: &'static str) -> Vec<&'static str> {
+    vec![
+        "clay-drop",
+        "--clay-fine",
+        "1e-3",
+        "--clay-fine-half",
+        "15e-3",
+        "--clay-fine-depth",
+        fine_depth,
+        "--clay-half-width",
+        "0.1",
+        "--clay-depth",
+        depth,
+        "--clay-erosion-strain",
+        "1.5",
+        "--diameter",
+        "9e-3",
+        "--mass",
+        "8e-3",
+        "--height",
+        "183.5",
+        "--end-time",
+        "1.5e-4",
+        "--output-interval",
+        "5e-6",
+    ]
 }
 
 /// A ply on the clay (`weft-weave woven --backing clay`), struck at 100 m/s by the rigid
@@ -550,36 +557,9 @@ fn a_ply_on_the_clay_presses_a_crater_that_follows_its_back_face() {
 fn a_crater_deeper_than_its_block_stops_the_run_naming_the_flag() {
     let dir = tempfile::tempdir().unwrap();
     let (m, r) = (dir.path().join("m"), dir.path().join("r"));
-    run_ok(
-        WEAVE,
-        &[
-            "clay-drop",
-            "--out",
-            m.to_str().unwrap(),
-            "--clay-fine",
-            "1e-3",
-            "--clay-fine-half",
-            "15e-3",
-            "--clay-fine-depth",
-            "6e-3",
-            "--clay-half-width",
-            "0.1",
-            "--clay-depth",
-            "0.008",
-            "--clay-erosion-strain",
-            "1.5",
-            "--diameter",
-            "9e-3",
-            "--mass",
-            "8e-3",
-            "--height",
-            "183.5",
-            "--end-time",
-            "1.5e-4",
-            "--output-interval",
-            "5e-6",
-        ],
-    );
+    let mut weave: Vec<&str> = eroding_drop("6e-3", "0.008");
+    weave.extend(["--out", m.to_str().unwrap()]);
+    run_ok(WEAVE, &weave);
     let o = std::process::Command::new(env!("CARGO_BIN_EXE_weft-simulate"))
         .args([
             "--model",

@@ -159,29 +159,11 @@ impl Sampler {
                 sink.layers(tk, rows)?;
             }
             if !cur.states.is_empty() {
-                let rows = if w >= 1.0 || prev.states.len() != cur.states.len() {
-                    &cur.states
-                } else {
-                    self.interp_states.clear();
-                    for (a, b) in prev.states.iter().zip(&cur.states) {
-                        self.interp_states
-                            .push(std::array::from_fn(|c| a[c] + w * (b[c] - a[c])));
-                    }
-                    &self.interp_states
-                };
+                let rows = lerp_rows(&prev.states, &cur.states, w, &mut self.interp_states);
                 sink.element_states(tk, rows)?;
             }
             if !cur.crater.is_empty() {
-                let rows = if w >= 1.0 || prev.crater.len() != cur.crater.len() {
-                    &cur.crater
-                } else {
-                    self.interp_crater.clear();
-                    for (a, b) in prev.crater.iter().zip(&cur.crater) {
-                        self.interp_crater
-                            .push(std::array::from_fn(|c| a[c] + w * (b[c] - a[c])));
-                    }
-                    &self.interp_crater
-                };
+                let rows = lerp_rows(&prev.crater, &cur.crater, w, &mut self.interp_crater);
                 sink.crater(tk, rows)?;
             }
             progress(*k, tk);
@@ -191,6 +173,26 @@ impl Sampler {
         self.have_prev = true;
         Ok(())
     }
+}
+
+/// Rows of values interpolated between two snapshots at weight `w` (into `out`), or
+/// the current ones where `w` ≥ 1 or the rows differ in number.
+fn lerp_rows<'a, const N: usize>(
+    prev: &[[f64; N]],
+    cur: &'a [[f64; N]],
+    w: f64,
+    out: &'a mut Vec<[f64; N]>,
+) -> &'a [[f64; N]] {
+    if w >= 1.0 || prev.len() != cur.len() {
+        return cur;
+    }
+    out.clear();
+    out.extend(
+        prev.iter()
+            .zip(cur)
+            .map(|(a, b)| std::array::from_fn(|c| a[c] + w * (b[c] - a[c]))),
+    );
+    out
 }
 
 /// Everything in memory: `u[k][j]` is the displacement of output node j at sample k.
