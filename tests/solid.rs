@@ -371,6 +371,13 @@ fn bad_solids_are_refused_naming_what_is_wrong() {
         },
         "tangent",
     );
+    refused(
+        PartProps {
+            solid_formulation: Some("fully_integrated".into()),
+            ..steel(0.3)
+        },
+        "solid_formulation `fully_integrated`",
+    );
 }
 
 #[test]

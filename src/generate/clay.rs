@@ -59,6 +59,9 @@ pub struct Clay {
     pub hourglass: f64,
     /// Erosion of the cells at this equivalent plastic strain (None: none).
     pub erosion_plastic_strain: Option<f64>,
+    /// Selective-reduced (eight-point, hourglass-free) cells instead of the one-point
+    /// ones (then `hourglass` is not used): the part's `solid_formulation`.
+    pub selective_reduced: bool,
 }
 
 impl Clay {
@@ -77,6 +80,7 @@ impl Clay {
             reference_rate: 1.0,
             hourglass: 0.1,
             erosion_plastic_strain: None,
+            selective_reduced: false,
         }
     }
 
@@ -92,6 +96,9 @@ impl Clay {
             plasticine_m: Some(self.m),
             plasticine_reference_rate: Some(self.reference_rate),
             erosion_plastic_strain: self.erosion_plastic_strain,
+            solid_formulation: self
+                .selective_reduced
+                .then(|| "selective_reduced".to_string()),
             ..Default::default()
         }
     }

@@ -599,6 +599,17 @@ part_properties! {
         aliases: [],
         meaning: "the material law of a solid part, by name: `elastic`, `j2`, `johnson_cook`, `plasticine` (src/material/)",
     },
+    solid_formulation: String {
+        unit: "",
+        // Checked when the hexahedra are built.
+        kinds: [Hex: Rule::Free],
+        null: null(
+            "one_point",
+            "the one-point element with the viscous hourglass control; the column is written only when some part names a formulation",
+        ),
+        aliases: [],
+        meaning: "the hexahedron's integration: `one_point` (one point, Flanagan–Belytschko hourglass control, `hourglass` its coefficient) or `selective_reduced` (eight points for the deviatoric stress, the mean for the pressure: no hourglass modes, no coefficient; several times the cost; src/solver/solid/selective.rs)",
+    },
 }
 
 impl PartProps {

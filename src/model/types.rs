@@ -27,6 +27,24 @@ impl Part {
     pub fn material(&self) -> crate::error::Result<crate::material::Material> {
         crate::material::Material::of_part(&self.name, self.props.material.as_deref(), &self.props)
     }
+
+    /// Whether a solid part's hexahedra are selective-reduced (its `solid_formulation`:
+    /// null or `one_point`: no; `selective_reduced`: yes); another name is an error
+    /// naming the part and the column.
+    pub fn selective_reduced(&self) -> crate::error::Result<bool> {
+        match self.props.solid_formulation.as_deref() {
+            None | Some("one_point") => Ok(false),
+            Some("selective_reduced") => Ok(true),
+            Some(other) => Err(crate::error::WeftError::input(format!(
+                "part `{}` (hex): solid_formulation `{other}`",
+                self.name
+            ))
+            .in_file("parts.parquet")
+            .in_column("solid_formulation")
+            .expected("`one_point` or `selective_reduced`")
+            .hint("see docs/tables.md, parts.parquet")),
+        }
+    }
 }
 
 /// Elements of one kind, struct-of-arrays; `nodes` holds `nodes_per_element` node

@@ -42,7 +42,7 @@ pub fn validate_part(p: &Part) -> Result<()> {
         ElementKind::Tri | ElementKind::Quad => validate_membrane_part(p),
         // The material's constants that involve each other (E_t < E, T_room < T_melt,
         // Johnson–Cook's n ≤ 1, χ ≤ 1, one plasticity model).
-        ElementKind::Hex => p.material().map(|_| ()),
+        ElementKind::Hex => p.material().and_then(|_| p.selective_reduced()).map(|_| ()),
         _ => Ok(()),
     }
 }

@@ -123,6 +123,9 @@ pub enum Criterion {
     TimeStep,
     /// A hexahedron's equivalent plastic strain (its part's `erosion_plastic_strain`).
     PlasticStrain,
+    /// A selective-reduced hexahedron of an eroding part folded at an integration point
+    /// (det J ≤ 0 there): the value is the point's det J over the element's mean, V/8.
+    Inverted,
 }
 
 impl Criterion {
@@ -136,6 +139,7 @@ impl Criterion {
             Criterion::Opening => "opening",
             Criterion::TimeStep => "time_step",
             Criterion::PlasticStrain => "plastic_strain",
+            Criterion::Inverted => "inverted",
         }
     }
 }

@@ -6,6 +6,13 @@ use std::path::PathBuf;
 use weft::generate::clay::{Clay, ClayBlock, ClayDropParams};
 use weft::generate::weave::Spec;
 
+/// The clay cells' integration (--clay-formulation).
+#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum ClayFormulation {
+    OnePoint,
+    SelectiveReduced,
+}
+
 /// The backing clay's constants and its block (defaults: Roma Plastilina No. 1 as the
 /// model calibrates it, in NIJ Standard-0101.06's 610 × 610 × 140 mm box).
 #[derive(clap::Args)]
@@ -45,6 +52,12 @@ pub struct ClayArgs {
     /// "The backing clay", "The pack on the clay").
     #[arg(long)]
     clay_erosion_strain: Option<f64>,
+    /// The clay cells' integration: `one-point` (one point with the viscous hourglass
+    /// control of --clay-hourglass) or `selective-reduced` (eight points for the
+    /// deviatoric stress, the mean for the pressure: no hourglass modes and no
+    /// coefficient, at several times the cost) (docs/theory.md, "The pack on the clay").
+    #[arg(long, value_enum, default_value_t = ClayFormulation::OnePoint)]
+    clay_formulation: ClayFormulation,
     /// Half the clay box's width [m] (quarter model: the block spans 0 to it in x and y)
     /// [default: 0.305, the standard's box].
     #[arg(long)]
@@ -83,6 +96,7 @@ impl ClayArgs {
             reference_rate: self.clay_reference_rate,
             hourglass: self.clay_hourglass.unwrap_or(hourglass),
             erosion_plastic_strain: self.clay_erosion_strain.or(erosion).filter(|&e| e != 0.0),
+            selective_reduced: self.clay_formulation == ClayFormulation::SelectiveReduced,
         }
     }
     /// The block, `d`'s values where the flags are not given.

@@ -37,6 +37,7 @@
 //! run's stiffening check stop it, naming the element, before it goes unstable.
 
 use super::kernel::{self, BULK_Q1, BULK_Q2};
+use super::selective::Eroded;
 use crate::error::Result;
 use crate::material::{Material, PointState};
 use crate::model::ElementKind;
@@ -59,8 +60,14 @@ pub struct HexGroup {
     pub materials: Vec<Material>,
     /// Q_hg of the element's part.
     pub q_hg: Vec<f64>,
-    /// The integration point's state (stress, plastic strain, temperature).
+    /// The integration point's state (stress, plastic strain, temperature); for a
+    /// selective-reduced element the volume-weighted mean of its eight points' states.
     pub state: Vec<PointState>,
+    /// Whether the element is selective-reduced (its part's `solid_formulation`).
+    pub selective: Vec<bool>,
+    /// The eight points' states of every element when some part is selective-reduced
+    /// (the one-point elements' stay unused), empty otherwise.
+    pub points: Vec<[PointState; 8]>,
     /// Accumulated [internal, bulk viscosity, hourglass] energy [J] per element.
     pub work: Vec<[f64; 3]>,
     /// The last step's bulk viscosity and hourglass forces, for the energy booking.
@@ -109,6 +116,15 @@ pub fn gershgorin_rows(g: &HexGeometry, lam: f64, mu: f64) -> [f64; 8] {
         }
         g.volume.abs() * best
     })
+}
+
+/// The element's Gershgorin rows at the shape `x`, by its formulation.
+fn rows_at(selective: bool, x: &[Vec3; 8], lam: f64, mu: f64) -> [f64; 8] {
+    if selective {
+        super::selective::gershgorin_rows(&super::selective::gauss_geometry(x), lam, mu)
+    } else {
+        gershgorin_rows(&hex8::hex_geometry(x), lam, mu)
+    }
 }
 
 /// Tensor contraction σ:ε of Voigt [xx, yy, zz, xy, yz, zx] tensor components.
@@ -257,7 +273,7 @@ impl Family for HexGroup {
                 let g = hex8::hex_geometry(&xe);
                 let l = hex8::characteristic_length(&xe, g.volume);
                 let (lam, mu) = self.mat(e).lame();
-                let now = gershgorin_rows(&g, lam, mu);
+                let now = rows_at(self.selective[e], &xe, lam, mu);
                 let add = std::array::from_fn(|a| now[a] - self.rows[e][a]);
                 (add, [g.volume / self.v0[e], l / self.l0[e], 0.0])
             })
@@ -302,6 +318,7 @@ impl Family for HexGroup {
             return Ok(g);
         };
         let mut by_part: Vec<Option<u32>> = vec![None; m.parts.len()];
+        let mut selective_part: Vec<Option<bool>> = vec![None; m.parts.len()];
         for e in 0..b.len() {
             let pi = b.part[e];
             let part = &m.parts[pi];
@@ -325,14 +342,22 @@ impl Family for HexGroup {
             g.id.push(b.id[e]);
             g.nodes.push(ns.map(|n| n as u32));
             g.material.push(mi);
+            let sel = match selective_part[pi] {
+                Some(s) => s,
+                None => *selective_part[pi].insert(part.selective_reduced()?),
+            };
             g.q_hg.push(part.props.hourglass_coefficient());
             g.state.push(mat.initial_state());
+            g.selective.push(sel);
             g.work.push([0.0; 3]);
             g.previous.push(Previous::default());
             g.l0.push(hex8::characteristic_length(&x, geo.volume));
             g.v0.push(geo.volume);
             let (lam, mu) = mat.lame();
-            g.rows.push(gershgorin_rows(&geo, lam, mu));
+            g.rows.push(rows_at(sel, &x, lam, mu));
+        }
+        if g.selective.iter().any(|&s| s) {
+            g.points = g.state.iter().map(|&st| [st; 8]).collect();
         }
         if g.materials
             .iter()
@@ -364,77 +389,130 @@ impl Family for HexGroup {
             work,
             previous,
             erosion,
+            selective,
+            points,
             ..
         } = self;
-        let (nodes, material, materials, q_hg) = (&*nodes, &*material, &*materials, &*q_hg);
+        let (nodes, material, materials) = (&*nodes, &*material, &*materials);
+        let (q_hg, selective) = (&*q_hg, &*selective);
         // Element e's step into its force slots (its node positions and velocities
-        // gathered); whether it has eroded.
+        // gathered; its eight points' states when some part is selective-reduced);
+        // why it eroded at this step, if it did.
         let step = |e: usize,
                     st: &mut PointState,
                     pv: &mut Previous,
                     wk: &mut [f64; 3],
+                    pts: Option<&mut [PointState; 8]>,
                     slots: &mut [Vec3]|
-         -> bool {
+         -> Option<Eroded> {
             let ns = &nodes[e];
             let x: [Vec3; 8] = std::array::from_fn(|a| ctx.x[ns[a] as usize]);
             let v: [Vec3; 8] = std::array::from_fn(|a| ctx.v[ns[a] as usize]);
-            element_step(
-                &materials[material[e] as usize],
-                q_hg[e],
-                st,
-                pv,
-                wk,
-                &x,
-                &v,
-                ctx.dt_prev,
-                slots,
-            )
-        };
-        if !erosion.active() {
-            // Each chunk of force slots travels with its elements' state, previous forces
-            // and work.
-            let slices = (
-                (Per(fe, 8), Per(&mut state[..], 1)),
-                (Per(&mut previous[..], 1), Per(&mut work[..], 1)),
-            );
-            for_chunks_of(nodes.len(), slices, |ci, ((out, st), (pv, wk))| {
-                let e0 = ci * CHUNK;
-                for (j, slots) in out.chunks_exact_mut(8).enumerate() {
-                    step(e0 + j, &mut st[j], &mut pv[j], &mut wk[j], slots);
-                }
-            });
-            return;
-        }
-        // With erosion: the same, and each element that erodes this step is reported.
-        let Erosion { fate, any, .. } = erosion;
-        let any = &*any;
-        let slices = (
-            (Per(fe, 8), Per(&mut state[..], 1)),
-            (
-                (Per(&mut previous[..], 1), Per(&mut work[..], 1)),
-                Per(&mut fate[..], 1),
-            ),
-        );
-        for_chunks_of(nodes.len(), slices, |ci, ((out, st), ((pv, wk), fates))| {
-            let e0 = ci * CHUNK;
-            for (j, slots) in out.chunks_exact_mut(8).enumerate() {
-                let e = e0 + j;
-                let eroded = step(e, &mut st[j], &mut pv[j], &mut wk[j], slots);
-                if eroded && !fates[j].eroded {
-                    let mat = &materials[material[e] as usize];
-                    let failure = Failure {
-                        kind: ElementKind::Hex,
-                        element: e,
-                        criterion: Criterion::PlasticStrain,
-                        value: st[j].plastic_strain,
-                        limit: mat.erosion_plastic_strain.unwrap_or(f64::NAN),
-                        eroded: true,
-                        energy: 0.0,
-                    };
-                    fates[j].fail(failure, any);
-                }
+            let mat = &materials[material[e] as usize];
+            match pts {
+                Some(p) if selective[e] => super::selective::element_step(
+                    mat,
+                    p,
+                    st,
+                    &mut pv.bulk,
+                    wk,
+                    &x,
+                    &v,
+                    ctx.dt_prev,
+                    slots,
+                ),
+                _ => element_step(mat, q_hg[e], st, pv, wk, &x, &v, ctx.dt_prev, slots)
+                    .then_some(Eroded::PlasticStrain),
             }
-        });
+        };
+        // An element that erodes this step, reported once.
+        let report = |e: usize,
+                      why: Eroded,
+                      st: &PointState,
+                      fate: &mut crate::solver::failure::Fate,
+                      any| {
+            if fate.eroded {
+                return;
+            }
+            let mat = &materials[material[e] as usize];
+            let (criterion, value, limit) = match why {
+                Eroded::PlasticStrain => (
+                    Criterion::PlasticStrain,
+                    st.plastic_strain,
+                    mat.erosion_plastic_strain.unwrap_or(f64::NAN),
+                ),
+                Eroded::Inverted(ratio) => (Criterion::Inverted, ratio, 0.0),
+            };
+            let failure = Failure {
+                kind: ElementKind::Hex,
+                element: e,
+                criterion,
+                value,
+                limit,
+                eroded: true,
+                energy: 0.0,
+            };
+            fate.fail(failure, any);
+        };
+        // Each chunk of force slots travels with its elements' state, previous forces,
+        // work, points (when selective-reduced) and fates (when eroding).
+        let n = nodes.len();
+        let own = (
+            (Per(fe, 8), Per(&mut state[..], 1)),
+            (Per(&mut previous[..], 1), Per(&mut work[..], 1)),
+        );
+        match (erosion.active(), points.is_empty()) {
+            (false, true) => for_chunks_of(n, own, |ci, ((out, st), (pv, wk))| {
+                for (j, slots) in out.chunks_exact_mut(8).enumerate() {
+                    step(
+                        ci * CHUNK + j,
+                        &mut st[j],
+                        &mut pv[j],
+                        &mut wk[j],
+                        None,
+                        slots,
+                    );
+                }
+            }),
+            (false, false) => {
+                let slices = (own, Per(&mut points[..], 1));
+                for_chunks_of(n, slices, |ci, (((out, st), (pv, wk)), pts)| {
+                    for (j, slots) in out.chunks_exact_mut(8).enumerate() {
+                        let p = Some(&mut pts[j]);
+                        step(ci * CHUNK + j, &mut st[j], &mut pv[j], &mut wk[j], p, slots);
+                    }
+                })
+            }
+            (true, true) => {
+                let any = &erosion.any;
+                let slices = (own, Per(&mut erosion.fate[..], 1));
+                for_chunks_of(n, slices, |ci, (((out, st), (pv, wk)), fates)| {
+                    for (j, slots) in out.chunks_exact_mut(8).enumerate() {
+                        let e = ci * CHUNK + j;
+                        if let Some(why) = step(e, &mut st[j], &mut pv[j], &mut wk[j], None, slots)
+                        {
+                            report(e, why, &st[j], &mut fates[j], any);
+                        }
+                    }
+                })
+            }
+            (true, false) => {
+                let any = &erosion.any;
+                let slices = (
+                    own,
+                    (Per(&mut points[..], 1), Per(&mut erosion.fate[..], 1)),
+                );
+                for_chunks_of(n, slices, |ci, (((out, st), (pv, wk)), (pts, fates))| {
+                    for (j, slots) in out.chunks_exact_mut(8).enumerate() {
+                        let e = ci * CHUNK + j;
+                        let p = Some(&mut pts[j]);
+                        if let Some(why) = step(e, &mut st[j], &mut pv[j], &mut wk[j], p, slots) {
+                            report(e, why, &st[j], &mut fates[j], any);
+                        }
+                    }
+                })
+            }
+        }
     }
     fn erosion(&self) -> Option<&Erosion> {
         self.erosion.active().then_some(&self.erosion)

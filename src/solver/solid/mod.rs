@@ -5,7 +5,10 @@
 //! - [`kernel`]: velocity gradient, objective rotation of the stress, hourglass shape
 //!   vectors and forces, bulk viscosity; the geometry (exact volume, the mean-strain
 //!   gradient operator) is the shape's, [`crate::shape::hex8`];
+//! - [`selective`]: the selective-reduced (B̄, eight-point) element, hourglass-free,
+//!   for parts whose `solid_formulation` is `selective_reduced`;
 //! - the material laws the element carries are [`crate::material`]'s.
 
 pub mod hex;
 pub mod kernel;
+pub mod selective;
