@@ -433,6 +433,41 @@ mod tests {
         }
     }
 
+    /// A corner driven through the element (node 7 of a unit cube pushed from (1, 1, 1)
+    /// to (0.1, 0.1, 0.1)) folds the point nearest it: det J = −0.0849 there (the
+    /// trilinear map evaluated independently, with numpy), V = 0.325 still positive; in
+    /// a part that erodes the element leaves at once with zero forces and that det J
+    /// over V/8 (−2.09) as its reason; in one that does not it carries on (the run's
+    /// health checks judge it).
+    #[test]
+    fn a_folded_element_of_an_eroding_part_erodes_as_inverted() {
+        let mut x = unit_cube();
+        x[6] = [0.1, 0.1, 0.1];
+        let gg = gauss_geometry(&x);
+        let folded = gg.dv.iter().fold(f64::INFINITY, |m, &d| m.min(d));
+        assert!((folded + 0.084_927_86).abs() < 1e-8, "{:?}", gg.dv);
+        assert!((gg.volume - 0.325).abs() < 1e-15);
+        let v = [[0.0; 3]; 8];
+        for erosion in [Some(1.5), None] {
+            let mut mat = elastic(1e9, 0.3);
+            mat.erosion_plastic_strain = erosion;
+            let mut pts = [PointState::default(); 8];
+            let (mut mean, mut q, mut work) = (PointState::default(), 0.0, [0.0; 3]);
+            let mut out = [[1.0; 3]; 8];
+            let why = element_step(
+                &mat, &mut pts, &mut mean, &mut q, &mut work, &x, &v, 1e-9, &mut out,
+            );
+            if erosion.is_some() {
+                assert_eq!(why, Some(Eroded::Inverted(folded / (gg.volume / 8.0))));
+                assert!(mean.eroded && pts.iter().all(|p| p.eroded));
+                assert_eq!(out, [[0.0; 3]; 8]);
+            } else {
+                assert_eq!(why, None);
+                assert!(!mean.eroded);
+            }
+        }
+    }
+
     /// The Gershgorin rows bound the largest eigenvalue of the element stiffness
     /// (Gershgorin's theorem): the largest ω²m of a unit cube found by power iteration on
     /// K u = −f(u), run through the element itself, stays below max_a S_a.
