@@ -170,7 +170,7 @@ fn selective_reduced_cells_meet_the_sphere_as_hertz_says() {
 /// The clay as weft ships it (Roma Plastilina No. 1 calibrated, the default block and
 /// cells of 3 mm), struck as NIJ Standard-0101.06 calibrates it: the indentation within
 /// the standard's 19 ± 3 mm, and `clay_calibration.parquet` says so with the constants
-/// used. Measured: 18.90 mm (18.83 with 2 mm cells, 19.03 with 4 mm: the depth moves by
+/// used. Measured: 19.00 mm (18.93 with 2 mm cells, 19.12 with 4 mm: the depth moves by
 /// 0.4 % from 3 to 2 mm); the energy balance 2.3e-5.
 #[test]
 fn the_standard_drop_indents_the_shipped_clay_within_the_band() {

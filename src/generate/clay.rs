@@ -67,7 +67,7 @@ pub struct Clay {
 impl Clay {
     /// Roma Plastilina No. 1 as the model's calibration sets it (docs/theory.md, "The
     /// backing clay"): density, elasticity and rate exponent assumed, A = 99 kPa set so
-    /// that the standard's drop indents 19 mm (18.90 mm with the default 3 mm cells).
+    /// that the standard's drop indents 19 mm (19.00 mm with the default 3 mm cells).
     pub fn roma() -> Clay {
         Clay {
             density: 1500.0,
