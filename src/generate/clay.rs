@@ -227,7 +227,9 @@ impl ClayBlock {
 /// The hourglass coefficient of the clay under a pack: the yarns press the clay's top at
 /// points a spacing apart, and at the drop's Q_hg = 0.1 its surface corrugates cell by
 /// cell (±1 mm at 6 mm deep, the balance 6 % at 200 µs: 4 plies at 150 m/s); 0.3 keeps it
-/// smooth (the crater 1.1 % shallower). Not the drop's default: there the step is the
+/// smooth (the crater 1.1 % shallower); 0.2 goes unstable at 175 µs, and from 0.3 to 1.0
+/// the crater at 1 ms spans 0.25 % (no hourglass control at all, selective-reduced cells:
+/// +0.1 % at 200 µs). Not the drop's default: there the step is the
 /// clay's own, which the hourglass viscosity (not in the stable-step estimate) then
 /// exceeds (docs/theory.md, "The pack on the clay").
 pub const PACK_HOURGLASS: f64 = 0.3;
