@@ -143,7 +143,7 @@ pub fn run_drop(m: &Model) -> Result<Drop> {
             reference_rate: c.plasticine_reference_rate.unwrap_or(1.0),
             hourglass: c.hourglass_coefficient(),
             erosion_plastic_strain: c.erosion_plastic_strain,
-            selective_reduced: c.solid_formulation.as_deref() == Some("selective_reduced"),
+            selective_reduced: part.selective_reduced()?,
         },
         fine,
         end_time: stats.end_time,

@@ -127,12 +127,6 @@ fn rows_at(selective: bool, x: &[Vec3; 8], lam: f64, mu: f64) -> [f64; 8] {
     }
 }
 
-/// Tensor contraction σ:ε of Voigt [xx, yy, zz, xy, yz, zx] tensor components.
-#[inline(always)]
-fn contract(s: &[f64; 6], e: &[f64; 6]) -> f64 {
-    s[0] * e[0] + s[1] * e[1] + s[2] * e[2] + 2.0 * (s[3] * e[3] + s[4] * e[4] + s[5] * e[5])
-}
-
 /// What the energy booking of the next step needs of this one: the bulk viscosity q^n
 /// [Pa] and the hourglass coefficient times the mode velocities, coef·q_α^n [N].
 #[derive(Debug, Clone, Copy, Default)]
@@ -169,9 +163,7 @@ fn element_step(
     let mut d_mid = [0.0; 6];
     let mut v_mid = 0.0;
     if dt > 0.0 {
-        let xm: [Vec3; 8] =
-            std::array::from_fn(|a| std::array::from_fn(|i| x[a][i] - 0.5 * dt * v[a][i]));
-        let gm = hex8::hex_geometry(&xm);
+        let gm = hex8::hex_geometry(&kernel::mid_step_shape(x, v, dt));
         let l = kernel::velocity_gradient(&gm.b, v);
         let (d, w) = kernel::split_velocity_gradient(&l);
         let r = kernel::hughes_winget(&w, dt);
@@ -180,7 +172,7 @@ fn element_step(
         let deps: [f64; 6] = std::array::from_fn(|i| d[i] * dt);
         mat.update(st, &deps, dt);
         let mid: [f64; 6] = std::array::from_fn(|i| 0.5 * (before[i] + st.stress[i]));
-        work[0] += contract(&mid, &deps) * gm.volume;
+        work[0] += kernel::contract(&mid, &deps) * gm.volume;
         d_mid = d;
         v_mid = gm.volume;
     }

@@ -48,6 +48,18 @@ pub fn velocity_gradient(b: &[[f64; 3]; 8], v: &[[f64; 3]; 8]) -> Mat3 {
     l
 }
 
+/// The mid-step shape x^{n−½} = xⁿ − ½Δt v^{n−½}, where the step's rates are taken.
+#[inline]
+pub fn mid_step_shape(x: &[Vec3; 8], v: &[Vec3; 8], dt: f64) -> [Vec3; 8] {
+    std::array::from_fn(|a| std::array::from_fn(|i| x[a][i] - 0.5 * dt * v[a][i]))
+}
+
+/// σ:ε of symmetric tensors in Voigt order [xx, yy, zz, xy, yz, zx] (tensor components).
+#[inline(always)]
+pub fn contract(s: &[f64; 6], e: &[f64; 6]) -> f64 {
+    s[0] * e[0] + s[1] * e[1] + s[2] * e[2] + 2.0 * (s[3] * e[3] + s[4] * e[4] + s[5] * e[5])
+}
+
 /// D = ½(L + Lᵀ) in Voigt order [xx, yy, zz, xy, yz, zx] (tensor components, not
 /// engineering shear: D_xy = ½(L_xy + L_yx)).
 pub fn rate_of_deformation(l: &Mat3) -> [f64; 6] {

@@ -164,18 +164,6 @@ pub fn gershgorin_rows(gg: &GaussGeometry, lam: f64, mu: f64) -> [f64; 8] {
     })
 }
 
-/// L = Σ_a v_a ⊗ ∇N_a at one point.
-#[inline]
-fn gradient_at(grad: &[[f64; 3]; 8], v: &[Vec3; 8]) -> [[f64; 3]; 3] {
-    kernel::velocity_gradient(grad, v)
-}
-
-/// σ:ε of Voigt tensor components.
-#[inline(always)]
-fn contract(s: &[f64; 6], e: &[f64; 6]) -> f64 {
-    s[0] * e[0] + s[1] * e[1] + s[2] * e[2] + 2.0 * (s[3] * e[3] + s[4] * e[4] + s[5] * e[5])
-}
-
 /// Why an element eroded at this step.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Eroded {
@@ -210,14 +198,12 @@ pub fn element_step(
     let mut tr_mid = 0.0;
     let mut v_mid = 0.0;
     if dt > 0.0 {
-        let xm: [Vec3; 8] =
-            std::array::from_fn(|a| std::array::from_fn(|i| x[a][i] - 0.5 * dt * v[a][i]));
-        let gm = gauss_geometry(&xm);
+        let gm = gauss_geometry(&kernel::mid_step_shape(x, v, dt));
         let l_mean = kernel::velocity_gradient(&gm.mean, v);
         tr_mid = l_mean[0][0] + l_mean[1][1] + l_mean[2][2];
         v_mid = gm.volume;
         for (g, st) in points.iter_mut().enumerate() {
-            let l = gradient_at(&gm.grad[g], v);
+            let l = kernel::velocity_gradient(&gm.grad[g], v);
             let (mut d, w) = kernel::split_velocity_gradient(&l);
             let shift = (d[0] + d[1] + d[2] - tr_mid) / 3.0;
             for c in d.iter_mut().take(3) {
@@ -229,7 +215,7 @@ pub fn element_step(
             let deps: [f64; 6] = std::array::from_fn(|i| d[i] * dt);
             mat.law.update(&mat.elastic, st, &deps, dt);
             let mid: [f64; 6] = std::array::from_fn(|i| 0.5 * (before[i] + st.stress[i]));
-            work[0] += contract(&mid, &deps) * gm.dv[g];
+            work[0] += kernel::contract(&mid, &deps) * gm.dv[g];
         }
     }
     let gg = gauss_geometry(x);
