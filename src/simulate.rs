@@ -50,6 +50,9 @@ pub struct Config {
     /// End the run once the projectile's outcome is decided (analysis `stop_on_outcome`).
     #[serde(default)]
     pub stop_on_outcome: Option<bool>,
+    /// Subcycle the slow solids (analysis `subcycle`).
+    #[serde(default)]
+    pub subcycle: Option<bool>,
 }
 
 /// What a run reports back to the binary.
@@ -98,6 +101,9 @@ pub fn apply_overrides(m: &mut Model, c: &Config) {
     }
     if let Some(v) = c.stop_on_outcome {
         a.stop_on_outcome = v;
+    }
+    if let Some(v) = c.subcycle {
+        a.subcycle = v;
     }
     if let Some(speed) = c.projectile_velocity {
         m.set_striking_speed(speed);
@@ -533,6 +539,22 @@ fn run_columns(r: &Report, s: &Solver, st: &RunStats) -> Vec<Col> {
         Col::Str("controlling_kind", vec![kind]),
         Col::I64("controlling_element", vec![id]),
         Col::I64("controlling_node", vec![s.node_ids()[s.time_step().node]]),
+        Col::OptI64(
+            "subcycle_ratio",
+            vec![s.subcycle().map(|c| c.first_ratio as i64)],
+        ),
+        Col::OptI64(
+            "subcycle_ratio_min",
+            vec![s.subcycle().map(|c| c.ratio as i64)],
+        ),
+        Col::I64(
+            "slow_elements",
+            vec![s.subcycle().map_or(0, |c| c.elements as i64)],
+        ),
+        Col::I64(
+            "slow_samples",
+            vec![s.subcycle().map_or(0, |c| c.samples as i64)],
+        ),
         Col::OptF64(
             "dt_stable_unscaled",
             vec![sc.as_ref().map(|x| x.dt_stable_unscaled)],

@@ -14,7 +14,7 @@
 
 use weft::generate::block::hex_block;
 use weft::model::{ElementKind, Load, Model, PartProps, TimeLaw};
-use weft::solver::family::{Build, Family, ForceCtx};
+use weft::solver::family::{Build, Family, ForceCtx, SlowStep};
 use weft::solver::rotations::Rotations;
 use weft::solver::run_in_memory;
 use weft::solver::solid::hex::HexGroup;
@@ -219,6 +219,7 @@ fn the_patch_test_a_linear_velocity_field_on_a_distorted_mesh_gives_one_stress_a
         v: &v,
         rot_r: &[],
         dt_prev: dt,
+        slow: SlowStep::NONE,
     };
     let mut fe = vec![[0.0; 3]; 8 * g.len()];
     g.forces(&ctx, &mut fe);
@@ -292,6 +293,7 @@ fn a_rigid_rotation_of_ninety_degrees_turns_a_uniaxial_stress_with_the_body() {
             v: &v,
             rot_r: &[],
             dt_prev: dt,
+            slow: SlowStep::NONE,
         };
         g.forces(&ctx, &mut fe);
         prev = x;

@@ -147,8 +147,33 @@ pub(crate) fn part_list(m: &Model) -> String {
 /// solver's own lumping, before ties and mass scaling).
 pub fn lumped_masses(m: &Model, keep: &[bool]) -> Result<Vec<f64>> {
     let mut mm = m.clone();
+    // A solid's material refuses a zero density: the hexahedra of the parts left out
+    // are removed instead (their block keeps the rest, in order).
+    if let Some(b) = mm.elements.get_mut(&ElementKind::Hex) {
+        let kept: Vec<usize> = (0..b.len()).filter(|&e| keep[b.part[e]]).collect();
+        if kept.len() < b.len() {
+            let pick = |v: &[Option<i64>]| -> Vec<Option<i64>> {
+                if v.is_empty() {
+                    vec![]
+                } else {
+                    kept.iter().map(|&e| v[e]).collect()
+                }
+            };
+            b.layer = pick(&b.layer);
+            b.yarn = pick(&b.yarn);
+            if !b.failure_factor.is_empty() {
+                b.failure_factor = kept.iter().map(|&e| b.failure_factor[e]).collect();
+            }
+            b.nodes = kept
+                .iter()
+                .flat_map(|&e| b.nodes[8 * e..8 * e + 8].to_vec())
+                .collect();
+            b.id = kept.iter().map(|&e| b.id[e]).collect();
+            b.part = kept.iter().map(|&e| b.part[e]).collect();
+        }
+    }
     for (p, part) in mm.parts.iter_mut().enumerate() {
-        if !keep[p] {
+        if !keep[p] && part.kind != ElementKind::Hex {
             if part.props.density.is_some() {
                 part.props.density = Some(0.0);
             }

@@ -82,6 +82,12 @@ struct Cli {
     /// (arrested, or perforated and free of the fabric) instead of at the end time.
     #[arg(long)]
     stop_on_outcome: bool,
+    /// Subcycle the solids whose stable step is many times the step, `on` or `off` [model
+    /// default: analysis `subcycle`]: they are updated every so many steps, their forces
+    /// the impulse of that slow step (docs/theory.md, "Subcycling"; a clay block under a
+    /// yarn-level pack). The summary reports the ratio and the slow elements.
+    #[arg(long, value_parser = on_off)]
+    subcycle: Option<bool>,
     /// Linear static solve (K u = F with the load amplitudes) instead of the explicit run:
     /// history.parquet gets one sample at t = 0.
     #[arg(long = "static")]
@@ -89,6 +95,15 @@ struct Cli {
     /// No progress bar.
     #[arg(long, short)]
     quiet: bool,
+}
+
+/// `on` / `off` for a flag that overrides a model's setting either way.
+fn on_off(s: &str) -> Result<bool, String> {
+    match s {
+        "on" => Ok(true),
+        "off" => Ok(false),
+        _ => Err(format!("`{s}`: expected `on` or `off`")),
+    }
 }
 
 fn main() -> ExitCode {
@@ -119,6 +134,7 @@ fn run_cli() -> anyhow::Result<ExitCode> {
         element_results: cli.element_results.clone(),
         projectile_velocity: cli.projectile_velocity,
         stop_on_outcome: cli.stop_on_outcome.then_some(true),
+        subcycle: cli.subcycle,
     };
     let progress = Progress::new(
         cli.quiet,

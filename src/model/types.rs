@@ -311,6 +311,11 @@ pub struct Analysis {
     /// contact penalties keep the first step's stiffness (so their ωΔt only falls).
     /// Default false: one step for the whole run, and a crushed solid stops it, named.
     pub variable_time_step: bool,
+    /// Subcycle the solids whose stable step is many times the step (docs/theory.md,
+    /// "Subcycling"): they are updated every `ratio` steps, their forces the impulse of
+    /// that slow step (a clay block under a yarn-level pack: its cells' step is hundreds
+    /// of the yarns'). Default false: every element every step.
+    pub subcycle: bool,
 }
 
 impl Default for Analysis {
@@ -326,6 +331,7 @@ impl Default for Analysis {
             max_energy_error: 0.1,
             stop_on_outcome: false,
             variable_time_step: false,
+            subcycle: false,
         }
     }
 }

@@ -56,6 +56,48 @@ pub struct ForceCtx<'a> {
     pub rot_r: &'a [Mat3],
     /// Δt^{n−½} [s].
     pub dt_prev: f64,
+    /// Where this step stands in the subcycle of the slow elements
+    /// ([`crate::solver::subcycle`]); [`SlowStep::NONE`] when nothing is subcycled.
+    pub slow: SlowStep,
+}
+
+/// The slow elements' part of a step ([`crate::solver::subcycle`]): whether they are
+/// updated at this step (a sample of the slow step), the time since their last update
+/// T^{k−½} [s] (their Δt), and the weight of their forces, (T^{k−½} + T^{k+½}) /
+/// (Δt^{n−½} + Δt^{n+½}), which makes the node update's kick of this step the slow
+/// step's impulse.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SlowStep {
+    pub sample: bool,
+    pub dt: f64,
+    pub weight: f64,
+    /// The weight of an element that leaves the slow step at this sample (fast from the
+    /// next step: its impulse closes the slow interval and opens a fast step),
+    /// (T^{k−½} + Δt^{n+½}) / (Δt^{n−½} + Δt^{n+½}).
+    pub close: f64,
+}
+
+impl SlowStep {
+    /// No subcycle: every element is updated every step.
+    pub const NONE: SlowStep = SlowStep {
+        sample: true,
+        dt: 0.0,
+        weight: 1.0,
+        close: 1.0,
+    };
+}
+
+/// The slow elements a family chose for the subcycle ([`Family::choose_subcycle`]).
+#[derive(Debug, Clone, Default)]
+pub struct SlowChoice {
+    /// Fast steps per slow step.
+    pub ratio: u64,
+    /// How many elements are slow.
+    pub elements: usize,
+    /// The nodes of the slow elements (ascending).
+    pub nodes: Vec<usize>,
+    /// Those of them that no fast element of the family has.
+    pub slow_only: Vec<usize>,
 }
 
 /// What the stable-step bound reads.
@@ -217,6 +259,27 @@ pub trait Family: Sized + Send + Sync {
     /// with and the fixed directions (the membranes' collapse criterion keeps what it
     /// compares with).
     fn step_was_set(&mut self, _x_ref: &[Vec3], _mass: &[f64], _fixed: &[u8]) {}
+    /// A family that can subcycle ([`crate::solver::subcycle`]; the hexahedra) chooses its
+    /// slow elements from each node's stable step `node_dt` [s] (with the margin of the
+    /// fast step) and the fast step `dt`, and from then on updates them at the slow
+    /// samples of [`ForceCtx::slow`] only. `None` (the default): nothing subcycles.
+    fn choose_subcycle(&mut self, _node_dt: &[f64], _dt: f64, _x: &[Vec3]) -> Option<SlowChoice> {
+        None
+    }
+    /// The slow elements' forces per node at the last slow sample [N], unweighted
+    /// ([`crate::solver::subcycle`]); `None` without slow elements.
+    fn slow_forces(&self) -> Option<&[Vec3]> {
+        None
+    }
+    /// The stiffening of the slow elements at `x` (as [`Family::add_stiffening`], which
+    /// leaves them out: the slow step follows them, not the fast one).
+    fn add_slow_stiffening(
+        &self,
+        _x: &[Vec3],
+        _extra: &mut [f64],
+        _most: &mut [Option<Stiffened>],
+    ) {
+    }
 }
 
 /// Totals of the energy ledger's groups (see [`EnergyGroup`]).
@@ -372,6 +435,38 @@ macro_rules! families {
                         $crate::solver::family::Family::add_stiffening(&self.$field, x, extra, most);
                     }
                 )*
+            }
+            /// The first family that subcycles ([`Family::choose_subcycle`]), in list order.
+            pub fn choose_subcycle(
+                &mut self,
+                node_dt: &[f64],
+                dt: f64,
+                x: &[$crate::solver::vec3::Vec3],
+            ) -> Option<$crate::solver::family::SlowChoice> {
+                $(
+                    if let Some(c) = $crate::solver::family::Family::choose_subcycle(&mut self.$field, node_dt, dt, x) {
+                        return Some(c);
+                    }
+                )*
+                None
+            }
+            /// The slow elements' forces per node of the first family that has some.
+            pub fn slow_forces(&self) -> Option<&[$crate::solver::vec3::Vec3]> {
+                $(
+                    if let Some(f) = $crate::solver::family::Family::slow_forces(&self.$field) {
+                        return Some(f);
+                    }
+                )*
+                None
+            }
+            /// Every family's slow elements' stiffening ([`Family::add_slow_stiffening`]).
+            pub fn add_slow_stiffening(
+                &self,
+                x: &[$crate::solver::vec3::Vec3],
+                extra: &mut [f64],
+                most: &mut [Option<$crate::solver::family::Stiffened>],
+            ) {
+                $($crate::solver::family::Family::add_slow_stiffening(&self.$field, x, extra, most);)*
             }
             /// Marks the nodes of the families the variable step follows.
             pub fn mark_variable_step_nodes(&self, mark: &mut [bool]) {

@@ -33,6 +33,10 @@ pub struct Nodal<'a> {
     pub fixed: &'a [u8],
     /// Mass-proportional damping α [1/s].
     pub alpha: f64,
+    /// At a slow sample whose intervals are not the slow step ([`super::subcycle`]): per
+    /// node the slow forces' acceleration a_s and the coefficients (c₋, c₊) of the kinetic
+    /// energy's form ½ m (v^{n−½} + c₋ a_s)·(v^{n+½} + c₊ a_s); `None`: no shift.
+    pub ke_shift: Option<(&'a [[f64; 3]], f64, f64)>,
 }
 
 /// Gather forces and advance every node by one step; when `SNAP`, x^n and v^n are
@@ -100,7 +104,22 @@ pub fn advance_nodes<const SNAP: bool>(
                 // The kinetic energy the central difference conserves with the strain
                 // energy at x^n: ½ m v^{n−½}·v^{n+½} (exactly, for a linear system; see
                 // `advance_nodes`' doc).
-                ke += 0.5 * mass[i] * dot(&vo, &vnew);
+                ke += 0.5
+                    * mass[i]
+                    * match nd.ke_shift {
+                        None => dot(&vo, &vnew),
+                        Some((acc, cm, cp)) => {
+                            let a = acc[i];
+                            dot(
+                                &[vo[0] + cm * a[0], vo[1] + cm * a[1], vo[2] + cm * a[2]],
+                                &[
+                                    vnew[0] + cp * a[0],
+                                    vnew[1] + cp * a[1],
+                                    vnew[2] + cp * a[2],
+                                ],
+                            )
+                        }
+                    };
             }
             dp += mass[i] * v2;
             let xo = x[j];

@@ -56,6 +56,7 @@ pub mod sliding_link;
 pub mod solid;
 pub mod stable;
 pub mod statics;
+pub mod subcycle;
 pub mod ties;
 mod time_loop;
 pub mod truss;
@@ -152,6 +153,9 @@ pub struct Solver {
     /// The last output time sent to the sink (NaN before the first): where the tables of
     /// a run that stopped end.
     sampled_to: f64,
+    /// The slow elements' step, when the analysis subcycles and some are slow
+    /// ([`subcycle`]).
+    subcycle: Option<subcycle::Subcycle>,
 }
 
 /// What other stages read of a solver.
@@ -164,6 +168,11 @@ impl Solver {
     /// start), which displacements are measured from.
     pub fn reference_positions(&self) -> &[[f64; 3]] {
         &self.x0
+    }
+    /// The slow step of a subcycled run ([`subcycle`]): its ratio (now and first), the
+    /// slow elements, the samples taken; `None` when nothing is subcycled.
+    pub fn subcycle(&self) -> Option<&subcycle::Subcycle> {
+        self.subcycle.as_ref()
     }
     /// Positions, velocities, rotations, time and step.
     pub fn state(&self) -> &State {
@@ -313,6 +322,7 @@ impl Solver {
             v: &self.state.v,
             rot_r: &self.state.rot.r,
             dt_prev: self.state.dt_prev,
+            slow: self.state.slow,
         };
         let sums = self.op.el.energies(&ctx);
         ElementEnergies {

@@ -11,7 +11,7 @@
 
 use super::contact::{ProjectileContact, SurfaceContact};
 use super::families::Families;
-use super::family::ForceCtx;
+use super::family::{ForceCtx, SlowStep};
 use super::rotations::Rotations;
 use super::ties::Ties;
 use super::vec3::{add, dot};
@@ -33,6 +33,8 @@ pub struct State {
     pub step: u64,
     /// Δt^{n−½} [s].
     pub dt_prev: f64,
+    /// The slow elements' part of this step ([`super::subcycle`]).
+    pub slow: SlowStep,
 }
 
 /// Loads with their time laws, and the external work they do.
@@ -176,6 +178,7 @@ impl Operator {
             v: &st.v,
             rot_r: &st.rot.r,
             dt_prev: st.dt_prev,
+            slow: st.slow,
         };
         self.el.forces(&ctx, &mut self.fe);
     }

@@ -122,6 +122,7 @@ impl Solver {
                 t: 0.0,
                 step: 0,
                 dt_prev: 0.0,
+                slow: family::SlowStep::NONE,
             },
             op,
             inv_m: vec![0.0; nn],
@@ -145,6 +146,7 @@ impl Solver {
             watch: watch::Watch::new(m),
             crater: None,
             sampled_to: f64::NAN,
+            subcycle: None,
         };
         s.failures = FailureLog::new(&s.op.el, nn);
         s.crater = crater::CraterWatch::new(m, &s.x0);
@@ -162,6 +164,7 @@ impl Solver {
             s.op.surfaces.track_friction(nn);
             s.op.projectiles.node_friction = Some(vec![0.0; nn]);
         }
+        s.start_subcycle();
         s.op.ties
             .update_slaves(&mut s.state.x, &mut s.state.v, None);
         s.check_slave_velocities(m)?;

@@ -131,11 +131,16 @@ impl NodalBound<'_> {
 
     /// The stable step's nodal rows and the buffers of [`NodalBound::check_stiffening`],
     /// made once per run so that the check allocates nothing.
-    pub fn stiffening_check(&self) -> StiffeningCheck {
+    /// `slow_only`: nodes that only slow elements have ([`super::subcycle`]), which the
+    /// variable step leaves to the slow step.
+    pub fn stiffening_check(&self, slow_only: &[usize]) -> StiffeningCheck {
         let (s, c) = self.nodal_sums();
         let nn = s.len();
         let mut variable = vec![false; nn];
         self.op.el.mark_variable_step_nodes(&mut variable);
+        for &i in slow_only {
+            variable[i] = false;
+        }
         StiffeningCheck {
             s,
             c,
@@ -167,6 +172,35 @@ impl NodalBound<'_> {
             .add_stiffening(&self.state.x, &mut k.extra, &mut k.most, true);
         let mut best: Option<(f64, usize)> = None;
         for &i in &k.variable_nodes {
+            if self.fixed[i] == 0b111 || self.mass[i] <= 0.0 {
+                continue;
+            }
+            let dt_i = nodal_dt(k.s[i] + k.extra[i], k.c[i], self.mass[i], self.alpha);
+            if best.is_none_or(|b| dt_i < b.0) {
+                best = Some((dt_i, i));
+            }
+        }
+        best.map(|(dt, i)| (dt, i, k.most[i]))
+    }
+
+    /// The slow step's bound ([`super::subcycle`]): the slow elements' rows at their
+    /// current shape (the reference rows plus their stiffening) at their nodes `nodes`,
+    /// and the smallest stable step of those nodes with the node's index and the element
+    /// that stiffened it most. `None` without nodes.
+    pub fn slow_step(
+        &self,
+        k: &mut StiffeningCheck,
+        nodes: &[usize],
+    ) -> Option<(f64, usize, Option<Stiffened>)> {
+        for &i in nodes {
+            k.extra[i] = 0.0;
+            k.most[i] = None;
+        }
+        self.op
+            .el
+            .add_slow_stiffening(&self.state.x, &mut k.extra, &mut k.most);
+        let mut best: Option<(f64, usize)> = None;
+        for &i in nodes {
             if self.fixed[i] == 0b111 || self.mass[i] <= 0.0 {
                 continue;
             }

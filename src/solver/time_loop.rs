@@ -39,7 +39,12 @@ impl Solver {
         let mut k = 0u64;
         let progress_every = (n_out / 200).max(1);
         let mut last_e = Energies::default();
-        let mut stiffening = self.nodal_bound().stiffening_check();
+        let slow_only = self
+            .subcycle
+            .as_ref()
+            .map(|s| s.slow_only.clone())
+            .unwrap_or_default();
+        let mut stiffening = self.nodal_bound().stiffening_check(&slow_only);
         // The step of the integration; `dt`, the first, stays the contact penalties' step.
         let mut dt_step = self.stable.dt_min.min(dt);
         while k <= n_out {
@@ -50,6 +55,7 @@ impl Solver {
                 self.nodal_bound()
                     .check_stiffening(&mut stiffening, dt_step, a.dt_safety)?;
             }
+            self.plan_slow_step(k, n_out, a.output_interval, dt_step, &mut stiffening)?;
             let t2 = self.compute_forces(dt, &mut times);
             let dt_next = dt_step;
             let snap = k as f64 * a.output_interval <= self.state.t + dt_next;
@@ -175,11 +181,17 @@ impl Solver {
     /// kinetic energy and the mass-damping power, or the error that names a node gone
     /// non-finite.
     fn advance_nodes(&mut self, snap: bool, dt: f64) -> Result<(f64, f64)> {
+        let shifted = if snap { self.slow_ke_shift() } else { None };
+        let shift = match (&self.subcycle, shifted) {
+            (Some(sc), Some((cm, cp))) => Some((&sc.shift[..], cm, cp)),
+            _ => None,
+        };
         let nd = Nodal {
             inv_m: &self.inv_m,
             mass: &self.mass,
             fixed: &self.fixed,
             alpha: self.alpha,
+            ke_shift: shift,
         };
         let r = if snap {
             integrator::advance_nodes::<true>(

@@ -52,26 +52,32 @@ pub fn read(r: &mut Reading) -> Result<()> {
             .bool_opt("variable_time_step")?
             .and_then(|v| v[0])
             .unwrap_or(d.variable_time_step),
+        subcycle: t
+            .bool_opt("subcycle")?
+            .and_then(|v| v[0])
+            .unwrap_or(d.subcycle),
     };
     Ok(())
 }
 
-/// Writes the settings, every one.
+/// Writes the settings, every one (`subcycle` only when on).
 pub fn write(m: &Model, w: &Writing) -> Result<()> {
     let a = &m.analysis;
-    w.table(
-        FILE,
-        &batch(vec![
-            Col::F64("end_time", vec![a.end_time]),
-            Col::F64("output_interval", vec![a.output_interval]),
-            Col::F64("dt_safety", vec![a.dt_safety]),
-            Col::F64("mass_damping", vec![a.mass_damping]),
-            Col::OptF64("time_step", vec![a.time_step]),
-            Col::OptF64("target_time_step", vec![a.target_time_step]),
-            Col::Str("history_sets", vec![a.history_sets.join(",")]),
-            Col::F64("max_energy_error", vec![a.max_energy_error]),
-            Col::Bool("stop_on_outcome", vec![a.stop_on_outcome]),
-            Col::Bool("variable_time_step", vec![a.variable_time_step]),
-        ]),
-    )
+    let mut cols = vec![
+        Col::F64("end_time", vec![a.end_time]),
+        Col::F64("output_interval", vec![a.output_interval]),
+        Col::F64("dt_safety", vec![a.dt_safety]),
+        Col::F64("mass_damping", vec![a.mass_damping]),
+        Col::OptF64("time_step", vec![a.time_step]),
+        Col::OptF64("target_time_step", vec![a.target_time_step]),
+        Col::Str("history_sets", vec![a.history_sets.join(",")]),
+        Col::F64("max_energy_error", vec![a.max_energy_error]),
+        Col::Bool("stop_on_outcome", vec![a.stop_on_outcome]),
+        Col::Bool("variable_time_step", vec![a.variable_time_step]),
+    ];
+    // Written only when on: the tables of a model without it stay as they were.
+    if a.subcycle {
+        cols.push(Col::Bool("subcycle", vec![true]));
+    }
+    w.table(FILE, &batch(cols))
 }

@@ -38,14 +38,15 @@
 
 use super::kernel::{self, BULK_Q1, BULK_Q2};
 use super::selective::Eroded;
+use super::slow::{self, Slow};
 use crate::error::Result;
 use crate::material::{Material, PointState};
 use crate::model::ElementKind;
 use crate::shape::hex8::{self, HexGeometry};
-use crate::solver::failure::{Criterion, Erosion, Failure, FailureLaw};
+use crate::solver::failure::{Criterion, Erosion, Failure, FailureLaw, Fate};
 use crate::solver::family::{
     chunk_partials, for_chunks_of, Build, EnergyGroup, EnergyPartial, Family, ForceCtx, Per,
-    StateValues, StiffCtx, Stiffened, CHUNK,
+    SlowChoice, StateValues, StiffCtx, Stiffened, CHUNK,
 };
 use crate::solver::vec3::Vec3;
 
@@ -86,12 +87,67 @@ pub struct HexGroup {
     /// erodes is reported as a `plastic_strain` failure taking no energy (its work stays
     /// in the internal energy, which its zero forces no longer change).
     pub erosion: Erosion,
+    /// The slow elements of a subcycled run ([`crate::solver::subcycle`]); `None`:
+    /// every element is updated every step.
+    pub subcycle: Option<Slow>,
     partials: Vec<EnergyPartial>,
 }
 
 impl HexGroup {
     fn mat(&self, e: usize) -> &Material {
         &self.materials[self.material[e] as usize]
+    }
+
+    /// [`Family::add_stiffening`] for the elements `which` (ascending; `None`: all):
+    /// each element's rows S_a at its current shape less the reference ones it was
+    /// given, added to its nodes where they have grown (a crushed element: |b|²V grows
+    /// as it flattens); `most` gets (added, kind, id, [V/V₀, l/l₀, 0]).
+    fn stiffening_of(
+        &self,
+        which: Option<&[u32]>,
+        x: &[Vec3],
+        extra: &mut [f64],
+        most: &mut [Option<Stiffened>],
+    ) {
+        use rayon::prelude::*;
+        let count = which.map_or(self.nodes.len(), <[u32]>::len);
+        let element = |i: usize| which.map_or(i, |w| w[i] as usize);
+        let grown: Vec<([f64; 8], [f64; 3])> = (0..count)
+            .into_par_iter()
+            .with_min_len(1024)
+            .map(|i| {
+                let e = element(i);
+                if self.state[e].eroded {
+                    return ([0.0; 8], [0.0; 3]);
+                }
+                let ns = &self.nodes[e];
+                let xe: [Vec3; 8] = std::array::from_fn(|a| x[ns[a] as usize]);
+                let g = hex8::hex_geometry(&xe);
+                let l = hex8::characteristic_length(&xe, g.volume);
+                let (lam, mu) = self.mat(e).lame();
+                let now = rows_at(self.selective[e], &xe, lam, mu);
+                let add = std::array::from_fn(|a| now[a] - self.rows[e][a]);
+                (add, [g.volume / self.v0[e], l / self.l0[e], 0.0])
+            })
+            .collect();
+        for (i, (add, q)) in grown.iter().enumerate() {
+            let e = element(i);
+            for (a, &n) in self.nodes[e].iter().enumerate() {
+                if add[a] <= 0.0 {
+                    continue;
+                }
+                let n = n as usize;
+                extra[n] += add[a];
+                if most[n].is_none_or(|m| add[a] > m.added) {
+                    most[n] = Some(Stiffened {
+                        added: add[a],
+                        id: self.id[e],
+                        q: *q,
+                        describe: Self::describe_stiffening,
+                    });
+                }
+            }
+        }
     }
 }
 
@@ -223,6 +279,40 @@ fn element_step(
     st.eroded
 }
 
+/// Element `e` erodes at this step (`why`, its point's state `st`): reported once in its
+/// fate, as the failure log's `plastic_strain` (at its material's erosion strain) or
+/// `inverted` (a folded point).
+fn report_erosion(
+    mat: &Material,
+    e: usize,
+    why: Eroded,
+    st: &PointState,
+    fate: &mut Fate,
+    any: &std::sync::atomic::AtomicBool,
+) {
+    if fate.eroded {
+        return;
+    }
+    let (criterion, value, limit) = match why {
+        Eroded::PlasticStrain => (
+            Criterion::PlasticStrain,
+            st.plastic_strain,
+            mat.erosion_plastic_strain.unwrap_or(f64::NAN),
+        ),
+        Eroded::Inverted(ratio) => (Criterion::Inverted, ratio, 0.0),
+    };
+    let failure = Failure {
+        kind: ElementKind::Hex,
+        element: e,
+        criterion,
+        value,
+        limit,
+        eroded: true,
+        energy: 0.0,
+    };
+    fate.fail(failure, any);
+}
+
 impl Family for HexGroup {
     const KIND: ElementKind = ElementKind::Hex;
     const SLOTS: usize = 8;
@@ -247,46 +337,26 @@ impl Family for HexGroup {
             ]);
         }
     }
-    /// For the stiffening check of the fixed step ([`crate::solver::stable`]): each
-    /// element's rows S_a at its current shape less the reference ones it was given,
-    /// added to its nodes where they have grown (a crushed element: |b|²V grows as it
-    /// flattens); `most` gets (added, kind, id, [V/V₀, l/l₀, 0]).
+    /// For the stiffening check of the fixed step ([`crate::solver::stable`]):
+    /// [`HexGroup::stiffening_of`] the fast elements (all, without a subcycle).
     fn add_stiffening(&self, x: &[Vec3], extra: &mut [f64], most: &mut [Option<Stiffened>]) {
-        use rayon::prelude::*;
-        let grown: Vec<([f64; 8], [f64; 3])> = (0..self.nodes.len())
-            .into_par_iter()
-            .with_min_len(1024)
-            .map(|e| {
-                if self.state[e].eroded {
-                    return ([0.0; 8], [0.0; 3]);
-                }
-                let ns = &self.nodes[e];
-                let xe: [Vec3; 8] = std::array::from_fn(|a| x[ns[a] as usize]);
-                let g = hex8::hex_geometry(&xe);
-                let l = hex8::characteristic_length(&xe, g.volume);
-                let (lam, mu) = self.mat(e).lame();
-                let now = rows_at(self.selective[e], &xe, lam, mu);
-                let add = std::array::from_fn(|a| now[a] - self.rows[e][a]);
-                (add, [g.volume / self.v0[e], l / self.l0[e], 0.0])
-            })
-            .collect();
-        for (e, (ns, (add, q))) in self.nodes.iter().zip(&grown).enumerate() {
-            for (a, &n) in ns.iter().enumerate() {
-                if add[a] <= 0.0 {
-                    continue;
-                }
-                let n = n as usize;
-                extra[n] += add[a];
-                if most[n].is_none_or(|m| add[a] > m.added) {
-                    most[n] = Some(Stiffened {
-                        added: add[a],
-                        id: self.id[e],
-                        q: *q,
-                        describe: Self::describe_stiffening,
-                    });
-                }
-            }
+        match &self.subcycle {
+            Some(sc) => self.stiffening_of(Some(&sc.fast_list), x, extra, most),
+            None => self.stiffening_of(None, x, extra, most),
         }
+    }
+    fn add_slow_stiffening(&self, x: &[Vec3], extra: &mut [f64], most: &mut [Option<Stiffened>]) {
+        if let Some(sc) = &self.subcycle {
+            self.stiffening_of(Some(&sc.slow_list), x, extra, most);
+        }
+    }
+    fn slow_forces(&self) -> Option<&[Vec3]> {
+        self.subcycle.as_ref().map(|s| &s.force[..])
+    }
+    fn choose_subcycle(&mut self, node_dt: &[f64], dt: f64, x: &[Vec3]) -> Option<SlowChoice> {
+        let (s, choice) = slow::choose(&self.nodes, node_dt, dt, x)?;
+        self.subcycle = Some(s);
+        Some(choice)
     }
     fn describe_stiffening(id: i64, q: [f64; 3], dt_safety: f64) -> (String, Option<String>) {
         (
@@ -383,13 +453,18 @@ impl Family for HexGroup {
             erosion,
             selective,
             points,
+            subcycle,
             ..
         } = self;
         let (nodes, material, materials) = (&*nodes, &*material, &*materials);
         let (q_hg, selective) = (&*q_hg, &*selective);
+        let sub = subcycle.as_ref();
+        let (sample, live) = (ctx.slow.sample, sub.is_some_and(|s| s.live));
         // Element e's step into its force slots (its node positions and velocities
         // gathered; its eight points' states when some part is selective-reduced);
-        // why it eroded at this step, if it did.
+        // why it eroded at this step, if it did. A slow element (subcycle) steps at the
+        // slow samples only, over the slow interval with its nodes' mean velocities, its
+        // forces the weighted impulse; between them its slots are zero.
         let step = |e: usize,
                     st: &mut PointState,
                     pv: &mut Previous,
@@ -398,53 +473,33 @@ impl Family for HexGroup {
                     slots: &mut [Vec3]|
          -> Option<Eroded> {
             let ns = &nodes[e];
+            let slow = sub.filter(|s| s.slow[e]);
+            if slow.is_some() && !sample {
+                if live {
+                    slots.iter_mut().for_each(|f| *f = [0.0; 3]);
+                }
+                return None;
+            }
             let x: [Vec3; 8] = std::array::from_fn(|a| ctx.x[ns[a] as usize]);
-            let v: [Vec3; 8] = std::array::from_fn(|a| ctx.v[ns[a] as usize]);
+            let (v, dt) = match slow {
+                Some(s) => (s.velocities(ns, &x, ctx.slow.dt), ctx.slow.dt),
+                None => (std::array::from_fn(|a| ctx.v[ns[a] as usize]), ctx.dt_prev),
+            };
             let mat = &materials[material[e] as usize];
-            match pts {
-                Some(p) if selective[e] => super::selective::element_step(
-                    mat,
-                    p,
-                    st,
-                    &mut pv.bulk,
-                    wk,
-                    &x,
-                    &v,
-                    ctx.dt_prev,
-                    slots,
-                ),
-                _ => element_step(mat, q_hg[e], st, pv, wk, &x, &v, ctx.dt_prev, slots)
+            let why = match pts {
+                Some(p) if selective[e] => {
+                    super::selective::element_step(mat, p, st, &mut pv.bulk, wk, &x, &v, dt, slots)
+                }
+                _ => element_step(mat, q_hg[e], st, pv, wk, &x, &v, dt, slots)
                     .then_some(Eroded::PlasticStrain),
+            };
+            if let Some(s) = slow {
+                s.weigh(e, why.is_some(), &ctx.slow, slots);
             }
+            why
         };
-        // An element that erodes this step, reported once.
-        let report = |e: usize,
-                      why: Eroded,
-                      st: &PointState,
-                      fate: &mut crate::solver::failure::Fate,
-                      any| {
-            if fate.eroded {
-                return;
-            }
-            let mat = &materials[material[e] as usize];
-            let (criterion, value, limit) = match why {
-                Eroded::PlasticStrain => (
-                    Criterion::PlasticStrain,
-                    st.plastic_strain,
-                    mat.erosion_plastic_strain.unwrap_or(f64::NAN),
-                ),
-                Eroded::Inverted(ratio) => (Criterion::Inverted, ratio, 0.0),
-            };
-            let failure = Failure {
-                kind: ElementKind::Hex,
-                element: e,
-                criterion,
-                value,
-                limit,
-                eroded: true,
-                energy: 0.0,
-            };
-            fate.fail(failure, any);
+        let report = |e: usize, why, st: &PointState, fate: &mut Fate, any| {
+            report_erosion(&materials[material[e] as usize], e, why, st, fate, any)
         };
         // Each chunk of force slots travels with its elements' state, previous forces,
         // work, points (when selective-reduced) and fates (when eroding).
@@ -504,6 +559,16 @@ impl Family for HexGroup {
                     }
                 })
             }
+        }
+        if let Some(s) = subcycle.as_mut() {
+            let eroding =
+                erosion.active() && erosion.any.load(std::sync::atomic::Ordering::Relaxed);
+            s.after_pass(
+                ctx,
+                nodes,
+                fe,
+                eroding.then_some(|e: usize| state[e].eroded),
+            );
         }
     }
     fn erosion(&self) -> Option<&Erosion> {

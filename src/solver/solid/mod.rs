@@ -7,8 +7,10 @@
 //!   gradient operator) is the shape's, [`crate::shape::hex8`];
 //! - [`selective`]: the selective-reduced (B̄, eight-point) element, hourglass-free,
 //!   for parts whose `solid_formulation` is `selective_reduced`;
+//! - [`slow`]: the slow elements of a subcycled run ([`crate::solver::subcycle`]);
 //! - the material laws the element carries are [`crate::material`]'s.
 
 pub mod hex;
 pub mod kernel;
 pub mod selective;
+pub mod slow;

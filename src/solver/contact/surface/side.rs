@@ -356,6 +356,15 @@ impl MasterFaces {
 }
 
 impl Side {
+    /// The live faces' nodes (a solid's boundary, not the dormant interior faces of an
+    /// eroding one), each face's `nf` nodes in turn.
+    pub fn for_live_faces(&self, mut f: impl FnMut(&[u32])) {
+        for (i, face) in self.faces.iter().enumerate() {
+            if self.face_alive.get(i).copied().unwrap_or(true) {
+                f(&face[..self.nf]);
+            }
+        }
+    }
     /// The side of definition `row` whose `slave` nodes meet the faces of part `master`,
     /// with the nodal masses `mass`.
     pub(super) fn new(m: &Model, row: usize, slave: &Slave, master: usize, mass: &[f64]) -> Side {
