@@ -70,6 +70,8 @@ pub struct Report {
     /// A line on failures and the projectile's outcome, when the model can fail or has
     /// fabric layers and a projectile.
     pub ballistic: Option<String>,
+    /// A line on the subcycle, when the run subcycled (`analysis.subcycle`).
+    pub subcycle: Option<String>,
 }
 
 /// Apply command-line overrides to a model's analysis settings.
@@ -285,6 +287,12 @@ impl Report {
             out: c.out.clone(),
             contact: (!surfaces.is_empty()).then(|| surfaces.report(solver.node_ids())),
             ballistic: ballistic_line(solver),
+            subcycle: solver.subcycle().map(|c| {
+                format!(
+                    "subcycle: {} hexahedra on a slow step of {} steps ({} at the end), {} slow samples",
+                    c.elements, c.first_ratio, c.ratio, c.samples
+                )
+            }),
             stats,
         }
     }
@@ -502,6 +510,7 @@ fn run_static(
         out: c.out.clone(),
         contact: None,
         ballistic: None,
+        subcycle: None,
     })
 }
 

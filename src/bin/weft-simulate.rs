@@ -169,6 +169,9 @@ fn run_cli() -> anyhow::Result<ExitCode> {
         s.times.output.as_secs_f64(),
         s.element_updates_per_second()
     );
+    if let Some(line) = &r.subcycle {
+        eprintln!("  {line}");
+    }
     if let Some(c) = &r.contact {
         eprintln!(
             "  contact: {} definitions ({} sides on {} master surfaces), {} slave nodes against {} faces or segments; {} broad-phase builds (skin {:.3e} m) {:.3} s, narrow phase {:.3} s; {} slaves in contact at the end, friction work {:.4e} J",
