@@ -266,6 +266,12 @@ pub trait Family: Sized + Send + Sync {
     fn choose_subcycle(&mut self, _node_dt: &[f64], _dt: f64, _x: &[Vec3]) -> Option<SlowChoice> {
         None
     }
+    /// Per model node, whether only the family's slow elements act on it (between slow
+    /// samples no force does: the node update skips its slots); `None` without slow
+    /// elements.
+    fn drift_nodes(&self) -> Option<&[bool]> {
+        None
+    }
     /// The slow elements' forces per node at the last slow sample [N], unweighted
     /// ([`crate::solver::subcycle`]); `None` without slow elements.
     fn slow_forces(&self) -> Option<&[Vec3]> {
@@ -446,6 +452,15 @@ macro_rules! families {
                 $(
                     if let Some(c) = $crate::solver::family::Family::choose_subcycle(&mut self.$field, node_dt, dt, x) {
                         return Some(c);
+                    }
+                )*
+                None
+            }
+            /// The drifting nodes of the first family that has slow elements.
+            pub fn drift_nodes(&self) -> Option<&[bool]> {
+                $(
+                    if let Some(d) = $crate::solver::family::Family::drift_nodes(&self.$field) {
+                        return Some(d);
                     }
                 )*
                 None

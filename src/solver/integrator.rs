@@ -37,6 +37,9 @@ pub struct Nodal<'a> {
     /// node the slow forces' acceleration a_s and the coefficients (c₋, c₊) of the kinetic
     /// energy's form ½ m (v^{n−½} + c₋ a_s)·(v^{n+½} + c₊ a_s); `None`: no shift.
     pub ke_shift: Option<(&'a [[f64; 3]], f64, f64)>,
+    /// Between slow samples ([`super::subcycle`]): the nodes on which only slow elements
+    /// act, whose element slots are then zero and are skipped; `None`: none skipped.
+    pub drift: Option<&'a [bool]>,
 }
 
 /// Gather forces and advance every node by one step; when `SNAP`, x^n and v^n are
@@ -85,7 +88,10 @@ pub fn advance_nodes<const SNAP: bool>(
         let (mut ke, mut dp, mut bad) = (0.0, 0.0, usize::MAX);
         for j in 0..x.len() {
             let i = i0 + j;
-            let a = accel.of(i);
+            let a = match nd.drift {
+                Some(d) if d[i] => accel.without_slots(i),
+                _ => accel.of(i),
+            };
             let vo = v[j];
             let vh = [
                 (vo[0] + h_prev * a[0]) * c1,
@@ -176,6 +182,28 @@ impl Acceleration<'_> {
         }
         for &s in self.gather.of(i) {
             add(&mut f, &self.fe[s as usize]);
+        }
+        let im = self.inv_m[i];
+        let mut a = [f[0] * im, f[1] * im, f[2] * im];
+        let fx = self.fixed[i];
+        if fx != 0 {
+            for (d, ad) in a.iter_mut().enumerate() {
+                if fx & (1 << d) != 0 {
+                    *ad = 0.0;
+                }
+            }
+        }
+        a
+    }
+
+    /// Node i's acceleration without its element slots (a node whose only elements are
+    /// slow, between slow samples: their slots are zero): the load and the contact force
+    /// times 1/m, 0 along the fixed directions.
+    #[inline(always)]
+    fn without_slots(&self, i: usize) -> [f64; 3] {
+        let mut f = self.fext[i];
+        if let Some(fc) = self.fcon {
+            add(&mut f, &fc[i]);
         }
         let im = self.inv_m[i];
         let mut a = [f[0] * im, f[1] * im, f[2] * im];

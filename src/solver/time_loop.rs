@@ -192,6 +192,11 @@ impl Solver {
             fixed: &self.fixed,
             alpha: self.alpha,
             ke_shift: shift,
+            drift: if self.state.slow.sample {
+                None
+            } else {
+                self.op.el.drift_nodes()
+            },
         };
         let r = if snap {
             integrator::advance_nodes::<true>(

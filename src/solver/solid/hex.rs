@@ -350,6 +350,9 @@ impl Family for HexGroup {
             self.stiffening_of(Some(&sc.slow_list), x, extra, most);
         }
     }
+    fn drift_nodes(&self) -> Option<&[bool]> {
+        self.subcycle.as_ref().map(|s| &s.drift[..])
+    }
     fn slow_forces(&self) -> Option<&[Vec3]> {
         self.subcycle.as_ref().map(|s| &s.force[..])
     }

@@ -37,6 +37,9 @@ pub struct Slow {
     /// Per element: leaving the slow step at the next sample.
     pub leaving: Vec<bool>,
     pub any_leaving: bool,
+    /// Per model node: whether only slow elements act on it, so that between samples no
+    /// force does and it drifts (the node update then skips its slots).
+    pub drift: Vec<bool>,
 }
 
 /// Per element, the other elements that share a node with it (ascending).
@@ -153,6 +156,7 @@ pub fn choose(
         seen: vec![false; n],
         leaving: vec![false; n],
         any_leaving: false,
+        drift: (0..x.len()).map(|a| in_slow[a] && !in_fast[a]).collect(),
     };
     Some((s, choice))
 }
@@ -178,7 +182,7 @@ impl Slow {
     }
 
     /// After a sample: the elements that left the slow step there are fast from now on.
-    fn left(&mut self) {
+    fn left(&mut self, nodes: &[[u32; 8]]) {
         if !self.any_leaving {
             return;
         }
@@ -186,6 +190,9 @@ impl Slow {
             if self.leaving[e] {
                 self.slow[e] = false;
                 self.leaving[e] = false;
+                for &a in &nodes[e] {
+                    self.drift[a as usize] = false;
+                }
             }
         }
         self.any_leaving = false;
@@ -282,6 +289,6 @@ impl Slow {
             }
         }
         self.live = true;
-        self.left();
+        self.left(nodes);
     }
 }
