@@ -96,8 +96,6 @@ pub struct SlowChoice {
     pub elements: usize,
     /// The nodes of the slow elements (ascending).
     pub nodes: Vec<usize>,
-    /// Those of them that no fast element of the family has.
-    pub slow_only: Vec<usize>,
 }
 
 /// What the stable-step bound reads.

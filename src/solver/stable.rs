@@ -131,16 +131,14 @@ impl NodalBound<'_> {
 
     /// The stable step's nodal rows and the buffers of [`NodalBound::check_stiffening`],
     /// made once per run so that the check allocates nothing.
-    /// `slow_only`: nodes that only slow elements have ([`super::subcycle`]), which the
-    /// variable step leaves to the slow step.
-    pub fn stiffening_check(&self, slow_only: &[usize]) -> StiffeningCheck {
+    /// (With a subcycle the nodes of slow cells stay in the variable step's list: their
+    /// slow cells add no stiffening to it, and a cell that leaves the slow step, the
+    /// crater's floor, is followed from then on.)
+    pub fn stiffening_check(&self) -> StiffeningCheck {
         let (s, c) = self.nodal_sums();
         let nn = s.len();
         let mut variable = vec![false; nn];
         self.op.el.mark_variable_step_nodes(&mut variable);
-        for &i in slow_only {
-            variable[i] = false;
-        }
         StiffeningCheck {
             s,
             c,

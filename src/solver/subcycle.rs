@@ -43,9 +43,8 @@ pub struct Subcycle {
     pub first_ratio: u64,
     /// How many elements are slow.
     pub elements: usize,
-    /// The slow elements' nodes (ascending), and those that only slow elements have.
+    /// The slow elements' nodes (ascending).
     pub nodes: Vec<usize>,
-    pub slow_only: Vec<usize>,
     /// Fast steps since the last slow sample.
     since: u64,
     /// The time of the last slow sample [s].
@@ -132,7 +131,6 @@ impl Solver {
                 first_ratio: ch.ratio,
                 elements: ch.elements,
                 nodes: ch.nodes,
-                slow_only: ch.slow_only,
                 shift: vec![[0.0; 3]; self.mass.len()],
                 ..Default::default()
             });

@@ -39,12 +39,7 @@ impl Solver {
         let mut k = 0u64;
         let progress_every = (n_out / 200).max(1);
         let mut last_e = Energies::default();
-        let slow_only = self
-            .subcycle
-            .as_ref()
-            .map(|s| s.slow_only.clone())
-            .unwrap_or_default();
-        let mut stiffening = self.nodal_bound().stiffening_check(&slow_only);
+        let mut stiffening = self.nodal_bound().stiffening_check();
         // The step of the integration; `dt`, the first, stays the contact penalties' step.
         let mut dt_step = self.stable.dt_min.min(dt);
         while k <= n_out {

@@ -138,11 +138,6 @@ pub fn choose(
         ratio: m,
         elements: slow_list.len(),
         nodes: slow_nodes.iter().map(|&a| a as usize).collect(),
-        slow_only: slow_nodes
-            .iter()
-            .map(|&a| a as usize)
-            .filter(|&a| !in_fast[a])
-            .collect(),
     };
     let s = Slow {
         slow,
