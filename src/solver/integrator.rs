@@ -33,9 +33,10 @@ pub struct Nodal<'a> {
     pub fixed: &'a [u8],
     /// Mass-proportional damping α [1/s].
     pub alpha: f64,
-    /// At a slow sample whose intervals are not the slow step ([`super::subcycle`]): per
-    /// node the slow forces' acceleration a_s and the coefficients (c₋, c₊) of the kinetic
-    /// energy's form ½ m (v^{n−½} + c₋ a_s)·(v^{n+½} + c₊ a_s); `None`: no shift.
+    /// At an output sample that is a slow sample between two unequal slow intervals
+    /// ([`super::subcycle`]): per node the slow forces' acceleration a_s and the
+    /// coefficients (c₋, c₊) of the kinetic energy's form
+    /// ½ m (v^{n−½} + c₋ a_s)·(v^{n+½} + c₊ a_s); `None`: no shift.
     pub ke_shift: Option<(&'a [[f64; 3]], f64, f64)>,
     /// Between slow samples ([`super::subcycle`]): the nodes on which only slow elements
     /// act, whose element slots are then zero and are skipped; `None`: none skipped.
