@@ -24,7 +24,7 @@
 mod common;
 use common::*;
 
-use weft::analysis::energy::{self, reflection, region_energies, Region};
+use weft::analysis::energy;
 use weft::analysis::pulse::{self, launch_pulse};
 use weft::model::{ElementKind, Model, PartProps, Tie};
 use weft::solver::run_in_memory;
@@ -126,19 +126,8 @@ fn measured_r(b: &Bar2) -> f64 {
     let m = two_bars(b);
     let (_s, out, _) = run_in_memory(&m).unwrap();
     assert_eq!(out.nodes, (0..m.num_nodes()).collect::<Vec<_>>());
-    let regions = [
-        Region::parse("bar1").unwrap(),
-        Region::parse("bar2").unwrap(),
-    ];
-    let en = region_energies(
-        &m,
-        &regions,
-        &out.t,
-        &out.u,
-        &out.v,
-        std::path::Path::new("(memory)"),
-    )
-    .unwrap();
+    let t1 = L1 / c1();
+    let (en, r) = common::reflected_fraction(&m, &out, &["bar1", "bar2"], (1.4 * t1, 2.6 * t1));
     // The launched energy is the strip's kinetic energy, ½ Σ mᵢ vᵢ².
     let e0: f64 = m
         .initial_velocities
@@ -168,17 +157,7 @@ fn measured_r(b: &Bar2) -> f64 {
         rel(sum, e0) < 0.01,
         "bars hold {sum} J of {e0} J at the end"
     );
-    let t1 = L1 / c1();
-    let r = reflection(
-        "bar1",
-        &en.t,
-        &en.total(0),
-        Some(0.0),
-        Some((1.4 * t1, 2.6 * t1)),
-    )
-    .unwrap();
-    assert!(r.window_samples > 50);
-    r.reflection
+    r
 }
 
 fn exact_r(b: &Bar2) -> f64 {

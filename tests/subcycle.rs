@@ -12,7 +12,7 @@
 //!   is conserved;
 //! - the same bits on 1 and 2 threads.
 
-use weft::analysis::energy::{reflection, region_energies, Region};
+mod common;
 use weft::analysis::pulse::launch_pulse;
 use weft::model::{ElementKind, Model, PartProps};
 use weft::solver::run_in_memory;
@@ -111,25 +111,9 @@ fn measured(e2: f64, rho2: f64, subcycle: bool) -> (f64, u64, f64) {
     let m = truss_then_hex(e2, rho2, subcycle);
     let (s, out, stats) = run_in_memory(&m).unwrap();
     let ratio = s.subcycle().map_or(1, |c| c.ratio);
-    let en = region_energies(
-        &m,
-        &[Region::parse("bar1").unwrap()],
-        &out.t,
-        &out.u,
-        &out.v,
-        std::path::Path::new("(memory)"),
-    )
-    .unwrap();
     let t1 = L1 / c1();
-    let r = reflection(
-        "bar1",
-        &en.t,
-        &en.total(0),
-        Some(0.0),
-        Some((1.4 * t1, 2.6 * t1)),
-    )
-    .unwrap();
-    (r.reflection, ratio, stats.max_balance_error_relative)
+    let (_, r) = common::reflected_fraction(&m, &out, &["bar1"], (1.4 * t1, 2.6 * t1));
+    (r, ratio, stats.max_balance_error_relative)
 }
 
 #[test]

@@ -184,17 +184,7 @@ impl Acceleration<'_> {
         for &s in self.gather.of(i) {
             add(&mut f, &self.fe[s as usize]);
         }
-        let im = self.inv_m[i];
-        let mut a = [f[0] * im, f[1] * im, f[2] * im];
-        let fx = self.fixed[i];
-        if fx != 0 {
-            for (d, ad) in a.iter_mut().enumerate() {
-                if fx & (1 << d) != 0 {
-                    *ad = 0.0;
-                }
-            }
-        }
-        a
+        self.finish(f, i)
     }
 
     /// Node i's acceleration without its element slots (a node whose only elements are
@@ -206,6 +196,12 @@ impl Acceleration<'_> {
         if let Some(fc) = self.fcon {
             add(&mut f, &fc[i]);
         }
+        self.finish(f, i)
+    }
+
+    /// Node i's force `f` times 1/m, 0 along its fixed directions.
+    #[inline(always)]
+    fn finish(&self, f: [f64; 3], i: usize) -> [f64; 3] {
         let im = self.inv_m[i];
         let mut a = [f[0] * im, f[1] * im, f[2] * im];
         let fx = self.fixed[i];

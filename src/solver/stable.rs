@@ -168,17 +168,7 @@ impl NodalBound<'_> {
         self.op
             .el
             .add_stiffening(&self.state.x, &mut k.extra, &mut k.most, true);
-        let mut best: Option<(f64, usize)> = None;
-        for &i in &k.variable_nodes {
-            if self.fixed[i] == 0b111 || self.mass[i] <= 0.0 {
-                continue;
-            }
-            let dt_i = nodal_dt(k.s[i] + k.extra[i], k.c[i], self.mass[i], self.alpha);
-            if best.is_none_or(|b| dt_i < b.0) {
-                best = Some((dt_i, i));
-            }
-        }
-        best.map(|(dt, i)| (dt, i, k.most[i]))
+        self.smallest_step(k, &k.variable_nodes)
     }
 
     /// The slow step's bound ([`super::subcycle`]): the slow elements' rows at their
@@ -197,6 +187,16 @@ impl NodalBound<'_> {
         self.op
             .el
             .add_slow_stiffening(&self.state.x, &mut k.extra, &mut k.most);
+        self.smallest_step(k, nodes)
+    }
+
+    /// The smallest stable step of `nodes` with their rows and stiffening in `k`, the
+    /// node's index and the element that stiffened it most (free nodes with mass only).
+    fn smallest_step(
+        &self,
+        k: &StiffeningCheck,
+        nodes: &[usize],
+    ) -> Option<(f64, usize, Option<Stiffened>)> {
         let mut best: Option<(f64, usize)> = None;
         for &i in nodes {
             if self.fixed[i] == 0b111 || self.mass[i] <= 0.0 {

@@ -392,3 +392,32 @@ pub fn weft_run(root: &Path, pipeline: &str) -> String {
     assert!(o.status.success(), "weft run {pipeline} failed:\n{err}");
     err
 }
+
+/// The energies of the named regions in an in-memory run's samples, and the fraction of
+/// the first region's launched energy (at t = 0) that is back in it over `window` [s]:
+/// a pulse's reflection at an interface (`weft-energy`'s reflection, measured as the
+/// stage measures it).
+pub fn reflected_fraction(
+    m: &Model,
+    out: &weft::solver::output::MemorySink,
+    regions: &[&str],
+    window: (f64, f64),
+) -> (weft::analysis::energy::RegionEnergies, f64) {
+    use weft::analysis::energy::{reflection, region_energies, Region};
+    let regions: Vec<Region> = regions.iter().map(|r| Region::parse(r).unwrap()).collect();
+    let en = region_energies(m, &regions, &out.t, &out.u, &out.v, Path::new("(memory)")).unwrap();
+    let r = reflection(
+        &regions[0].name,
+        &en.t,
+        &en.total(0),
+        Some(0.0),
+        Some(window),
+    )
+    .unwrap();
+    assert!(
+        r.window_samples > 50,
+        "{} samples in the window",
+        r.window_samples
+    );
+    (en, r.reflection)
+}
