@@ -610,6 +610,32 @@ fn run_columns(r: &Report, s: &Solver, st: &RunStats) -> Vec<Col> {
     ]
 }
 
+/// The fabric's areal density [kg/m²]: per layer, the `ply_areal_density` of its yarn
+/// parts (weft-weave woven writes it), summed over the layers; `None` without layers or
+/// when a layer's parts give none.
+fn areal_density(s: &Solver, m: &Model) -> Option<f64> {
+    let w = s.watch();
+    let mut per_layer: Vec<Option<f64>> = vec![None; w.n_layers];
+    for b in m.elements.values() {
+        for e in 0..b.len() {
+            let (Some(l), Some(d)) = (b.layer_of(e), m.parts[b.part[e]].props.ply_areal_density)
+            else {
+                continue;
+            };
+            if let Some(slot) = usize::try_from(l - 1)
+                .ok()
+                .and_then(|k| per_layer.get_mut(k))
+            {
+                *slot = Some(slot.map_or(d, |x: f64| x.max(d)));
+            }
+        }
+    }
+    if per_layer.is_empty() {
+        return None;
+    }
+    per_layer.into_iter().sum()
+}
+
 /// The summary's columns about how the run ended and what an armour engineer reads:
 /// status and stop reason; the first projectile's striking velocity, outcome, residual
 /// velocity, mass and radius (null without a projectile); the layers, failures, broken
@@ -618,8 +644,17 @@ fn run_columns(r: &Report, s: &Solver, st: &RunStats) -> Vec<Col> {
 fn ballistic_columns(s: &Solver, m: &Model, status: &Status, end: f64) -> Vec<Col> {
     use crate::solver::watch::Outcome;
     let w = s.watch();
-    let p = m.projectiles.first();
-    let speed = |v: &[f64; 3]| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+    // The striker: the first rigid projectile, or the deformable bullet (its mass the
+    // lumped mass of its nodes, its radius about its axis).
+    let p = m.has_striker().then_some(());
+    let (mass, radius) = match (m.projectiles.first(), m.bullet_nodes()) {
+        (Some(p), _) => (Some(p.mass), Some(p.radius)),
+        (None, Some(nodes)) => (
+            Some(nodes.iter().map(|&i| s.masses()[i]).sum::<f64>()),
+            Some(w.bullet_radius),
+        ),
+        (None, None) => (None, None),
+    };
     let (outcome, perforated, residual, when) = match (p, w.outcome) {
         (None, _) => (None, None, None, None),
         (Some(_), Outcome::Undecided) => (Some("undecided"), Some(false), None, None),
@@ -662,14 +697,18 @@ fn ballistic_columns(s: &Solver, m: &Model, status: &Status, end: f64) -> Vec<Co
                 Status::Stopped(why) => Some(why.clone()),
             }],
         ),
-        Col::OptF64("striking_velocity", vec![p.map(|p| speed(&p.velocity))]),
+        Col::OptF64("striking_velocity", vec![m.striking_speed()]),
         Col::OptStr("outcome", vec![outcome.map(String::from)]),
         Col::OptBool("perforated", vec![perforated]),
         Col::OptF64("residual_velocity", vec![residual]),
         Col::OptF64("outcome_time", vec![when]),
-        Col::OptF64("projectile_mass", vec![p.map(|p| p.mass)]),
-        Col::OptF64("projectile_radius", vec![p.map(|p| p.radius)]),
+        Col::OptF64("projectile_mass", vec![mass]),
+        Col::OptF64("projectile_radius", vec![radius]),
         Col::I64("layers", vec![w.n_layers as i64]),
+        Col::OptI64(
+            "plies_perforated",
+            vec![(layered && p.is_some()).then_some(w.plies_perforated() as i64)],
+        ),
         Col::I64("failed_elements", vec![eroded as i64]),
         Col::OptI64("broken_yarns", vec![layered.then_some(broken as i64)]),
         Col::OptF64("first_failure_time", vec![first_failure]),
@@ -678,6 +717,7 @@ fn ballistic_columns(s: &Solver, m: &Model, status: &Status, end: f64) -> Vec<Co
             vec![layered.then_some(w.back_face_peak)],
         ),
         Col::OptF64("energy_absorbed", vec![layered.then_some(absorbed)]),
+        Col::OptF64("areal_density", vec![areal_density(s, m)]),
         // The back-face signature: the backing clay's crater at the run's end, its
         // deepest point along `clay_profile` (a model with clay; `solver::crater`).
         Col::OptF64(

@@ -220,6 +220,13 @@ part_properties! {
         aliases: ["A"],
         meaning: "cross-section area A",
     },
+    ply_areal_density: f64 {
+        unit: "kg/m²",
+        kinds: [Truss: Rule::Positive, Tri: Rule::Positive, Quad: Rule::Positive],
+        null: null("unknown", "the summary's `areal_density` is then null"),
+        aliases: [],
+        meaning: "the areal density of the fabric ply whose yarns the part models (weft-weave woven writes it on the yarn parts): the solver does not read it; the summary's `areal_density` sums it over the layers",
+    },
     tension_only: bool {
         unit: "",
         kinds: [Truss: Rule::Free],

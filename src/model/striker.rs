@@ -81,6 +81,30 @@ impl Model {
         })
     }
 
+    /// The striking speed [m/s]: the first rigid projectile's, or the deformable
+    /// bullet's (its nodes' mean initial velocity); `None` without a striker.
+    pub fn striking_speed(&self) -> Option<f64> {
+        let norm = |v: [f64; 3]| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+        if let Some(p) = self.projectiles.first() {
+            return Some(norm(p.velocity));
+        }
+        let nodes = self.bullet_nodes()?;
+        let mut in_set = vec![false; self.num_nodes()];
+        for &i in nodes {
+            in_set[i] = true;
+        }
+        let (mut s, mut n) = ([0.0; 3], 0usize);
+        for (i, v) in &self.initial_velocities {
+            if in_set[*i] {
+                for d in 0..3 {
+                    s[d] += v[d];
+                }
+                n += 1;
+            }
+        }
+        Some(norm(s) / nodes.len().max(n).max(1) as f64)
+    }
+
     /// Strike at `speed` [m/s] along the striker's direction: each rigid projectile's
     /// velocity (along its axis when at rest), or every node of the deformable bullet's
     /// initial velocity.

@@ -15,7 +15,17 @@ impl Solver {
         let axis = w.axis().unwrap_or([0.0, 0.0, -1.0]);
         let n = w.n_layers;
         rows.clear();
-        rows.resize(n, [0.0; 9]);
+        rows.resize(n, [0.0; 10]);
+        let proj = self
+            .op
+            .projectiles
+            .projectiles
+            .first()
+            .map(|p| (p.tip, p.v_full, p.force, p.radius))
+            .or_else(|| self.bullet_state());
+        let tip_a = proj.map_or(f64::INFINITY, |p| dot(&p.0, &axis));
+        let w = &self.watch;
+        let on_cap = w.cap_layers(&self.state.xn, tip_a);
         let (xn, vn, x0) = (&self.state.xn, &self.state.vn, &self.x0);
         let fr_s = self.op.surfaces.node_friction.as_deref();
         let fr_p = self.op.projectiles.node_friction.as_deref();
@@ -63,19 +73,15 @@ impl Solver {
         }
         let back = rows.last().map_or(0.0, |r| r[7]);
         let t = self.state.t;
-        let proj = self
-            .op
-            .projectiles
-            .projectiles
-            .first()
-            .map(|p| (p.tip, p.v_full, p.force, p.radius))
-            .or_else(|| self.bullet_state());
         let w = &mut self.watch;
         w.back_face_peak = w.back_face_peak.max(back);
-        w.last_rows.clone_from(rows);
         if let Some((tip, v, f, radius)) = proj {
-            w.judge(t, &tip, &v, &f, radius);
+            w.judge(t, &tip, &v, &f, radius, &on_cap);
         }
+        for (l, r) in rows.iter_mut().enumerate() {
+            r[9] = w.perforated_at(l + 1);
+        }
+        w.last_rows.clone_from(rows);
     }
 
     /// A deformable bullet as the watch judges it at t_n: its most advanced node's

@@ -63,6 +63,7 @@ pub mod truss;
 mod variable_step;
 /// The small vector helpers, shared below the solver ([`crate::vec3`]).
 pub use crate::vec3;
+pub mod plies;
 pub mod watch;
 
 use std::time::Duration;

@@ -152,6 +152,8 @@ impl Sampler {
                         r[5] = a[5];
                         r[6] = a[6];
                         r[8] = a[8];
+                        // Perforated by t_k when the later step says so at or before it.
+                        r[9] = if b[9] <= tk { b[9] } else { a[9] };
                         self.interp_layers.push(r);
                     }
                     &self.interp_layers
@@ -362,6 +364,16 @@ impl ParquetSink {
                 "first_failure_time",
                 rows.iter()
                     .map(|r| Some(r.2[8]).filter(|t| !t.is_nan()))
+                    .collect(),
+            ),
+            Col::Bool(
+                "perforated",
+                rows.iter().map(|r| !r.2[9].is_nan()).collect(),
+            ),
+            Col::OptF64(
+                "perforated_time",
+                rows.iter()
+                    .map(|r| Some(r.2[9]).filter(|t| !t.is_nan()))
                     .collect(),
             ),
         ]))

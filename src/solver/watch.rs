@@ -16,8 +16,9 @@ use crate::model::{ElementKind, Model};
 
 /// Values per layer at one time, in this order: kinetic, strain, eroded, friction,
 /// absorbed [J], failed elements, broken yarns, deflection [m], the time of its first
-/// failure [s] (NaN: none yet).
-pub type LayerValues = [f64; 9];
+/// failure [s] (NaN: none yet), the time it was perforated [s] (NaN: not yet; see
+/// [`Watch::perforated_at`]).
+pub type LayerValues = [f64; 10];
 
 /// How the projectile's impact ended.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -31,7 +32,9 @@ pub enum Outcome {
     /// Free of the fabric: its tip beyond where the fabric's back face started by more
     /// than its radius, and no contact force on it (below [`FREE_FORCE_FRACTION`] of the
     /// peak so far) at [`FREE_SAMPLES`] output samples in a row, the last at `time`,
-    /// moving at `residual_velocity` [m/s].
+    /// moving at `residual_velocity` [m/s]. A pack on a backing (clay): every ply
+    /// perforated ([`PATH_FRACTION`]) at `time`, the projectile entering the backing at
+    /// `residual_velocity`.
     Perforated { time: f64, residual_velocity: f64 },
 }
 
@@ -75,11 +78,50 @@ struct Tag {
     section: u32,
 }
 
-/// A cross-section of a yarn: its yarn and how many of its elements are live.
+/// A cross-section of a yarn: its yarn, how many of its elements are live, and whether
+/// it lies near the shot (an element's centroid within [`CUT_REACH`] radii of the shot's
+/// line).
 #[derive(Debug, Clone, Copy)]
 struct Section {
     yarn: u32,
     live: u32,
+    near: bool,
+}
+
+/// A ply is perforated once the projectile's tip has passed where the ply's back face
+/// started and the nose has a hole through it, which is either of:
+/// - **cut**: every yarn of the ply that crosses the projectile's path (its reference
+///   line within [`PATH_FRACTION`] of the projectile's radius R of the shot's line) has
+///   failed at a cross-section near the shot (within [`CUT_REACH`] R of the line);
+/// - **cleared**: none of the ply's nodes still joined to the ply beyond [`CUT_REACH`] R
+///   through live elements ([`super::plies::Around`]: a fragment cut free riding on the
+///   nose is not the ply) lies on the nose's front cap: within [`PATH_FRACTION`] R of
+///   the line and less than R behind the tip (the yarns there broken and slid off, or
+///   pushed aside: windowing).
+///
+/// Either alone misses holes: cut ends whipping ahead of the nose can sit on the cap
+/// (the outcome's note on [`FREE_SAMPLES`]), and a yarn on the path pushed aside intact
+/// is never cut. An intact ply in front of the nose satisfies neither: its yarns are
+/// whole and its nodes lie on the cap.
+pub const PATH_FRACTION: f64 = 0.5;
+
+/// How far from the shot's line, in projectile radii, a yarn's failure counts as a cut
+/// of the ply's path ([`PATH_FRACTION`]): a yarn loaded by the nose fails where it
+/// leaves the nose's contact, within a radius of the line or a little beyond.
+pub const CUT_REACH: f64 = 2.0;
+
+/// Per layer, what its perforation is judged by ([`PATH_FRACTION`]).
+#[derive(Debug, Clone, Default)]
+struct Plies {
+    /// Per yarn: it crosses the projectile's path, and it has been cut near the shot.
+    on_path: Vec<bool>,
+    cut: Vec<bool>,
+    /// Per layer (index 0 unused): yarns on the path, those of them cut, where its back
+    /// face started along the strike, and when it was perforated (NaN: not yet).
+    path_yarns: Vec<u32>,
+    cut_yarns: Vec<u32>,
+    back: Vec<f64>,
+    at: Vec<f64>,
 }
 
 /// The watch of one run.
@@ -116,6 +158,15 @@ pub struct Watch {
     pub bullet: Vec<usize>,
     /// The bullet's radius about its axis (`striker::axis_point`) [m].
     pub bullet_radius: f64,
+    plies: Plies,
+    /// The shot's line (a point on it, its unit direction) and the projectile's radius.
+    shot: Option<([f64; 3], [f64; 3], f64)>,
+    /// The ply's elements around the shot ([`Watch::cap_layers`]).
+    around: super::plies::Around,
+    /// A pack on a backing (the clay's `clay_profile`): the bullet that has perforated
+    /// every ply is in the backing, whose contact force never lets it go free; the
+    /// outcome is then decided by the plies ([`Outcome::Perforated`] once every ply is).
+    backed: bool,
 }
 
 impl Watch {
@@ -151,6 +202,27 @@ impl Watch {
                 }
             }
         }
+        // The shot's line (a point on it, its direction) and the projectile's radius.
+        let shot = match (m.projectiles.first(), w.axis) {
+            (Some(p), Some(a)) => Some((p.tip, a, p.radius)),
+            (None, Some(a)) if !w.bullet.is_empty() => {
+                let xs: Vec<[f64; 3]> = w.bullet.iter().map(|&i| m.coords[i]).collect();
+                Some((
+                    crate::model::striker::axis_point(&xs, a),
+                    a,
+                    w.bullet_radius,
+                ))
+            }
+            _ => None,
+        };
+        w.shot = shot;
+        let lateral = |x: &[f64; 3]| -> f64 {
+            shot.map_or(f64::INFINITY, |(p, a, _)| lateral_distance(x, &p, &a))
+        };
+        let radius = shot.map_or(0.0, |s| s.2);
+        if shot.is_some() {
+            w.around = super::plies::Around::new(m, lateral, CUT_REACH * radius);
+        }
         let mut yarn_index: HashMap<(usize, i64), u32> = HashMap::new();
         let mut section_index: HashMap<(u32, i64), u32> = HashMap::new();
         for kind in [ElementKind::Truss, ElementKind::Tri, ElementKind::Quad] {
@@ -175,8 +247,21 @@ impl Watch {
                     if let Some(yarn) = b.yarn_of(e) {
                         let yi = *yarn_index.entry((b.part[e], yarn)).or_insert_with(|| {
                             w.yarns.push((layer, false));
+                            w.plies.on_path.push(false);
+                            w.plies.cut.push(false);
                             w.yarns.len() as u32 - 1
                         });
+                        let xs = &b.nodes[npe * e..npe * e + npe];
+                        if xs
+                            .iter()
+                            .any(|&n| lateral(&m.coords[n]) <= PATH_FRACTION * radius)
+                        {
+                            w.plies.on_path[yi as usize] = true;
+                        }
+                        let centroid: [f64; 3] = std::array::from_fn(|d| {
+                            xs.iter().map(|&n| m.coords[n][d]).sum::<f64>() / npe as f64
+                        });
+                        let near = lateral(&centroid) <= CUT_REACH * radius;
                         // A truss is a section of its own; a membrane's section is its
                         // station along the yarn (its material direction 1).
                         let station = if kind == ElementKind::Truss {
@@ -185,10 +270,15 @@ impl Watch {
                             station(m, kind, e)
                         };
                         let si = *section_index.entry((yi, station)).or_insert_with(|| {
-                            w.sections.push(Section { yarn: yi, live: 0 });
+                            w.sections.push(Section {
+                                yarn: yi,
+                                live: 0,
+                                near: false,
+                            });
                             w.sections.len() as u32 - 1
                         });
                         w.sections[si as usize].live += 1;
+                        w.sections[si as usize].near |= near;
                         tag.section = si;
                     }
                 }
@@ -208,7 +298,71 @@ impl Watch {
         w.failed = vec![0; w.n_layers + 1];
         w.broken = vec![0; w.n_layers + 1];
         w.first_failure = vec![f64::NAN; w.n_layers + 1];
+        let n = w.n_layers + 1;
+        let pl = &mut w.plies;
+        (pl.path_yarns, pl.cut_yarns) = (vec![0; n], vec![0; n]);
+        (pl.back, pl.at) = (vec![f64::NEG_INFINITY; n], vec![f64::NAN; n]);
+        for (y, &(layer, _)) in w.yarns.iter().enumerate() {
+            if pl.on_path[y] {
+                pl.path_yarns[layer as usize] += 1;
+            }
+        }
+        if let Some(a) = w.axis {
+            for (i, x) in m.coords.iter().enumerate() {
+                let l = w.node_layer[i] as usize;
+                if l > 0 {
+                    pl.back[l] = pl.back[l].max(x[0] * a[0] + x[1] * a[1] + x[2] * a[2]);
+                }
+            }
+        }
+        w.backed = m.node_sets.contains_key(super::crater::PROFILE_SET);
         w
+    }
+
+    /// When layer `l` (1 = the strike face) was perforated ([`PATH_FRACTION`]): NaN
+    /// while it is not, and for a layer without yarns on the projectile's path.
+    pub fn perforated_at(&self, l: usize) -> f64 {
+        self.plies.at[l]
+    }
+
+    /// The layers perforated so far.
+    pub fn plies_perforated(&self) -> usize {
+        self.plies.at.iter().filter(|t| !t.is_nan()).count()
+    }
+
+    /// Per layer (1 first): whether a node of it at `x`, joined to the ply beyond the
+    /// reach, lies on the nose's front cap ([`PATH_FRACTION`]), the projectile's tip at
+    /// `tip_a` along the strike; all false without a shot.
+    pub fn cap_layers(&self, x: &[[f64; 3]], tip_a: f64) -> Vec<bool> {
+        let mut on = vec![false; self.n_layers];
+        let Some((p, a, r)) = self.shot else {
+            return on;
+        };
+        self.around.for_joined(|i| {
+            let l = self.node_layer[i] as usize;
+            if l > 0
+                && !on[l - 1]
+                && x[i][0] * a[0] + x[i][1] * a[1] + x[i][2] * a[2] > tip_a - r
+                && lateral_distance(&x[i], &p, &a) <= PATH_FRACTION * r
+            {
+                on[l - 1] = true;
+            }
+        });
+        on
+    }
+
+    /// Layers that the tip (`tip_a`, along the strike) has passed, with every yarn on the
+    /// path cut or nothing left on the nose's cap (`on_cap[l - 1]`: an attached node of
+    /// layer l on it), are perforated at t ([`PATH_FRACTION`]).
+    fn follow_plies(&mut self, t: f64, tip_a: f64, on_cap: &[bool]) {
+        let pl = &mut self.plies;
+        for l in 1..pl.at.len() {
+            let cut = pl.path_yarns[l] > 0 && pl.cut_yarns[l] == pl.path_yarns[l];
+            let cleared = !on_cap.get(l - 1).copied().unwrap_or(true);
+            if pl.at[l].is_nan() && tip_a > pl.back[l] && (cut || cleared) {
+                pl.at[l] = t;
+            }
+        }
     }
 
     /// Whether the run has anything to watch: layers or a moving projectile.
@@ -231,6 +385,7 @@ impl Watch {
 
     /// Element e of kind `kind` has left the model at time t.
     pub fn on_erosion(&mut self, kind: ElementKind, e: usize, t: f64) {
+        self.around.on_erosion(kind, e);
         let Some(tag) = self.tags.get(&kind).and_then(|t| t.get(e)).copied() else {
             return;
         };
@@ -246,6 +401,11 @@ impl Watch {
             let s = &mut self.sections[tag.section as usize];
             s.live = s.live.saturating_sub(1);
             if s.live == 0 {
+                let yi = s.yarn as usize;
+                if s.near && self.plies.on_path[yi] && !self.plies.cut[yi] {
+                    self.plies.cut[yi] = true;
+                    self.plies.cut_yarns[l] += 1;
+                }
                 let y = &mut self.yarns[s.yarn as usize];
                 if !y.1 {
                     y.1 = true;
@@ -266,12 +426,32 @@ impl Watch {
     }
 
     /// Judges the outcome at time t from the first projectile's tip, velocity, contact
-    /// force and radius (see [`Outcome`]).
-    pub fn judge(&mut self, t: f64, tip: &[f64; 3], v: &[f64; 3], force: &[f64; 3], radius: f64) {
+    /// force and radius (see [`Outcome`]), and the plies perforated so far (`on_cap`:
+    /// per layer, whether an attached node of it lies on the nose's cap, [`Watch::on_cap`]).
+    #[allow(clippy::too_many_arguments)]
+    pub fn judge(
+        &mut self,
+        t: f64,
+        tip: &[f64; 3],
+        v: &[f64; 3],
+        force: &[f64; 3],
+        radius: f64,
+        on_cap: &[bool],
+    ) {
         let Some(a) = self.axis else { return };
         let f = (force[0] * force[0] + force[1] * force[1] + force[2] * force[2]).sqrt();
         self.peak_force = self.peak_force.max(f);
+        let tip_a = tip[0] * a[0] + tip[1] * a[1] + tip[2] * a[2];
+        self.follow_plies(t, tip_a, on_cap);
         if self.outcome.is_decided() {
+            return;
+        }
+        let speed = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+        if self.backed && self.n_layers > 0 && self.plies_perforated() == self.n_layers {
+            self.outcome = Outcome::Perforated {
+                time: t,
+                residual_velocity: speed,
+            };
             return;
         }
         let along = v[0] * a[0] + v[1] * a[1] + v[2] * a[2];
@@ -280,7 +460,6 @@ impl Watch {
             self.outcome = Outcome::Arrested { time: t };
             return;
         }
-        let tip_a = tip[0] * a[0] + tip[1] * a[1] + tip[2] * a[2];
         let free = self.peak_force > 0.0
             && f <= FREE_FORCE_FRACTION * self.peak_force
             && tip_a > self.back_start + radius;
@@ -288,10 +467,18 @@ impl Watch {
         if self.free_run >= FREE_SAMPLES {
             self.outcome = Outcome::Perforated {
                 time: t,
-                residual_velocity: (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt(),
+                residual_velocity: speed,
             };
         }
     }
+}
+
+/// The distance of `x` from the line through `p` along the unit `a`.
+fn lateral_distance(x: &[f64; 3], p: &[f64; 3], a: &[f64; 3]) -> f64 {
+    let d = [x[0] - p[0], x[1] - p[1], x[2] - p[2]];
+    let s = d[0] * a[0] + d[1] * a[1] + d[2] * a[2];
+    let r = [d[0] - s * a[0], d[1] - s * a[1], d[2] - s * a[2]];
+    (r[0] * r[0] + r[1] * r[1] + r[2] * r[2]).sqrt()
 }
 
 /// A membrane element's station along its yarn: its centroid's coordinate along the

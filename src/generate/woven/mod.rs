@@ -297,6 +297,9 @@ pub fn woven(p: &WovenBandParams) -> Result<(Model, WovenInfo)> {
         contact_thickness: weave.section.t_centre,
         layer_pitch: pitch,
     };
+    for &part in &yarn_parts {
+        m.parts[part].props.ply_areal_density = Some(info.areal_density);
+    }
     if let Some(s) = &p.surround {
         surround(&mut m, p, s, &info)?;
     }
