@@ -708,3 +708,103 @@ fn the_nij_verdict_follows_the_standards_rules() {
         "{e}"
     );
 }
+
+#[test]
+fn the_armour_test_judges_each_shot_at_its_level_and_names_the_lightest_pass() {
+    use weft::table::{batch, write_table, Col, Provenance};
+    let dir = tempfile::tempdir().unwrap();
+    let prov = Provenance::new("test", serde_json::json!({}));
+    // (plies, velocity, outcome, plies perforated, bfs, expected level, expected pass):
+    // NIJ Standard-0101.06's rules (IIA 373, II 398 ± 9.1 m/s; no perforation, BFS ≤ 44 mm).
+    type Case = (
+        i64,
+        f64,
+        &'static str,
+        i64,
+        f64,
+        Option<&'static str>,
+        Option<bool>,
+    );
+    let cases: [Case; 6] = [
+        (4, 373.0, "perforated", 4, 0.070, Some("IIA"), Some(false)),
+        (4, 398.0, "perforated", 4, 0.080, Some("II"), Some(false)),
+        (8, 373.0, "arrested", 5, 0.041, Some("IIA"), Some(true)),
+        (8, 398.0, "arrested", 6, 0.046, Some("II"), Some(false)),
+        (16, 398.0, "arrested", 3, 0.030, Some("II"), Some(true)),
+        (16, 385.0, "arrested", 3, 0.030, None, None),
+    ];
+    let shots = dir.path().join("shots");
+    for (plies, v, outcome, perf, bfs, _, _) in cases {
+        let run = shots.join(plies.to_string()).join(format!("{v}"));
+        std::fs::create_dir_all(&run).unwrap();
+        let b = batch(vec![
+            Col::Str("status", vec!["completed".into()]),
+            Col::OptStr("outcome", vec![Some(outcome.into())]),
+            Col::OptF64("striking_velocity", vec![Some(v)]),
+            Col::OptF64("bfs", vec![Some(bfs)]),
+            Col::I64("layers", vec![plies]),
+            Col::OptI64("plies_perforated", vec![Some(perf)]),
+            Col::OptF64("areal_density", vec![Some(0.2 * plies as f64)]),
+        ]);
+        write_table(&run.join("summary.parquet"), &b, &prov).unwrap();
+    }
+    let out = dir.path().join("verdict");
+    let o = std::process::Command::new(BALLISTIC)
+        .args(["armour-test", "--run"])
+        .arg(&shots)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{e}");
+    assert!(
+        e.contains("level IIA: the lightest pack that passes has 8 plies"),
+        "{e}"
+    );
+    assert!(
+        e.contains("level II: the lightest pack that passes has 16 plies"),
+        "{e}"
+    );
+    let t = Table::read(&out.join("armour_test.parquet")).unwrap();
+    let (plies, v) = (t.i64("plies", "").unwrap(), t.f64("velocity", "").unwrap());
+    let level = t.str_opt("level").unwrap().unwrap();
+    let pass = t.bool_opt("pass").unwrap().unwrap();
+    let perf = t.i64_opt("plies_perforated").unwrap().unwrap();
+    let mut want = cases.to_vec();
+    want.sort_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
+    for (k, c) in want.iter().enumerate() {
+        assert_eq!((plies[k], v[k]), (c.0, c.1));
+        assert_eq!(level[k].as_deref(), c.5, "{c:?}");
+        assert_eq!(pass[k], c.6, "{c:?}");
+        assert_eq!(perf[k], Some(c.3));
+    }
+    // The figure draws from the table.
+    let png = dir.path().join("bfs.png");
+    run_ok(
+        env!("CARGO_BIN_EXE_weft-plot"),
+        &[
+            "armour",
+            "--table",
+            out.join("armour_test.parquet").to_str().unwrap(),
+            "--out",
+            png.to_str().unwrap(),
+        ],
+    );
+    assert!(std::fs::metadata(&png).unwrap().len() > 1000);
+    // A folder with no shot in it: named.
+    let empty = dir.path().join("empty");
+    std::fs::create_dir_all(&empty).unwrap();
+    let o = std::process::Command::new(BALLISTIC)
+        .args(["armour-test", "--run"])
+        .arg(&empty)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success() && e.contains("--run") && e.contains("summary.parquet"),
+        "{e}"
+    );
+}

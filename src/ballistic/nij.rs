@@ -43,6 +43,13 @@ impl Level {
             Level::II => 398.0,
         }
     }
+    /// The level whose fair hits a shot at `v` [m/s] is one of (the levels' velocity
+    /// bands do not overlap: 373 + 9.1 < 398 − 9.1), if any.
+    pub fn of_velocity(v: f64) -> Option<Level> {
+        [Level::IIA, Level::II]
+            .into_iter()
+            .find(|l| (v - l.velocity()).abs() <= VELOCITY_TOLERANCE)
+    }
 }
 
 /// One shot judged.
@@ -55,6 +62,13 @@ pub struct Verdict {
     /// The run's outcome (`arrested`, `perforated`, `undecided`) and its BFS [m].
     pub outcome: String,
     pub perforated: bool,
+    /// The pack's plies (the summary's `layers`), those perforated, and its areal
+    /// density [kg/m²] (null in older runs' summaries).
+    pub plies: i64,
+    pub plies_perforated: Option<i64>,
+    pub areal_density: Option<f64>,
+    /// The level the shot was judged at.
+    pub level: Option<Level>,
     pub bfs: f64,
     /// [`BFS_LIMIT`] − BFS [m]: positive when the crater is within the limit.
     pub bfs_margin: f64,
@@ -63,8 +77,10 @@ pub struct Verdict {
     pub reason: String,
 }
 
-/// Judges the shot of the run folder `run` (its summary.parquet) at `level`.
-pub fn judge(run: &Path, level: Level) -> Result<Verdict> {
+/// Judges the shot of the run folder `run` (its summary.parquet) at `level`, or, with
+/// none, at the level whose velocity band its striking velocity lies in (no verdict
+/// when it lies in neither).
+pub fn judge(run: &Path, level: Option<Level>) -> Result<Verdict> {
     let path = run.join("summary.parquet");
     let t = Table::read(&path)?;
     let one = |c: &str| -> Result<Option<f64>> {
@@ -95,7 +111,8 @@ pub fn judge(run: &Path, level: Level) -> Result<Verdict> {
         .and_then(|v| v.first().cloned().flatten())
         .unwrap_or_else(|| "undecided".into());
     let perforated = outcome == "perforated";
-    let velocity_in_range = (v - level.velocity()).abs() <= VELOCITY_TOLERANCE;
+    let level = level.or_else(|| Level::of_velocity(v));
+    let velocity_in_range = level.is_some_and(|l| (v - l.velocity()).abs() <= VELOCITY_TOLERANCE);
     let (pass, reason) = if status != "completed" {
         (
             None,
@@ -104,11 +121,16 @@ pub fn judge(run: &Path, level: Level) -> Result<Verdict> {
     } else if !velocity_in_range {
         (
             None,
-            format!(
-                "striking velocity {v:.1} m/s outside level {}'s {:.0} ± {VELOCITY_TOLERANCE} m/s: not a fair hit",
-                level.name(),
-                level.velocity()
-            ),
+            match level {
+                Some(level) => format!(
+                    "striking velocity {v:.1} m/s outside level {}'s {:.0} ± {VELOCITY_TOLERANCE} m/s: not a fair hit",
+                    level.name(),
+                    level.velocity()
+                ),
+                None => format!(
+                    "striking velocity {v:.1} m/s within no level's band (IIA 373, II 398 ± {VELOCITY_TOLERANCE} m/s): not a fair hit"
+                ),
+            },
         )
     } else if perforated {
         (Some(false), "perforated".into())
@@ -126,17 +148,67 @@ pub fn judge(run: &Path, level: Level) -> Result<Verdict> {
     } else {
         (Some(true), String::new())
     };
+    let int = |c: &str| -> Result<Option<i64>> {
+        Ok(t.i64_opt(c)?.and_then(|v| v.first().copied().flatten()))
+    };
     Ok(Verdict {
         run: run.to_path_buf(),
         striking_velocity: v,
         velocity_in_range,
         outcome,
         perforated,
+        plies: int("layers")?.unwrap_or(0),
+        plies_perforated: int("plies_perforated")?,
+        areal_density: one("areal_density")?,
+        level,
         bfs,
         bfs_margin: BFS_LIMIT - bfs,
         pass,
         reason,
     })
+}
+
+/// `armour_test.parquet`: one row per shot, each judged at the level of its velocity
+/// (docs/tables.md).
+pub fn write_armour_test(path: &Path, vs: &[Verdict], prov: &Provenance) -> Result<()> {
+    let f = |g: fn(&Verdict) -> f64| vs.iter().map(g).collect::<Vec<f64>>();
+    write_table(
+        path,
+        &batch(vec![
+            Col::I64("plies", vs.iter().map(|v| v.plies).collect()),
+            Col::OptF64(
+                "areal_density",
+                vs.iter().map(|v| v.areal_density).collect(),
+            ),
+            Col::F64("velocity", f(|v| v.striking_velocity)),
+            Col::OptStr(
+                "level",
+                vs.iter()
+                    .map(|v| v.level.map(|l| l.name().into()))
+                    .collect(),
+            ),
+            Col::Str("outcome", vs.iter().map(|v| v.outcome.clone()).collect()),
+            Col::Bool("perforated", vs.iter().map(|v| v.perforated).collect()),
+            Col::OptI64(
+                "plies_perforated",
+                vs.iter().map(|v| v.plies_perforated).collect(),
+            ),
+            Col::F64("bfs", f(|v| v.bfs)),
+            Col::F64("bfs_margin", f(|v| v.bfs_margin)),
+            Col::OptBool("pass", vs.iter().map(|v| v.pass).collect()),
+            Col::OptStr(
+                "reason",
+                vs.iter()
+                    .map(|v| (!v.reason.is_empty()).then(|| v.reason.clone()))
+                    .collect(),
+            ),
+            Col::Str(
+                "run",
+                vs.iter().map(|v| v.run.display().to_string()).collect(),
+            ),
+        ]),
+        prov,
+    )
 }
 
 /// `nij.parquet`: one row per shot judged at `level` (docs/tables.md).

@@ -1,6 +1,7 @@
 //! `weft-ballistic`: ballistic limits from impact runs (`fit`), or by running the impacts
-//! (`search`), the failed zone of impact runs (`zone`), and the backing clay's drop
-//! calibration (`clay-calibration`).
+//! (`search`), the failed zone of impact runs (`zone`), the backing clay's drop
+//! calibration (`clay-calibration`), and the armour test's verdicts on shots on the clay
+//! (`nij`, `armour-test`).
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -17,7 +18,7 @@ use weft::table::Provenance;
 #[command(
     name = "weft-ballistic",
     version,
-    about = "Ballistic limits (V50, the Lambert–Jonas fit) from impact runs, or by running them; the failed zone of impact runs; the backing clay's drop calibration; the armour test's verdict on shots on the clay",
+    about = "Ballistic limits (V50, the Lambert–Jonas fit) from impact runs, or by running them; the failed zone of impact runs; the backing clay's drop calibration; the armour test's verdict on shots on the clay, one level or many packs",
     long_about = "The ballistic limit of a fabric from impacts at several striking velocities \
                   (docs/theory.md, \"Failure, perforation and the ballistic limit\").\n\n\
                   `fit` gathers impact runs (the weft-simulate output folders, or one table that \
@@ -36,12 +37,14 @@ use weft::table::Provenance;
                   (clay_calibration.parquet).\n\n\
                   `nij` judges shots of a pack on the clay as the standard does: no \
                   perforation and a back-face signature of at most 44 mm at the level's \
-                  velocity (nij.parquet).\n\n\
+                  velocity (nij.parquet). `armour-test` judges many packs' shots at once, each \
+                  at the level of its velocity (armour_test.parquet).\n\n\
                   Example:\n  weft-ballistic fit --runs runs/v300 runs/v350 runs/v400 --out runs/limit\n  \
                   weft-ballistic search --model runs/patch --lo 50 --hi 400 --tolerance 5 --out runs/search\n  \
                   weft-ballistic zone --run runs/v400 --model runs/patch --out runs/zone\n  \
                   weft-ballistic clay-calibration --model runs/drop --out runs/clay\n  \
-                  weft-ballistic nij --run runs/pack-398 --level II --out runs/verdict"
+                  weft-ballistic nij --run runs/pack-398 --level II --out runs/verdict\n  \
+                  weft-ballistic armour-test --run runs/armour_test/shots --out runs/armour_test/verdict"
 )]
 struct Cli {
     #[command(subcommand)]
@@ -108,6 +111,31 @@ enum Command {
         after_help = "Example:\n  weft-weave woven --layers 24 --backing clay --projectile-velocity 398 --out runs/pack\n  weft-simulate --model runs/pack --out runs/pack-398 --end-time 1e-3\n  weft-ballistic nij --run runs/pack-398 --level II --out runs/verdict"
     )]
     Nij(NijArgs),
+    /// The armour test over packs and velocities: each shot judged at the level of its
+    /// velocity, one table of plies, areal density, outcome, BFS and verdict.
+    #[command(
+        long_about = "The armour test over packs and velocities (pipelines/armour_test.toml): each \
+                      shot of a pack on the clay (weft-simulate of weft-weave woven --backing clay) \
+                      is judged as `nij` judges it, at the level whose velocity band its striking \
+                      velocity lies in (IIA 373, II 398 ± 9.1 m/s; no verdict in neither). Prints \
+                      per level the lightest pack that passes.\n\n\
+                      Writes armour_test.parquet (one row per run: plies, areal_density, velocity, \
+                      level, outcome, perforated, plies_perforated, bfs, bfs_margin, pass, reason) \
+                      into --out (docs/tables.md).",
+        after_help = "Example:\n  weft-ballistic armour-test --run runs/armour/shots/*/* --out runs/armour/verdict"
+    )]
+    ArmourTest(ArmourArgs),
+}
+
+#[derive(clap::Args)]
+struct ArmourArgs {
+    /// Shots' run folders (weft-simulate --out, their summary.parquet), or folders
+    /// holding them (searched two levels down, as a pipeline's `shots/<plies>/<velocity>`).
+    #[arg(long, required = true, num_args = 1..)]
+    run: Vec<PathBuf>,
+    /// Output folder for armour_test.parquet.
+    #[arg(long)]
+    out: PathBuf,
 }
 
 #[derive(clap::Args)]
@@ -278,7 +306,99 @@ fn run_cli() -> anyhow::Result<ExitCode> {
         Command::Zone(a) => zone_cmd(a),
         Command::ClayCalibration(a) => clay_cmd(a),
         Command::Nij(a) => nij_cmd(a),
+        Command::ArmourTest(a) => armour_cmd(a),
     }
+}
+
+/// The run folders under `p`: itself when it holds a summary, else its sub-folders'
+/// (two levels down), sorted.
+fn shot_folders(p: &std::path::Path, depth: u32) -> anyhow::Result<Vec<PathBuf>> {
+    if p.join("summary.parquet").is_file() {
+        return Ok(vec![p.to_path_buf()]);
+    }
+    if depth == 0 || !p.is_dir() {
+        return Ok(vec![]);
+    }
+    let mut subs: Vec<PathBuf> = std::fs::read_dir(p)
+        .map_err(|e| weft::WeftError::io(p, e))?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|q| q.is_dir())
+        .collect();
+    subs.sort();
+    let mut out = vec![];
+    for q in subs {
+        out.extend(shot_folders(&q, depth - 1)?);
+    }
+    Ok(out)
+}
+
+fn armour_cmd(a: ArmourArgs) -> anyhow::Result<ExitCode> {
+    use weft::ballistic::nij;
+    let mut runs = vec![];
+    for r in &a.run {
+        let found = shot_folders(r, 2)?;
+        if found.is_empty() {
+            return Err(weft::WeftError::input(format!(
+                "--run {}: no summary.parquet in it or in its sub-folders",
+                r.display()
+            ))
+            .expected("a weft-simulate run folder of a shot on the clay, or a folder of them")
+            .into());
+        }
+        runs.extend(found);
+    }
+    let mut prov = Provenance::new("ballistic", serde_json::json!({ "runs": runs }));
+    let mut vs = vec![];
+    for run in &runs {
+        prov = prov.with_input(&run.join("summary.parquet"))?;
+        vs.push(nij::judge(run, None)?);
+    }
+    vs.sort_by(|p, q| {
+        p.plies
+            .cmp(&q.plies)
+            .then(p.striking_velocity.total_cmp(&q.striking_velocity))
+    });
+    for v in &vs {
+        eprintln!(
+            "{:>3} plies at {:.0} m/s ({}): {}, {} plies perforated, BFS {:.1} mm: {}{}",
+            v.plies,
+            v.striking_velocity,
+            v.level.map_or("no level", |l| l.name()),
+            v.outcome,
+            v.plies_perforated.map_or("?".into(), |n| n.to_string()),
+            1e3 * v.bfs,
+            match v.pass {
+                Some(true) => "PASS",
+                Some(false) => "FAIL",
+                None => "no verdict",
+            },
+            if v.reason.is_empty() {
+                String::new()
+            } else {
+                format!(" ({})", v.reason)
+            }
+        );
+    }
+    for level in [nij::Level::IIA, nij::Level::II] {
+        let lightest = vs
+            .iter()
+            .filter(|v| v.level == Some(level) && v.pass == Some(true))
+            .min_by_key(|v| v.plies);
+        match lightest {
+            Some(v) => eprintln!(
+                "  level {}: the lightest pack that passes has {} plies ({})",
+                level.name(),
+                v.plies,
+                v.areal_density
+                    .map_or("areal density unknown".into(), |d| format!("{d:.2} kg/m²"))
+            ),
+            None => eprintln!("  level {}: no pack passes", level.name()),
+        }
+    }
+    std::fs::create_dir_all(&a.out).map_err(|e| weft::WeftError::io(&a.out, e))?;
+    nij::write_armour_test(&a.out.join("armour_test.parquet"), &vs, &prov)?;
+    eprintln!("  wrote {}/armour_test.parquet", a.out.display());
+    Ok(ExitCode::SUCCESS)
 }
 
 fn nij_cmd(a: NijArgs) -> anyhow::Result<ExitCode> {
@@ -290,7 +410,7 @@ fn nij_cmd(a: NijArgs) -> anyhow::Result<ExitCode> {
     let mut verdicts = vec![];
     for run in &a.run {
         prov = prov.with_input(&run.join("summary.parquet"))?;
-        let v = nij::judge(run, a.level)?;
+        let v = nij::judge(run, Some(a.level))?;
         eprintln!(
             "{}: {:.1} m/s, {}, BFS {:.1} mm (margin {:+.1} mm): {}{}",
             run.display(),

@@ -88,6 +88,12 @@ enum Figure {
         after_help = "Examples:\n  weft-plot crater --bfs runs/pack-out/bfs.parquet --kind depth --limit 0.044 --out bfs.png\n  weft-plot crater --bfs runs/pack-out/bfs.parquet --kind profile --time 2e-4 --time 4e-4 \\\n    --max-radius 0.06 --out crater.png"
     )]
     Crater(CraterArgs),
+    /// The armour test (armour_test.parquet of weft-ballistic armour-test): each shot's
+    /// back-face signature against its pack's areal density, per level, the perforated
+    /// shots apart, and the standard's 44 mm limit.
+    #[command(after_help = "Example:
+  weft-plot armour --table runs/armour_test/verdict/armour_test.parquet --out bfs.png")]
+    Armour(ArmourArgs),
     /// Colour map of a nodal quantity (uz, |u|, vx, ...) over the mesh at one output
     /// time, on the initial or deformed mesh, with a colour bar; several models side by
     /// side on one colour scale (the paper's Fig. 4).
@@ -117,6 +123,15 @@ struct BulletArgs {
     /// Legend label of each run (default: the folder name).
     #[arg(long)]
     label: Vec<String>,
+    #[command(flatten)]
+    common: Common,
+}
+
+#[derive(Args)]
+struct ArmourArgs {
+    /// armour_test.parquet (weft-ballistic armour-test).
+    #[arg(long)]
+    table: PathBuf,
     #[command(flatten)]
     common: Common,
 }
@@ -487,6 +502,10 @@ fn run() -> anyhow::Result<()> {
                 limit: a.limit,
                 max_radius: a.max_radius,
             }),
+            a.common,
+        ),
+        Figure::Armour(a) => (
+            plot::Figure::Armour(plot::armour::ArmourFigure { table: a.table }),
             a.common,
         ),
         Figure::Fit(a) => (

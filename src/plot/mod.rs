@@ -7,6 +7,7 @@
 //! Errors are `anyhow` errors: problems with the input are [`WeftError`]s inside them;
 //! the file system and the drawing backend fail with their own errors under a context.
 
+pub mod armour;
 pub mod ballistic;
 pub mod bullet;
 mod chart;
@@ -62,6 +63,8 @@ pub enum Figure {
     Bullet(bullet::BulletFigure),
     /// The backing clay's crater: its depth against time or its profile.
     Crater(crater::CraterFigure),
+    /// The armour test: back-face signature against areal density.
+    Armour(armour::ArmourFigure),
 }
 
 /// What drawing a figure reports back to the binary.
@@ -86,6 +89,7 @@ pub fn run(c: &Config) -> anyhow::Result<Report> {
         Figure::Ballistic(a) => ballistic::ballistic(a)?,
         Figure::Bullet(a) => bullet::bullet(a)?,
         Figure::Crater(a) => crater::crater(a)?,
+        Figure::Armour(a) => armour::armour(a)?,
         Figure::Weave(a) => weave::weave(a)?,
         Figure::Field(a) => {
             let (f, report) = field::build(a)?;
