@@ -301,29 +301,34 @@ impl Watch {
         w.failed = vec![0; w.n_layers + 1];
         w.broken = vec![0; w.n_layers + 1];
         w.first_failure = vec![f64::NAN; w.n_layers + 1];
-        let n = w.n_layers + 1;
-        let pl = &mut w.plies;
+        w.count_paths(m);
+        w.backed = m.node_sets.contains_key(super::crater::PROFILE_SET);
+        w
+    }
+
+    /// Per layer: its yarns on the path, where its back face starts along the strike and
+    /// whether a node of it starts on the path ([`PATH_FRACTION`]).
+    fn count_paths(&mut self, m: &Model) {
+        let n = self.n_layers + 1;
+        let pl = &mut self.plies;
         (pl.path_yarns, pl.cut_yarns) = (vec![0; n], vec![0; n]);
         (pl.back, pl.at) = (vec![f64::NEG_INFINITY; n], vec![f64::NAN; n]);
-        for (y, &(layer, _)) in w.yarns.iter().enumerate() {
+        for (y, &(layer, _)) in self.yarns.iter().enumerate() {
             if pl.on_path[y] {
                 pl.path_yarns[layer as usize] += 1;
             }
         }
         pl.path_nodes = vec![false; n];
-        if let Some(a) = w.axis {
-            for (i, x) in m.coords.iter().enumerate() {
-                let l = w.node_layer[i] as usize;
-                if l > 0 {
-                    pl.back[l] = pl.back[l].max(x[0] * a[0] + x[1] * a[1] + x[2] * a[2]);
-                    if let Some((p, a, r)) = w.shot {
-                        pl.path_nodes[l] |= lateral_distance(x, &p, &a) <= PATH_FRACTION * r;
-                    }
+        let Some(a) = self.axis else { return };
+        for (i, x) in m.coords.iter().enumerate() {
+            let l = self.node_layer[i] as usize;
+            if l > 0 {
+                pl.back[l] = pl.back[l].max(x[0] * a[0] + x[1] * a[1] + x[2] * a[2]);
+                if let Some((p, a, r)) = self.shot {
+                    pl.path_nodes[l] |= lateral_distance(x, &p, &a) <= PATH_FRACTION * r;
                 }
             }
         }
-        w.backed = m.node_sets.contains_key(super::crater::PROFILE_SET);
-        w
     }
 
     /// When layer `l` (1 = the strike face) was perforated ([`PATH_FRACTION`]): NaN
