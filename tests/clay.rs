@@ -436,6 +436,8 @@ fn a_ply_on_the_clay_presses_a_crater_that_follows_its_back_face() {
         "5e-6",
         "--backing",
         "clay",
+        "--projectile",
+        "rigid",
         "--clay-fine-half",
         "0.012",
         "--clay-fine-depth",

@@ -17,13 +17,15 @@ pub enum Projectile {
 pub struct BulletArgs {
     /// The projectile: a rigid shape, or a deformable 9 mm round-nose bullet of
     /// hexahedra (its diameter 2 × --projectile-radius, its mass --projectile-mass; docs/
-    /// theory.md, "The deformable bullet").
-    #[arg(long, value_enum, default_value_t = Projectile::Rigid)]
-    projectile: Projectile,
+    /// theory.md, "The deformable bullet") [default: deformable on the armour test's
+    /// clay (woven --backing clay), rigid otherwise].
+    #[arg(long, value_enum)]
+    projectile: Option<Projectile>,
     /// The deformable bullet: homogeneous (`lead`, the paper's) or a full metal jacket
-    /// (`fmj`: a core in a jacket).
-    #[arg(long, value_enum, default_value_t = BulletParams::default().kind)]
-    bullet: BulletKind,
+    /// (`fmj`: a core in a jacket) [default: fmj on the armour test's clay, the
+    /// standard's 9 mm FMJ RN; lead otherwise].
+    #[arg(long, value_enum)]
+    bullet: Option<BulletKind>,
     /// The bullet's metal (the core's for fmj).
     #[arg(long, value_enum, default_value_t = BulletParams::default().core)]
     bullet_material: Metal,
@@ -41,10 +43,16 @@ pub struct BulletArgs {
 impl BulletArgs {
     /// The bullet's parameters when deformable (diameter and mass are set from the
     /// projectile's flags by the generator); its flags are checked either way, so that a
-    /// bad value is not silently ignored with a rigid projectile.
-    pub fn params(&self) -> weft::error::Result<Option<BulletParams>> {
+    /// bad value is not silently ignored with a rigid projectile. `armour`: the pack is
+    /// on the armour test's clay, where the defaults are the standard's FMJ.
+    pub fn params(&self, armour: bool) -> weft::error::Result<Option<BulletParams>> {
+        let (projectile, kind) = if armour {
+            (Projectile::Deformable, BulletKind::Fmj)
+        } else {
+            (Projectile::Rigid, BulletParams::default().kind)
+        };
         let p = BulletParams {
-            kind: self.bullet,
+            kind: self.bullet.unwrap_or(kind),
             core: self.bullet_material,
             jacket: self.bullet_jacket,
             radial: self.bullet_radial,
@@ -52,6 +60,6 @@ impl BulletArgs {
             ..Default::default()
         };
         weft::generate::bullet::check(&p)?;
-        Ok((self.projectile == Projectile::Deformable).then_some(p))
+        Ok((self.projectile.unwrap_or(projectile) == Projectile::Deformable).then_some(p))
     }
 }

@@ -189,7 +189,11 @@ impl WovenBandArgs {
             },
             stop_on_outcome: self.ballistic.stop_on_outcome,
             // (Checked in `weave`, before the model is built.)
-            bullet: pr.bullet.params().ok().flatten(),
+            bullet: pr
+                .bullet
+                .params(self.backing == Backing::Clay)
+                .ok()
+                .flatten(),
             backing: (self.backing == Backing::Clay).then(|| clay::Backing {
                 clay: self
                     .clay
@@ -200,7 +204,9 @@ impl WovenBandArgs {
     }
 
     pub fn weave(&self) -> anyhow::Result<()> {
-        self.projectile.bullet.params()?;
+        self.projectile
+            .bullet
+            .params(self.backing == Backing::Clay)?;
         // The --clay-* flags are checked with or without --backing clay: a bad one is a
         // mistake either way.
         self.clay

@@ -164,7 +164,7 @@ impl WovenArgs {
             output_interval: run.output_interval,
             dt_safety: run.dt_safety,
             // (Checked in `weave`, before the model is built.)
-            bullet: pr.bullet.params().ok().flatten(),
+            bullet: pr.bullet.params(false).ok().flatten(),
             failure: ReducedFailure {
                 strain: self.failure_strain,
                 delay: self.ballistic.failure_delay,
@@ -175,7 +175,7 @@ impl WovenArgs {
     }
 
     pub fn weave(&self) -> anyhow::Result<()> {
-        self.projectile.bullet.params()?;
+        self.projectile.bullet.params(false)?;
         let p = self.params();
         let out = &self.out.out;
         let m = super::weave(&Spec::WovenReduced(p.clone()), out)?;

@@ -313,9 +313,9 @@ pub fn woven(p: &WovenBandParams) -> Result<(Model, WovenInfo)> {
 /// Lays the pack on the clay (`clay::clay_block`, part id 80): the clay's top a layer
 /// gap below the back ply's surface (its lowest node less half the contact thickness),
 /// the back ply's yarns and its membrane sheet against the clay's faces with the
-/// yarns' friction, and the pack's edges free (the clay holds it; the standard's straps
-/// hold nothing in a shot's fraction of a millisecond). The crater's profile is a
-/// history set.
+/// yarns' friction, a deformable bullet's nodes against them with its own, and the
+/// pack's edges free (the clay holds it; the standard's straps hold nothing in a shot's
+/// fraction of a millisecond). The crater's profile is a history set.
 fn back_with_clay(
     m: &mut Model,
     p: &WovenBandParams,
@@ -361,6 +361,18 @@ fn back_with_clay(
         }
         c.master_thickness = Some(0.0);
         m.contacts.push(c);
+    }
+    // A deformable bullet that perforates the pack meets the clay: its nodes against the
+    // clay's faces, with the projectile's friction (a rigid projectile meets every node,
+    // the clay's among them).
+    for name in ["bullet", "bullet_jacket"] {
+        if let Some(part) = m.parts.iter().position(|q| q.name == name) {
+            cid += 1;
+            let mut c =
+                ContactDef::new(cid, Slave::Part(part), clay).with_friction(p.projectile_friction);
+            c.master_thickness = Some(0.0);
+            m.contacts.push(c);
+        }
     }
     m.analysis.history_sets.push("clay_profile".into());
     Ok(())
