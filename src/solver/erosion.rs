@@ -9,7 +9,8 @@ use crate::model::ElementKind;
 
 impl Solver {
     /// The watch at a sample step (t_n, x^n, v^n): each layer's values into `rows` (layer
-    /// 1 first), the last layer's deflection peak, and the projectile's outcome.
+    /// 1 first), the last layer's deflection peak, the plies perforated and the
+    /// projectile's outcome.
     pub(super) fn watch_sample(&mut self, rows: &mut Vec<watch::LayerValues>) {
         let w = &self.watch;
         let axis = w.axis().unwrap_or([0.0, 0.0, -1.0]);
@@ -24,7 +25,6 @@ impl Solver {
             .map(|p| (p.tip, p.v_full, p.force, p.radius))
             .or_else(|| self.bullet_state());
         let tip_a = proj.map_or(f64::INFINITY, |p| dot(&p.0, &axis));
-        let w = &self.watch;
         let on_cap = w.cap_layers(&self.state.xn, tip_a);
         let (xn, vn, x0) = (&self.state.xn, &self.state.vn, &self.x0);
         let fr_s = self.op.surfaces.node_friction.as_deref();
