@@ -77,6 +77,36 @@ pub struct Verdict {
     pub reason: String,
 }
 
+impl Verdict {
+    /// `PASS`, `FAIL` or `no verdict`, then the reason in brackets when there is one:
+    /// how the binaries print it.
+    pub fn said(&self) -> String {
+        let word = match self.pass {
+            Some(true) => "PASS",
+            Some(false) => "FAIL",
+            None => "no verdict",
+        };
+        if self.reason.is_empty() {
+            word.into()
+        } else {
+            format!("{word} ({})", self.reason)
+        }
+    }
+}
+
+/// The verdict's columns both tables end with: `pass` and `reason`.
+fn verdict_columns(vs: &[Verdict]) -> [Col; 2] {
+    [
+        Col::OptBool("pass", vs.iter().map(|v| v.pass).collect()),
+        Col::OptStr(
+            "reason",
+            vs.iter()
+                .map(|v| (!v.reason.is_empty()).then(|| v.reason.clone()))
+                .collect(),
+        ),
+    ]
+}
+
 /// Judges the shot of the run folder `run` (its summary.parquet) at `level`, or, with
 /// none, at the level whose velocity band its striking velocity lies in (no verdict
 /// when it lies in neither).
@@ -174,39 +204,37 @@ pub fn write_armour_test(path: &Path, vs: &[Verdict], prov: &Provenance) -> Resu
     let f = |g: fn(&Verdict) -> f64| vs.iter().map(g).collect::<Vec<f64>>();
     write_table(
         path,
-        &batch(vec![
-            Col::I64("plies", vs.iter().map(|v| v.plies).collect()),
-            Col::OptF64(
-                "areal_density",
-                vs.iter().map(|v| v.areal_density).collect(),
-            ),
-            Col::F64("velocity", f(|v| v.striking_velocity)),
-            Col::OptStr(
-                "level",
-                vs.iter()
-                    .map(|v| v.level.map(|l| l.name().into()))
-                    .collect(),
-            ),
-            Col::Str("outcome", vs.iter().map(|v| v.outcome.clone()).collect()),
-            Col::Bool("perforated", vs.iter().map(|v| v.perforated).collect()),
-            Col::OptI64(
-                "plies_perforated",
-                vs.iter().map(|v| v.plies_perforated).collect(),
-            ),
-            Col::F64("bfs", f(|v| v.bfs)),
-            Col::F64("bfs_margin", f(|v| v.bfs_margin)),
-            Col::OptBool("pass", vs.iter().map(|v| v.pass).collect()),
-            Col::OptStr(
-                "reason",
-                vs.iter()
-                    .map(|v| (!v.reason.is_empty()).then(|| v.reason.clone()))
-                    .collect(),
-            ),
-            Col::Str(
+        &batch(
+            vec![
+                Col::I64("plies", vs.iter().map(|v| v.plies).collect()),
+                Col::OptF64(
+                    "areal_density",
+                    vs.iter().map(|v| v.areal_density).collect(),
+                ),
+                Col::F64("velocity", f(|v| v.striking_velocity)),
+                Col::OptStr(
+                    "level",
+                    vs.iter()
+                        .map(|v| v.level.map(|l| l.name().into()))
+                        .collect(),
+                ),
+                Col::Str("outcome", vs.iter().map(|v| v.outcome.clone()).collect()),
+                Col::Bool("perforated", vs.iter().map(|v| v.perforated).collect()),
+                Col::OptI64(
+                    "plies_perforated",
+                    vs.iter().map(|v| v.plies_perforated).collect(),
+                ),
+                Col::F64("bfs", f(|v| v.bfs)),
+                Col::F64("bfs_margin", f(|v| v.bfs_margin)),
+            ]
+            .into_iter()
+            .chain(verdict_columns(vs))
+            .chain([Col::Str(
                 "run",
                 vs.iter().map(|v| v.run.display().to_string()).collect(),
-            ),
-        ]),
+            )])
+            .collect(),
+        ),
         prov,
     )
 }
@@ -217,32 +245,30 @@ pub fn write(path: &Path, level: Level, vs: &[Verdict], prov: &Provenance) -> Re
     let f = |g: fn(&Verdict) -> f64| vs.iter().map(g).collect::<Vec<f64>>();
     write_table(
         path,
-        &batch(vec![
-            Col::Str(
-                "run",
-                vs.iter().map(|v| v.run.display().to_string()).collect(),
-            ),
-            Col::Str("level", vec![level.name().into(); n]),
-            Col::F64("velocity", vec![level.velocity(); n]),
-            Col::F64("velocity_tolerance", vec![VELOCITY_TOLERANCE; n]),
-            Col::F64("striking_velocity", f(|v| v.striking_velocity)),
-            Col::Bool(
-                "velocity_in_range",
-                vs.iter().map(|v| v.velocity_in_range).collect(),
-            ),
-            Col::Str("outcome", vs.iter().map(|v| v.outcome.clone()).collect()),
-            Col::Bool("perforated", vs.iter().map(|v| v.perforated).collect()),
-            Col::F64("bfs", f(|v| v.bfs)),
-            Col::F64("bfs_limit", vec![BFS_LIMIT; n]),
-            Col::F64("bfs_margin", f(|v| v.bfs_margin)),
-            Col::OptBool("pass", vs.iter().map(|v| v.pass).collect()),
-            Col::OptStr(
-                "reason",
-                vs.iter()
-                    .map(|v| (!v.reason.is_empty()).then(|| v.reason.clone()))
-                    .collect(),
-            ),
-        ]),
+        &batch(
+            vec![
+                Col::Str(
+                    "run",
+                    vs.iter().map(|v| v.run.display().to_string()).collect(),
+                ),
+                Col::Str("level", vec![level.name().into(); n]),
+                Col::F64("velocity", vec![level.velocity(); n]),
+                Col::F64("velocity_tolerance", vec![VELOCITY_TOLERANCE; n]),
+                Col::F64("striking_velocity", f(|v| v.striking_velocity)),
+                Col::Bool(
+                    "velocity_in_range",
+                    vs.iter().map(|v| v.velocity_in_range).collect(),
+                ),
+                Col::Str("outcome", vs.iter().map(|v| v.outcome.clone()).collect()),
+                Col::Bool("perforated", vs.iter().map(|v| v.perforated).collect()),
+                Col::F64("bfs", f(|v| v.bfs)),
+                Col::F64("bfs_limit", vec![BFS_LIMIT; n]),
+                Col::F64("bfs_margin", f(|v| v.bfs_margin)),
+            ]
+            .into_iter()
+            .chain(verdict_columns(vs))
+            .collect(),
+        ),
         prov,
     )
 }

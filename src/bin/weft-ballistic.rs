@@ -360,23 +360,14 @@ fn armour_cmd(a: ArmourArgs) -> anyhow::Result<ExitCode> {
     });
     for v in &vs {
         eprintln!(
-            "{:>3} plies at {:.0} m/s ({}): {}, {} plies perforated, BFS {:.1} mm: {}{}",
+            "{:>3} plies at {:.0} m/s ({}): {}, {} plies perforated, BFS {:.1} mm: {}",
             v.plies,
             v.striking_velocity,
             v.level.map_or("no level", |l| l.name()),
             v.outcome,
             v.plies_perforated.map_or("?".into(), |n| n.to_string()),
             1e3 * v.bfs,
-            match v.pass {
-                Some(true) => "PASS",
-                Some(false) => "FAIL",
-                None => "no verdict",
-            },
-            if v.reason.is_empty() {
-                String::new()
-            } else {
-                format!(" ({})", v.reason)
-            }
+            v.said()
         );
     }
     for level in [nij::Level::IIA, nij::Level::II] {
@@ -412,22 +403,13 @@ fn nij_cmd(a: NijArgs) -> anyhow::Result<ExitCode> {
         prov = prov.with_input(&run.join("summary.parquet"))?;
         let v = nij::judge(run, Some(a.level))?;
         eprintln!(
-            "{}: {:.1} m/s, {}, BFS {:.1} mm (margin {:+.1} mm): {}{}",
+            "{}: {:.1} m/s, {}, BFS {:.1} mm (margin {:+.1} mm): {}",
             run.display(),
             v.striking_velocity,
             v.outcome,
             1e3 * v.bfs,
             1e3 * v.bfs_margin,
-            match v.pass {
-                Some(true) => "PASS",
-                Some(false) => "FAIL",
-                None => "no verdict",
-            },
-            if v.reason.is_empty() {
-                String::new()
-            } else {
-                format!(" ({})", v.reason)
-            }
+            v.said()
         );
         verdicts.push(v);
     }
