@@ -7,6 +7,17 @@ use super::vec3::dot;
 use super::{failure, watch, Solver};
 use crate::model::ElementKind;
 
+/// The projectile as the watch judges it at a sample: its tip, velocity, the contact
+/// force on it and its radius; a deformable bullet's mass (`None`: a rigid projectile).
+#[derive(Debug, Clone, Copy)]
+struct Striker {
+    tip: [f64; 3],
+    v: [f64; 3],
+    force: [f64; 3],
+    radius: f64,
+    bullet_mass: Option<f64>,
+}
+
 impl Solver {
     /// The watch at a sample step (t_n, x^n, v^n): each layer's values into `rows` (layer
     /// 1 first), the last layer's deflection peak, the plies perforated and the
@@ -22,9 +33,15 @@ impl Solver {
             .projectiles
             .projectiles
             .first()
-            .map(|p| (p.tip, p.v_full, p.force, p.radius))
+            .map(|p| Striker {
+                tip: p.tip,
+                v: p.v_full,
+                force: p.force,
+                radius: p.radius,
+                bullet_mass: None,
+            })
             .or_else(|| self.bullet_state());
-        let tip_a = proj.map_or(f64::INFINITY, |p| dot(&p.0, &axis));
+        let tip_a = proj.map_or(f64::INFINITY, |p| dot(&p.tip, &axis));
         let on_cap = w.cap_layers(&self.state.xn, tip_a);
         let (xn, vn, x0) = (&self.state.xn, &self.state.vn, &self.x0);
         let fr_s = self.op.surfaces.node_friction.as_deref();
@@ -75,8 +92,14 @@ impl Solver {
         let t = self.state.t;
         let w = &mut self.watch;
         w.back_face_peak = w.back_face_peak.max(back);
-        if let Some((tip, v, f, radius)) = proj {
-            w.judge(t, &tip, &v, &f, radius, &on_cap);
+        if let Some(p) = proj {
+            // A deformable bullet: the contact forces' mean over the last samples, not
+            // their value now (fragments ring on its faces: `Watch::bullet_force`).
+            let f = p
+                .bullet_mass
+                .and_then(|m| w.bullet_force(t, &p.v, m))
+                .unwrap_or(p.force);
+            w.judge(t, &p.tip, &p.v, &f, p.radius, &on_cap);
         }
         for (l, r) in rows.iter_mut().enumerate() {
             r[9] = w.perforated_at(l + 1);
@@ -86,8 +109,8 @@ impl Solver {
 
     /// A deformable bullet as the watch judges it at t_n: its most advanced node's
     /// position as the tip, its momentum over its mass as the velocity, the contact forces
-    /// on its nodes summed, its radius.
-    fn bullet_state(&self) -> Option<([f64; 3], [f64; 3], [f64; 3], f64)> {
+    /// on its nodes summed, its radius, its mass.
+    fn bullet_state(&self) -> Option<Striker> {
         let w = &self.watch;
         let a = w.axis()?;
         if w.bullet.is_empty() {
@@ -107,7 +130,13 @@ impl Solver {
                 f[d] += fcon[i][d];
             }
         }
-        Some((tip, [p[0] / m, p[1] / m, p[2] / m], f, w.bullet_radius))
+        Some(Striker {
+            tip,
+            v: [p[0] / m, p[1] / m, p[2] / m],
+            force: f,
+            radius: w.bullet_radius,
+            bullet_mass: Some(m),
+        })
     }
 
     /// The failures of the force pass just done: logged, their nodes' attachments
