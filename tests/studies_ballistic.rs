@@ -58,7 +58,8 @@ fn limits(path: &Path, by: &str) -> BTreeMap<String, (f64, f64, f64)> {
 /// projectile velocity histories lowers that mismatch (the fit's last evaluation against
 /// its start), and the fitted girder's V50 lies nearer the reference's than the trial
 /// girder's, whose rods fail at the yarn's strain (a rod of a whole spacing, straight, is
-/// strained unlike the bands it stands for, so the yarn's strain is no more than a start).
+/// strained unlike the bands it stands for, so the yarn's strain is no more than a start),
+/// and equals the reference's within what the searches resolve (1 m/s).
 #[test]
 fn fitted_girder_v50_is_nearer_the_reference_than_the_trial_girder() {
     let dir = project_with("woven_reduced_ballistic.toml");
@@ -71,7 +72,7 @@ fn fitted_girder_v50_is_nearer_the_reference_than_the_trial_girder() {
             ("half_size = 0.05", "half_size = 0.02"),
             ("girder = 20", "girder = 8"),
             ("side = 0.1", "side = 0.04"),
-            ("tolerance = 2", "tolerance = 3"),
+            ("tolerance = 2", "tolerance = 1"),
             ("--max-evaluations 20", "--max-evaluations 12"),
             // No V50 of the combined models (6 and 8 crossings, woven but larger than
             // this reference of 5): the §3 test below judges that reduction.
@@ -89,6 +90,16 @@ fn fitted_girder_v50_is_nearer_the_reference_than_the_trial_girder() {
     assert!(
         (f - r).abs() < (t - r).abs(),
         "fitted {f} is not nearer the reference {r} than the trial {t}"
+    );
+    // The independent expectation: the fit matched the projectile's velocity history,
+    // not its limit, so a girder that stands for the reference (the paper's §5) has the
+    // reference's V50 to what the searches resolve: each is the middle of a bracket
+    // 1 m/s wide around its limit, so two equal limits give V50s within 1 m/s. Measured
+    // 2026-11-29: reference 20.1, fitted 20.4 (0.3 apart), the trial 22.2 (2.1 apart:
+    // this check alone tells it from the fitted girder).
+    assert!(
+        (f - r).abs() <= 1.0,
+        "the fitted girder's V50 {f:.2} m/s is not the reference's {r:.2} within the searches' 1 m/s"
     );
     let trace = Table::read(&out.join("fit/fit_trace.parquet")).unwrap();
     let obj = f64s(&trace, "T");
