@@ -174,6 +174,59 @@ fn a_truss_chain_breaks_at_its_failure_strain() {
     );
 }
 
+/// The rate law ε_f(ε̇) = ε_f (1 + C ln(ε̇/ε̇₀)) (docs/theory.md, "Rate dependence"),
+/// C = 0.146 at ε̇₀ = 30 s⁻¹ (the fit to Kevlar 49 fabric strips there). The strip of
+/// `a_truss_chain_breaks_at_its_failure_strain` pulled at 100 and at 1000 s⁻¹: the flaw
+/// fails where its strain reaches the law's threshold at the rate it is strained at,
+/// 0.8 ε_f (1 + C ln(ε̇/30)) with ε̇ = v/L, v the pull speed just before the failure (the
+/// end mass slows by 3 % or less by then). Measured: failed at 0.033733 at 96.8 s⁻¹ and
+/// 0.043582 at 999.5 s⁻¹, their limits 1.7·10⁻⁸ and 3.1·10⁻⁹ from the law at v/L (v
+/// sampled at the output before: tolerance 5·10⁻⁸), the strain above the limit by less
+/// than one step's increment; the quasi-static strip (no law) fails at 0.0288. (After the flaw
+/// breaks, the strip's ringing breaks others at 4–8 µs: their strain peaks, 0.038–0.041,
+/// come where the rate passes through zero and the threshold is back at ε_f: the law
+/// reads the rate at the step, docs/ballistic_convergence.md, "At armour velocity".)
+#[test]
+fn a_truss_fails_at_the_rate_laws_strain_for_the_rate_it_is_pulled_at() {
+    let (c, rate0) = (0.146, 30.0);
+    for speed in [1.0, 10.0] {
+        let (mut m, _) = truss_strip(10);
+        m.parts[0].props.failure_rate_coefficient = Some(c);
+        m.parts[0].props.failure_reference_rate = Some(rate0);
+        for iv in m.initial_velocities.iter_mut() {
+            iv.1[0] *= speed;
+        }
+        let law = |rate: f64| FLAW * EPS_F * (1.0 + c * (rate / rate0).ln());
+        // To the failure at the law's strain for the nominal rate, and 2 µs on.
+        m.analysis.end_time = 1.05 * law(speed * V / L) * L / (speed * V) + 2e-6;
+        m.analysis.output_interval = 5e-8;
+        let (s, out, _) = run_in_memory(&m).unwrap();
+        let ev = &s.failure_log().events;
+        assert!(!ev.is_empty(), "at {speed} m/s nothing failed");
+        // The flaw first.
+        let f = ev[0].failure;
+        assert_eq!((ev[0].id, f.criterion), (10, Criterion::Axial), "{ev:?}");
+        let tip = out.nodes.iter().position(|&i| i == 10).unwrap();
+        let vs = out.velocity_series(tip, 0);
+        let k = out.t.iter().position(|&t| t >= ev[0].time).unwrap();
+        let rate = vs[k - 1] / L;
+        let want = law(rate);
+        let inc = rate * s.time_step().dt;
+        println!(
+            "pulled at {rate:.1} 1/s: failed at {:.6} (limit {:.6}, {:.1e} from the law's {want:.6}), a step's increment {inc:.1e}",
+            f.value,
+            f.limit,
+            (f.limit - want).abs()
+        );
+        assert!(
+            (f.limit - want).abs() < 5e-8,
+            "limit {} against {want}",
+            f.limit
+        );
+        assert!(f.value >= f.limit && f.value - f.limit <= inc);
+    }
+}
+
 /// A band of quads (or of triangles, two per cell) along x on [0, L], `across` cells
 /// across its width w, material axis 1 along x (E₁ along, E₂ across, ν = 0), held at
 /// x = 0, y and z held everywhere (a uniaxial stretch); the last column flawed.
