@@ -5,7 +5,8 @@ One base shot (a quarter of 24 plies of aramid chains, 12 x 12 yarns failing at 
 the paper's §3 membrane out to 0.1 m, in air, struck at 398 m/s by the rigid 8 g round
 nose, run to its outcome), then one change at a time: the mesh, the failure
 regularisations, yarn friction, the far field's shear stiffness, the span, the patch, the
-yarns' strain-rate strengthening, the deformable bullet. Each case gives the residual
+yarns' strain-rate strengthening, the deformable bullet, the yarns as bands (membranes
+across their width, in contact on their lenticular faces) instead of truss chains. Each case gives the residual
 velocity v_r and the ballistic limit it implies by Lambert & Jonas with p = 2 (a rigid
 projectile whose lost kinetic energy is the pack's), V_bl = sqrt(v_s^2 - v_r^2), the
 whole pack's absorbed energy (4 x the quarter's), the plies perforated, the books and
@@ -15,7 +16,7 @@ docs/ballistic_convergence.md, "At armour velocity".
     python3 scripts/pack_physics.py --bin target/release --out runs/pack_physics
 
 Every case is a folder of its own under <out>; a case whose summary exists is not run
-again (delete the folder to rerun it). About 15 min on 2 cores.
+again (delete the folder to rerun it). About 30 min on 2 cores.
 """
 import argparse
 import math
@@ -54,6 +55,7 @@ CASES = [
     ("rate law (Kevlar 49 strips)", "physical", RATE),
     ("failure strain 0.045", "physical", ["--failure-strain", "0.045"]),
     ("FMJ bullet", "physical", ["--projectile", "deformable", "--bullet", "fmj"]),
+    ("band yarns", "physical", ["--yarn-model", "band"]),
 ]
 
 

@@ -156,8 +156,9 @@ pub struct Watch {
     /// The layers' values at the last sample.
     pub last_rows: Vec<LayerValues>,
     /// A deformable bullet's nodes (`Model::bullet_nodes`), judged as the projectile is:
-    /// its most advanced node as the tip, its mass-weighted velocity, the sum of the
-    /// contact forces on its nodes; empty with a rigid projectile or none.
+    /// its most advanced node as the tip, its mass-weighted velocity, the contact forces
+    /// on its nodes (their mean over the last samples, [`Watch::bullet_force`]); empty
+    /// with a rigid projectile or none.
     pub bullet: Vec<usize>,
     /// The bullet's radius about its axis (`striker::axis_point`) [m].
     pub bullet_radius: f64,
