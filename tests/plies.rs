@@ -72,6 +72,19 @@ fn perforated_times(b: &Table) -> Vec<Option<f64>> {
     first
 }
 
+/// The nodes of set `name` in the model at `model` (its `node_sets.parquet`).
+fn set_nodes(model: &std::path::Path, name: &str) -> Vec<i64> {
+    let sets = Table::read(&model.join("node_sets.parquet")).unwrap();
+    let (set, id) = (
+        sets.str("set", "").unwrap(),
+        sets.i64("node_id", "").unwrap(),
+    );
+    (0..id.len())
+        .filter(|&k| set[k] == name)
+        .map(|k| id[k])
+        .collect()
+}
+
 #[test]
 fn a_ply_is_perforated_exactly_when_the_projectile_goes_free() {
     // One ply, the rigid 9 mm nose: at 25 m/s it is arrested, no yarn breaks (the ply's
@@ -272,18 +285,10 @@ fn the_fmj_bullet_that_perforates_the_pack_ploughs_into_the_clay() {
         .into_iter()
         .zip(nodes.f64("z", "").unwrap())
         .collect();
-    let sets = Table::read(&m.join("node_sets.parquet")).unwrap();
-    let (set, id) = (
-        sets.str("set", "").unwrap(),
-        sets.i64("node_id", "").unwrap(),
-    );
-    let bullet: std::collections::HashSet<i64> = (0..id.len())
-        .filter(|&k| set[k] == "bullet")
-        .map(|k| id[k])
-        .collect();
-    let top = (0..id.len())
-        .filter(|&k| set[k] == "clay_profile")
-        .map(|k| z0[&id[k]])
+    let bullet: std::collections::HashSet<i64> = set_nodes(&m, "bullet").into_iter().collect();
+    let top = set_nodes(&m, "clay_profile")
+        .iter()
+        .map(|n| z0[n])
         .fold(f64::NEG_INFINITY, f64::max);
     let h = Table::read(&r.join("history.parquet")).unwrap();
     let (t, nid, uz, vz) = (
@@ -386,15 +391,8 @@ fn a_deformable_bullet_through_a_pack_in_air_goes_free_once_its_momentum_holds()
         "the last ply perforated at {last_ply} s, the bullet free at {free} s"
     );
     let v_r = s.f64("residual_velocity", "").unwrap()[0];
-    let m = dir.path().join("fmj-air");
-    let sets = Table::read(&m.join("node_sets.parquet")).unwrap();
-    let (set, id) = (
-        sets.str("set", "").unwrap(),
-        sets.i64("node_id", "").unwrap(),
-    );
-    let bullet: std::collections::HashSet<i64> = (0..id.len())
-        .filter(|&k| set[k] == "bullet")
-        .map(|k| id[k])
+    let bullet: std::collections::HashSet<i64> = set_nodes(&dir.path().join("fmj-air"), "bullet")
+        .into_iter()
         .collect();
     let h = Table::read(&dir.path().join("fmj-air-r/history.parquet")).unwrap();
     let (t, nid, vz) = (
